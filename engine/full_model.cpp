@@ -1,0 +1,310 @@
+// Builds the Simbody system of a scene: one mobilizer per scene joint (pin or slider),
+// loop closures as point-on-line constraints (two rows each, no redundancy), gears as
+// coordinate couplers or folded onto their driver, constraint actuators as prescribed
+// sliders, and the independent coordinate driven by a prescribed law when enabled.
+#include "engine/full_model_impl.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace rdyn::engine {
+
+using namespace SimTK;
+using models::JointType;
+
+Law poly_law(double q, double qdot, double qddot) { return Law(0, q, qdot, qddot, 0, 0); }
+Law harmonic_law(double c1, double c2, double c3, double c4, double c5) {
+  return Law(1, c1, c2, c3, c4, c5);
+}
+
+namespace {
+
+Vec3 v3(models::Vec2 p) { return Vec3(p.x, p.y, 0); }
+
+// Motion::Custom prescribing q(t) from a Law held in the State, so that changing the
+// law is a Stage::Time change (no re-realization of the instance).
+class LawMotion : public Motion::Custom::Implementation {
+ public:
+  LawMotion(const FullModel::Impl& impl, int slot) : impl_(impl), slot_(slot) {}
+  Motion::Level getLevel(const State&) const override { return Motion::Position; }
+  void realizeTopology(State& s) const override {
+    auto& idx = impl_.law_index;
+    if (static_cast<int>(idx.size()) <= slot_) idx.resize(slot_ + 1);
+    idx[slot_] = impl_.matter.allocateDiscreteVariable(s, Stage::Time, new Value<Law>(Law(0)));
+  }
+  void calcPrescribedPosition(const State& s, int nq, Real* q) const override {
+    q[0] = eval(s, 0);
+  }
+  void calcPrescribedPositionDot(const State& s, int nq, Real* qd) const override {
+    qd[0] = eval(s, 1);
+  }
+  void calcPrescribedPositionDotDot(const State& s, int nq, Real* qdd) const override {
+    qdd[0] = eval(s, 2);
+  }
+
+ private:
+  double eval(const State& s, int order) const {
+    const Law& c = Value<Law>::downcast(impl_.matter.getDiscreteVariable(s, impl_.law_index[slot_]));
+    const double t = s.getTime();
+    if (c[0] == 0) {  // c1 + c2 t + ½ c3 t²
+      return order == 0 ? c[1] + c[2] * t + 0.5 * c[3] * t * t : order == 1 ? c[2] + c[3] * t : c[3];
+    }
+    const double ph = c[4] * t + c[5];  // c1 + c2 t + c3 cos(c4 t + c5)
+    return order == 0   ? c[1] + c[2] * t + c[3] * std::cos(ph)
+           : order == 1 ? c[2] - c[3] * c[4] * std::sin(ph)
+                        : -c[3] * c[4] * c[4] * std::cos(ph);
+  }
+  const FullModel::Impl& impl_;
+  int slot_;
+};
+
+// Planar rigid body: mass, centre of mass and centroidal z inertia; the out-of-plane
+// moments are set equal to Izz (any valid value works: rotation stays about z).
+MassProperties planar_mass(double m, models::Vec2 com, double Izz_c, double extra_Izz) {
+  Inertia about_origin = Inertia(Izz_c).shiftFromMassCenter(v3(com), m);
+  if (extra_Izz > 0) about_origin += Inertia(extra_Izz);  // massless: same about any point
+  return MassProperties(m, v3(com), about_origin);
+}
+
+}  // namespace
+
+FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
+    : scene(s), options(o), matter(system), forces(system) {
+  const size_t nj = scene.joints.size(), nb = scene.bodies.size();
+  joint_mobod.resize(nj);
+  body_mobod.resize(nb);
+  joint_fold.resize(nj);
+  body_fold.resize(nb);
+  independent = scene.joint_index(scene.independent);
+
+  // 1. Which geared bodies can be folded onto their driver: a leaf turning about a fixed
+  //    axis through its centre of mass, touched by nothing else, whose motion is not
+  //    requested. Its kinetic energy ½ I (r u)² becomes ½ (r² I) u² on the driver.
+  std::vector<double> extra_inertia(nb, 0.0);
+  std::vector<bool> gear_folded(scene.gears.size(), false);
+  for (size_t g = 0; g < scene.gears.size() && options.fold_geared_bodies; ++g) {
+    const auto& gear = scene.gears[g];
+    const int jd = scene.joint_index(gear.driven), jr = scene.joint_index(gear.driver);
+    const auto& driven = scene.joints[jd];
+    const auto& driver = scene.joints[jr];
+    const int b = scene.body_index(driven.child);
+    const auto& body = scene.bodies[b];
+    bool ok = driven.parent == models::kGround && driver.parent == models::kGround &&
+              std::hypot(body.com_m.x - driven.child_point.x, body.com_m.y - driven.child_point.y) < 1e-12;
+    for (const auto& name : scene.outputs.bodies) ok &= name != body.name;
+    for (const auto& j : scene.joints) ok &= j.parent != body.name;
+    for (const auto& l : scene.loops) ok &= l.body_a != body.name && l.body_b != body.name;
+    for (const auto& sp : scene.springs) ok &= sp.body_a != body.name && sp.body_b != body.name;
+    for (const auto& t : scene.joint_torques) ok &= t.joint != driven.name && (!t.active_when || t.active_when->joint != driven.name);
+    for (const auto& m : scene.motors) ok &= m.joint != driven.name;
+    for (const auto& g2 : scene.gears) ok &= &g2 == &gear || (g2.driver != driven.name && g2.driven != driven.name);
+    for (const auto& c : scene.outputs.constraint_forces) ok &= c.joint != driven.name;
+    ok &= driven.name != scene.independent;
+    if (!ok) continue;
+    Fold f{b, jd, jr, gear.ratio, driven.guess - gear.ratio * driver.guess};
+    joint_fold[jd] = f;
+    body_fold[b] = f;
+    gear_folded[g] = true;
+    extra_inertia[scene.body_index(driver.child)] += gear.ratio * gear.ratio * body.inertia_kgm2;
+  }
+
+  // 2. Mobilizers in tree order (parents first).
+  std::vector<bool> built(nj, false);
+  for (size_t pass = 0, done = 0; done < nj && pass <= nj; ++pass) {
+    for (size_t j = 0; j < nj; ++j) {
+      const auto& jt = scene.joints[j];
+      if (built[j]) continue;
+      if (joint_fold[j]) { built[j] = true; ++done; continue; }
+      if (jt.parent != models::kGround && !body_mobod[scene.body_index(jt.parent)].isInSubsystem())
+        continue;
+      MobilizedBody parent = jt.parent == models::kGround ? MobilizedBody(matter.updGround())
+                                                          : body_mobod[scene.body_index(jt.parent)];
+      const int b = scene.body_index(jt.child);
+      const auto& bd = scene.bodies[b];
+      const Body::Rigid info(planar_mass(bd.mass_kg, bd.com_m, bd.inertia_kgm2, extra_inertia[b]));
+      int request = -1;
+      for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k)
+        if (scene.outputs.constraint_forces[k].joint == jt.name) request = static_cast<int>(k);
+
+      if (jt.type == JointType::Prismatic) {
+        const Rotation R(std::atan2(jt.axis.y, jt.axis.x), ZAxis);
+        MobilizedBody::Slider mb(parent, Transform(R, v3(jt.parent_point)), info,
+                                 Transform(R, v3(jt.child_point)));
+        joint_mobod[j] = body_mobod[b] = mb;
+      } else if (request >= 0 && options.route == ConstraintForceRoute::Actuator) {
+        // Constraint actuator: pin to a massless frame turned so its x is the requested
+        // direction, then a slider along it carrying the child. R_PB = Rz(offset+a)Rz(q)Rz(−a).
+        const auto& d = scene.outputs.constraint_forces[request].direction;
+        const double a = std::atan2(d.y, d.x);
+        MobilizedBody::Pin pin(parent, Transform(Rotation(jt.offset_rad + a, ZAxis), v3(jt.parent_point)),
+                               Body::Massless(), Transform());
+        MobilizedBody::Slider slider(pin, Transform(), info,
+                                     Transform(Rotation(a, ZAxis), v3(jt.child_point)));
+        joint_mobod[j] = pin;
+        body_mobod[b] = slider;
+        if (static_cast<int>(actuator_slider.size()) <= request) actuator_slider.resize(request + 1);
+        actuator_slider[request] = slider;
+      } else {
+        MobilizedBody::Pin mb(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)), info,
+                              Transform(v3(jt.child_point)));
+        joint_mobod[j] = body_mobod[b] = mb;
+      }
+      built[j] = true;
+      ++done;
+    }
+  }
+
+  // 3. Loop closures: a point of body_b stays on the z line through a point of body_a:
+  //    the two in-plane rows of a planar revolute, without Ball's redundant third row.
+  for (const auto& l : scene.loops) {
+    MobilizedBody a = l.body_a == models::kGround ? MobilizedBody(matter.updGround())
+                                                   : body_mobod[scene.body_index(l.body_a)];
+    MobilizedBody b = l.body_b == models::kGround ? MobilizedBody(matter.updGround())
+                                                   : body_mobod[scene.body_index(l.body_b)];
+    Constraint::PointOnLine(a, UnitVec3(ZAxis), v3(l.point_a), b, v3(l.point_b));
+  }
+  // 4. Gears that were not folded: q_driven − r·q_driver − c = 0.
+  for (size_t g = 0; g < scene.gears.size(); ++g) {
+    if (gear_folded[g]) continue;
+    const auto& gear = scene.gears[g];
+    const int jr = scene.joint_index(gear.driver), jd = scene.joint_index(gear.driven);
+    Vector coeff(3);
+    coeff[0] = -gear.ratio;
+    coeff[1] = 1.0;
+    coeff[2] = -(scene.joints[jd].guess - gear.ratio * scene.joints[jr].guess);
+    std::vector<MobilizedBodyIndex> mbs{joint_mobod[jr].getMobilizedBodyIndex(),
+                                        joint_mobod[jd].getMobilizedBodyIndex()};
+    std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
+    Constraint::CoordinateCoupler(matter, new Function::Linear(coeff), mbs, qs);
+  }
+
+  // 5. Prescribed laws: the independent coordinate (enabled for kinetostatic calls,
+  //    disabled for forward dynamics) and each constraint actuator (always x = 0).
+  independent_motion = Motion::Custom(joint_mobod[independent], new LawMotion(*this, 0));
+  for (size_t k = 0; k < actuator_slider.size(); ++k)
+    actuator_motion.push_back(Motion::Custom(actuator_slider[k], new LawMotion(*this, 1 + static_cast<int>(k))));
+
+  add_scene_loads(*this);
+
+  try {
+    default_state = system.realizeTopology();
+    system.realizeModel(default_state);
+  } catch (const std::exception& e) {
+    throw EngineError(std::string("Simbody could not build the system: ") + e.what());
+  }
+}
+
+const MobilizedBody& FullModel::Impl::mobod_of(const std::string& body) const {
+  if (body == models::kGround) return matter.getGround();
+  return body_mobod[scene.body_index(body)];
+}
+
+double FullModel::Impl::joint_q(const State& s, int j) const {
+  if (const auto& f = joint_fold[j]) return f->ratio * joint_q(s, f->driver_joint) + f->q_offset;
+  return joint_mobod[j].getOneQ(s, MobilizerQIndex(0));
+}
+
+double FullModel::Impl::joint_u(const State& s, int j) const {
+  if (const auto& f = joint_fold[j]) return f->ratio * joint_u(s, f->driver_joint);
+  return joint_mobod[j].getOneU(s, MobilizerUIndex(0));
+}
+
+double FullModel::Impl::body_rate(const State& s, int b) const {
+  if (const auto& f = body_fold[b]) return f->ratio * joint_u(s, f->driver_joint);
+  return body_mobod[b].getBodyAngularVelocity(s)[2];
+}
+
+void FullModel::Impl::set_law(State& s, int which, const Law& law) const {
+  Value<Law>::updDowncast(matter.updDiscreteVariable(s, law_index[which])) = law;
+}
+
+void FullModel::Impl::set_load_mode(State& s, LoadMode mode) const {
+  Value<int>::updDowncast(forces.updDiscreteVariable(s, load_mode_index)) = mode;
+}
+
+void FullModel::Impl::set_gate(State& s, int torque, bool on) const {
+  Value<bool>::updDowncast(forces.updDiscreteVariable(s, gate_index[torque])) = on;
+}
+
+bool FullModel::Impl::gate(const State& s, int torque) const {
+  return Value<bool>::downcast(forces.getDiscreteVariable(s, gate_index[torque]));
+}
+
+double FullModel::Impl::work(const State& s) const { return forces.getZ(s)[work_index]; }
+
+std::vector<double> FullModel::Impl::constraint_forces(const State& s) const {
+  const auto& req = scene.outputs.constraint_forces;
+  std::vector<double> out(req.size());
+  if (options.route == ConstraintForceRoute::Actuator) {
+    // Simbody's multipliers sit on the left (M u̇ + Gᵀλ + τ = f): actuator force = −τ.
+    for (size_t k = 0; k < req.size(); ++k) out[k] = -actuator_slider[k].getOneTau(s, MobilizerUIndex(0));
+    return out;
+  }
+  Vector_<SpatialVec> reactions;
+  matter.calcMobilizerReactionForces(s, reactions);
+  for (size_t k = 0; k < req.size(); ++k) {
+    const auto& jt = scene.joints[scene.joint_index(req[k].joint)];
+    const MobilizedBody& child = body_mobod[scene.body_index(jt.child)];
+    const Vec3 d_G = child.getBodyRotation(s) * v3(req[k].direction);
+    out[k] = dot(reactions[child.getMobilizedBodyIndex()][1], d_G);  // force on child at M, in G
+  }
+  return out;
+}
+
+std::pair<double, std::string> FullModel::Impl::worst_loop_gap(const State& s) const {
+  std::pair<double, std::string> worst{0.0, ""};
+  for (const auto& l : scene.loops) {
+    const Vec3 pa = mobod_of(l.body_a).findStationLocationInGround(s, v3(l.point_a));
+    const Vec3 pb = mobod_of(l.body_b).findStationLocationInGround(s, v3(l.point_b));
+    const double gap = (pa - pb).norm();
+    if (gap >= worst.first) worst = {gap, l.name};
+  }
+  return worst;
+}
+
+FullModel::FullModel(const models::Scene& scene, FullModelOptions options)
+    : impl_(std::make_unique<Impl>(scene, options)) {}
+FullModel::~FullModel() = default;
+const models::Scene& FullModel::scene() const { return impl_->scene; }
+const FullModelOptions& FullModel::options() const { return impl_->options; }
+int FullModel::num_simbody_bodies() const { return impl_->matter.getNumBodies() - 1; }
+bool FullModel::is_folded(const std::string& body) const {
+  const int b = impl_->scene.body_index(body);
+  return b >= 0 && impl_->body_fold[b].has_value();
+}
+
+FullWorkspace::FullWorkspace(const FullModel& model)
+    : impl_(std::make_unique<Impl>(model.impl())) {
+  const auto& m = model.impl();
+  State& s = impl_->state;
+  // Start from the scene's guesses (they pick the branch, e.g. knee in front), with the
+  // independent coordinate at its initial value and every constraint actuator at x = 0.
+  for (size_t j = 0; j < m.scene.joints.size(); ++j)
+    if (!m.joint_fold[j]) m.joint_mobod[j].setOneQ(s, MobilizerQIndex(0), m.scene.joints[j].guess);
+  m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.initial.q);
+  m.set_law(s, 0, poly_law(m.scene.initial.q, 0.0, 0.0));
+  Assembler assembler(m.system);
+  assembler.setAccuracy(1e-12);
+  assembler.lockMobilizer(m.joint_mobod[m.independent].getMobilizedBodyIndex());
+  for (const auto& sl : m.actuator_slider) assembler.lockMobilizer(sl.getMobilizedBodyIndex());
+  try {
+    assembler.initialize(s);
+    assembler.assemble();
+  } catch (const std::exception&) {
+    // Fall through: the gap check below reports which loop fails and by how much.
+  }
+  assembler.updateFromInternalState(s);
+  m.system.realize(s, Stage::Position);
+  const auto [gap, loop] = m.worst_loop_gap(s);
+  if (gap > 1e-8) {
+    throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {:.6g}: gap {:.6g} m "
+                                  "(check lengths and ground points)",
+                                  m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
+  }
+}
+
+FullWorkspace::~FullWorkspace() = default;
+FullWorkspace::FullWorkspace(FullWorkspace&&) noexcept = default;
+
+}  // namespace rdyn::engine

@@ -1,0 +1,73 @@
+// Full multibody model of a scene, built on Simbody (kept behind this header: no Simbody
+// type appears here). A FullModel is the immutable description (the Simbody system); a
+// FullWorkspace is the per-run state (configuration, continued from call to call).
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "models/scene.hpp"
+
+namespace rdyn::engine {
+
+// How requested constraint forces are computed.
+//  Actuator: the joint becomes a pin plus a slider along the requested direction whose
+//            coordinate x is prescribed to stay 0 (the paper's "constraint actuator");
+//            F_E = −τ_x, Simbody's motion multiplier.
+//  Reaction: plain pin; F_E = Simbody's mobilizer reaction projected on the direction.
+enum class ConstraintForceRoute { Actuator, Reaction };
+
+struct FullModelOptions {
+  ConstraintForceRoute route = ConstraintForceRoute::Actuator;
+  // Reduce a geared body whose own motion is not requested onto its driver
+  // (inertia r²·I), instead of simulating it as its own body with a gear constraint.
+  bool fold_geared_bodies = true;
+};
+
+// Failure of the engine on a valid scene (loop cannot close, dead point reached...).
+class EngineError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class FullModel {
+ public:
+  // Builds and realizes the Simbody system. Throws EngineError.
+  explicit FullModel(const models::Scene& scene, FullModelOptions options = {});
+  ~FullModel();
+  FullModel(const FullModel&) = delete;
+  FullModel& operator=(const FullModel&) = delete;
+
+  const models::Scene& scene() const;
+  const FullModelOptions& options() const;
+  // Bodies simulated as Simbody bodies (folded ones excluded).
+  int num_simbody_bodies() const;
+  bool is_folded(const std::string& body) const;
+
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// Per-run workspace: a Simbody state assembled on the scene's branch. Kinetostatic calls
+// continue from the previous configuration (Newton projection, no fresh assembly).
+class FullWorkspace {
+ public:
+  // Assembles at the scene's initial q. Throws EngineError naming the loop that cannot
+  // close and its gap in metres.
+  explicit FullWorkspace(const FullModel& model);
+  ~FullWorkspace();
+  FullWorkspace(FullWorkspace&&) noexcept;
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rdyn::engine

@@ -1,0 +1,94 @@
+// Internal to engine/: the Simbody objects behind FullModel. Includes Simbody.
+#pragma once
+
+#include <Simbody.h>
+
+#include <optional>
+#include <vector>
+
+#include "engine/full_model.hpp"
+
+namespace rdyn::engine {
+
+// Prescribed law of one coordinate, stored in the State (Stage::Time discrete variable):
+// [kind, c1..c5]. kind 0: q = c1 + c2 t + ½ c3 t²  (a kinetostatic point at t = 0: q, q̇, q̈);
+// kind 1: q = c1 + c2 t + c3 cos(c4 t + c5)  (the original authors' sweep law).
+using Law = SimTK::Vec6;
+Law poly_law(double q, double qdot, double qddot);
+Law harmonic_law(double c1, double c2, double c3, double c4, double c5);
+
+// Load modes of the SceneLoads force (Stage::Dynamics discrete variable).
+enum LoadMode : int {
+  kLoadsOff = 0,           // purely inertial (reduced-parameter extraction)
+  kLoadsConservative = 1,  // gravity and springs only
+  kLoadsInstant = 2,       // everything; rate gates from the instantaneous rate sign
+  kLoadsEvents = 3,        // everything; rate gates from flags switched by events
+};
+
+// A body reduced onto its driver joint through a gear of ratio r.
+struct Fold {
+  int body = -1;          // scene body index
+  int driven_joint = -1;  // scene joint index of the folded body's joint
+  int driver_joint = -1;
+  double ratio = 1.0;
+  double q_offset = 0.0;  // q_driven = r·q_driver + q_offset
+};
+
+struct FullModel::Impl {
+  models::Scene scene;
+  FullModelOptions options;
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter;
+  SimTK::GeneralForceSubsystem forces;
+
+  std::vector<SimTK::MobilizedBody> joint_mobod;  // per scene joint: owner of its coordinate
+  std::vector<SimTK::MobilizedBody> body_mobod;   // per scene body
+  std::vector<std::optional<Fold>> joint_fold;    // per scene joint
+  std::vector<std::optional<Fold>> body_fold;     // per scene body
+  std::vector<SimTK::MobilizedBody> actuator_slider;  // per constraint force (Actuator)
+  std::vector<SimTK::Motion::Custom> actuator_motion;
+  SimTK::Motion::Custom independent_motion;
+  int independent = -1;  // scene joint index
+
+  // Indices allocated at realizeTopology (mutable: set by the const realize callbacks).
+  mutable std::vector<SimTK::DiscreteVariableIndex> law_index;  // [0] independent, [1+k] slider k
+  mutable SimTK::DiscreteVariableIndex load_mode_index;
+  mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;  // per joint torque (if gated)
+  mutable SimTK::ZIndex work_index;
+
+  SimTK::State default_state;
+
+  Impl(const models::Scene& s, FullModelOptions o);
+
+  // Simbody mobilized body of a scene body name (Ground for "ground").
+  const SimTK::MobilizedBody& mobod_of(const std::string& body) const;
+  // Coordinate and rate of a scene joint (folded joints through their gear).
+  double joint_q(const SimTK::State& s, int joint) const;
+  double joint_u(const SimTK::State& s, int joint) const;
+  // Angular rate of a scene body about z (folded bodies through their gear).
+  double body_rate(const SimTK::State& s, int body) const;
+
+  void set_law(SimTK::State& s, int which, const Law& law) const;  // 0 indep, 1+k slider k
+  void set_load_mode(SimTK::State& s, LoadMode mode) const;
+  void set_gate(SimTK::State& s, int torque, bool on) const;
+  bool gate(const SimTK::State& s, int torque) const;
+  double work(const SimTK::State& s) const;
+
+  // Requested constraint forces at a state realized to Acceleration [N].
+  std::vector<double> constraint_forces(const SimTK::State& s) const;
+  // Largest loop-closure gap [m] and the loop's name, at a state realized to Position.
+  std::pair<double, std::string> worst_loop_gap(const SimTK::State& s) const;
+};
+
+struct FullWorkspace::Impl {
+  const FullModel::Impl& model;
+  SimTK::State state;
+  explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
+};
+
+// Adds the scene's loads as one custom force (engine/scene_loads.cpp).
+void add_scene_loads(FullModel::Impl& impl);
+// Generalized power of the non-conservative loads [W] (for the work integral).
+double non_conservative_power(const FullModel::Impl& impl, const SimTK::State& s);
+
+}  // namespace rdyn::engine

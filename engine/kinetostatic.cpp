@@ -1,0 +1,110 @@
+#include "engine/kinetostatic.hpp"
+
+#include <fmt/format.h>
+
+#include "engine/full_model_impl.hpp"
+
+namespace rdyn::engine {
+
+using namespace SimTK;
+
+namespace {
+
+LoadMode mode_of(Loads l) {
+  return l == Loads::Off ? kLoadsOff : l == Loads::Conservative ? kLoadsConservative : kLoadsInstant;
+}
+
+// Applies the prescribed laws (already stored in the state) and projects q and u onto the
+// constraint manifold, starting from the previous configuration.
+void project(const FullModel::Impl& m, State& s, double q_for_message) {
+  try {
+    m.system.realize(s, Stage::Time);
+    m.system.project(s, 1e-12);
+  } catch (const std::exception& e) {
+    throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                  "(dead point or a loop that cannot close): {}",
+                                  m.scene.source_file, m.scene.independent, q_for_message, e.what()));
+  }
+}
+
+KinetostaticResult collect(const FullModel::Impl& m, const State& s) {
+  m.system.realize(s, Stage::Acceleration);
+  KinetostaticResult r;
+  // Motion multipliers sit on the left (M u̇ + Gᵀλ + τ = f): the actuator supplies −τ.
+  r.driving_force = -m.joint_mobod[m.independent].getOneTau(s, MobilizerUIndex(0));
+  r.constraint_forces = m.constraint_forces(s);
+  const size_t nj = m.scene.joints.size();
+  r.joint_q.resize(nj);
+  r.joint_u.resize(nj);
+  for (size_t j = 0; j < nj; ++j) {
+    r.joint_q[j] = m.joint_q(s, static_cast<int>(j));
+    r.joint_u[j] = m.joint_u(s, static_cast<int>(j));
+  }
+  r.kinetic_energy = m.system.calcKineticEnergy(s);
+  // Folded bodies: ½ r² I u² is already in the driver's inertia.
+  r.potential_energy = m.system.calcPotentialEnergy(s);
+  return r;
+}
+
+void ensure_kinetostatic_mode(const FullModel::Impl& m, State& s) {
+  if (m.independent_motion.isDisabled(s)) {
+    m.independent_motion.enable(s);
+    m.system.realizeModel(s);
+  }
+}
+
+}  // namespace
+
+KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, double q, double qdot,
+                                     double qddot, Loads loads) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  m.set_law(s, 0, poly_law(q, qdot, qddot));
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.set_load_mode(s, mode_of(loads));
+  project(m, s, q);
+  return collect(m, s);
+}
+
+VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  const size_t nj = m.scene.joints.size(), nx = m.actuator_slider.size();
+  auto rates = [&] {
+    std::vector<double> u(nj);
+    for (size_t j = 0; j < nj; ++j) u[j] = m.joint_u(s, static_cast<int>(j));
+    return u;
+  };
+  VelocityRatios out;
+  m.set_law(s, 0, poly_law(q, 1.0, 0.0));
+  for (size_t k = 0; k < nx; ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  project(m, s, q);
+  out.wrt_q = rates();
+  for (size_t k = 0; k < nx; ++k) {
+    m.set_law(s, 0, poly_law(q, 0.0, 0.0));
+    for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, i == k ? 1.0 : 0.0, 0));
+    project(m, s, q);
+    out.wrt_x.push_back(rates());
+  }
+  for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, 0, 0));
+  return out;
+}
+
+KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws, const double c[5],
+                                             double t, Loads loads) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  ensure_kinetostatic_mode(m, s);
+  m.set_law(s, 0, harmonic_law(c[0], c[1], c[2], c[3], c[4]));
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.set_load_mode(s, mode_of(loads));
+  s.setTime(t);
+  project(m, s, c[0] + c[1] * t + c[2] * std::cos(c[3] * t + c[4]));
+  return collect(m, s);
+}
+
+}  // namespace rdyn::engine

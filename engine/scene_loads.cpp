@@ -1,0 +1,186 @@
+// The scene's applied loads as one Simbody custom force. Its mode, its rate-gate flags and
+// the work of the non-conservative loads live in the State, so kinetostatic calls can
+// switch loads off (purely inertial parameters) and forward dynamics can integrate
+// W(t) = ∫ P_nc dt next to the motion for the energy balance E(t) − E(0) = W(t).
+#include <cmath>
+
+#include "engine/full_model_impl.hpp"
+
+namespace rdyn::engine {
+
+using namespace SimTK;
+
+namespace {
+
+Vec3 v3(models::Vec2 p) { return Vec3(p.x, p.y, 0); }
+
+double resistance_torque(const models::Resistance& r, double omega) {
+  switch (r.law) {
+    case models::ResistanceLaw::Constant: return omega > 0 ? -r.coefficient : omega < 0 ? r.coefficient : 0.0;
+    case models::ResistanceLaw::Viscous: return -r.coefficient * omega;
+    case models::ResistanceLaw::Quadratic: return -r.coefficient * omega * std::abs(omega);
+  }
+  return 0.0;
+}
+
+int load_mode(const FullModel::Impl& m, const State& s) {
+  return Value<int>::downcast(m.forces.getDiscreteVariable(s, m.load_mode_index));
+}
+
+bool torque_active(const FullModel::Impl& m, const State& s, int i, int mode) {
+  const auto& t = m.scene.joint_torques[i];
+  if (!t.active_when) return true;
+  if (mode == kLoadsEvents) return m.gate(s, i);
+  const double rate = m.joint_u(s, m.scene.joint_index(t.active_when->joint));
+  return t.active_when->sign * rate > 0.0;
+}
+
+// Generalized force on a scene joint's coordinate; a folded joint's load goes to its
+// driver by virtual power (τ_driver = r·τ_driven).
+void add_joint_force(const FullModel::Impl& m, const State& s, int joint, double tau, Vector& mobility) {
+  if (const auto& f = m.joint_fold[joint]) return add_joint_force(m, s, f->driver_joint, f->ratio * tau, mobility);
+  m.joint_mobod[joint].applyOneMobilityForce(s, 0, tau, mobility);
+}
+
+class SceneLoads : public Force::Custom::Implementation {
+ public:
+  explicit SceneLoads(const FullModel::Impl& m) : m_(m) {}
+
+  void realizeTopology(State& s) const override {
+    auto& mm = const_cast<FullModel::Impl&>(m_);
+    mm.load_mode_index = m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<int>(kLoadsEvents));
+    mm.gate_index.clear();
+    for (size_t i = 0; i < m_.scene.joint_torques.size(); ++i)
+      mm.gate_index.push_back(m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<bool>(true)));
+    mm.work_index = m_.forces.allocateZ(s, Vector(1, 0.0));
+  }
+
+  void realizeAcceleration(const State& s) const override {
+    // dW/dt = power of the non-conservative loads (forward dynamics' work integral).
+    s.updZDot(m_.forces.getMySubsystemIndex())[m_.work_index] = non_conservative_power(m_, s);
+  }
+
+  void calcForce(const State& s, Vector_<SpatialVec>& body_forces, Vector_<Vec3>&,
+                 Vector& mobility) const override {
+    const int mode = load_mode(m_, s);
+    if (mode == kLoadsOff) return;
+    const auto& sc = m_.scene;
+    if (sc.gravity.enabled) {
+      const Vec3 g = v3(sc.gravity.g_m_s2);
+      for (size_t b = 0; b < sc.bodies.size(); ++b) {
+        if (m_.body_fold[b]) continue;  // folded bodies turn about their centre of mass
+        const auto& mb = m_.body_mobod[b];
+        mb.applyForceToBodyPoint(s, v3(sc.bodies[b].com_m), sc.bodies[b].mass_kg * g, body_forces);
+      }
+    }
+    for (const auto& sp : sc.springs) {
+      const auto& a = m_.mobod_of(sp.body_a);
+      const auto& b = m_.mobod_of(sp.body_b);
+      const Vec3 pa = a.findStationLocationInGround(s, v3(sp.point_a));
+      const Vec3 pb = b.findStationLocationInGround(s, v3(sp.point_b));
+      const Vec3 d = pb - pa;
+      const double L = d.norm();
+      if (L < 1e-15) continue;
+      const Vec3 f_on_b = -sp.stiffness_N_per_m * (L - sp.rest_length_m) * (d / L);
+      a.applyForceToBodyPoint(s, v3(sp.point_a), -f_on_b, body_forces);
+      b.applyForceToBodyPoint(s, v3(sp.point_b), f_on_b, body_forces);
+    }
+    if (mode == kLoadsConservative) return;
+    for (size_t i = 0; i < sc.joint_torques.size(); ++i)
+      if (torque_active(m_, s, static_cast<int>(i), mode))
+        add_joint_force(m_, s, sc.joint_index(sc.joint_torques[i].joint), sc.joint_torques[i].value, mobility);
+    for (const auto& mo : sc.motors) {
+      const int j = sc.joint_index(mo.joint);
+      add_joint_force(m_, s, j, mo.stall_torque * (1.0 - m_.joint_u(s, j) / mo.no_load_speed), mobility);
+    }
+    for (const auto& r : sc.resistances) {
+      const int b = sc.body_index(r.body);
+      const double T = resistance_torque(r, m_.body_rate(s, b));
+      if (const auto& f = m_.body_fold[b]) {
+        add_joint_force(m_, s, f->driven_joint, T, mobility);
+      } else {
+        m_.body_mobod[b].applyBodyTorque(s, Vec3(0, 0, T), body_forces);
+      }
+    }
+  }
+
+  Real calcPotentialEnergy(const State& s) const override {
+    if (load_mode(m_, s) == kLoadsOff) return 0.0;
+    const auto& sc = m_.scene;
+    double V = 0.0;
+    if (sc.gravity.enabled) {
+      const Vec3 g = v3(sc.gravity.g_m_s2);
+      for (size_t b = 0; b < sc.bodies.size(); ++b) {
+        if (m_.body_fold[b]) continue;
+        const Vec3 p = m_.body_mobod[b].findStationLocationInGround(s, v3(sc.bodies[b].com_m));
+        V -= sc.bodies[b].mass_kg * dot(g, p);  // V = −m g·p
+      }
+    }
+    for (const auto& sp : sc.springs) {
+      const Vec3 pa = m_.mobod_of(sp.body_a).findStationLocationInGround(s, v3(sp.point_a));
+      const Vec3 pb = m_.mobod_of(sp.body_b).findStationLocationInGround(s, v3(sp.point_b));
+      V += 0.5 * sp.stiffness_N_per_m * std::pow((pb - pa).norm() - sp.rest_length_m, 2);
+    }
+    return V;
+  }
+
+ private:
+  const FullModel::Impl& m_;
+};
+
+// Switches a gated torque when its joint rate changes sign (localized by the integrator,
+// so the discontinuous torque never sits inside a step).
+class GateSwitch : public TriggeredEventHandler {
+ public:
+  GateSwitch(const FullModel::Impl& m, int torque)
+      : TriggeredEventHandler(Stage::Velocity), m_(m), torque_(torque) {
+    getTriggerInfo().setTriggerOnRisingSignTransition(true);
+    getTriggerInfo().setTriggerOnFallingSignTransition(true);
+  }
+  Real getValue(const State& s) const override {
+    const auto& gate = *m_.scene.joint_torques[torque_].active_when;
+    return m_.joint_u(s, m_.scene.joint_index(gate.joint));
+  }
+  void handleEvent(State& s, Real, bool&) const override {
+    const auto& gate = *m_.scene.joint_torques[torque_].active_when;
+    const double rate = getValue(s);
+    // The state handed over is just past the crossing; at an exact zero keep toggling.
+    const bool on = rate != 0.0 ? gate.sign * rate > 0.0 : !m_.gate(s, torque_);
+    m_.set_gate(s, torque_, on);
+  }
+
+ private:
+  const FullModel::Impl& m_;
+  int torque_;
+};
+
+}  // namespace
+
+double non_conservative_power(const FullModel::Impl& m, const State& s) {
+  const int mode = load_mode(m, s);
+  if (mode == kLoadsOff || mode == kLoadsConservative) return 0.0;
+  const auto& sc = m.scene;
+  double P = 0.0;
+  for (size_t i = 0; i < sc.joint_torques.size(); ++i) {
+    const int j = sc.joint_index(sc.joint_torques[i].joint);
+    if (torque_active(m, s, static_cast<int>(i), mode)) P += sc.joint_torques[i].value * m.joint_u(s, j);
+  }
+  for (const auto& mo : sc.motors) {
+    const double u = m.joint_u(s, sc.joint_index(mo.joint));
+    P += mo.stall_torque * (1.0 - u / mo.no_load_speed) * u;
+  }
+  for (const auto& r : sc.resistances) {
+    const double w = m.body_rate(s, sc.body_index(r.body));
+    P += resistance_torque(r, w) * w;
+  }
+  return P;
+}
+
+void add_scene_loads(FullModel::Impl& impl) {
+  Force::Custom(impl.forces, new SceneLoads(impl));
+  for (size_t i = 0; i < impl.scene.joint_torques.size(); ++i)
+    if (impl.scene.joint_torques[i].active_when)
+      impl.system.addEventHandler(new GateSwitch(impl, static_cast<int>(i)));
+}
+
+}  // namespace rdyn::engine

@@ -1,0 +1,520 @@
+#include "models/scene_yaml.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "models/bicycle_leg.hpp"
+
+namespace rdyn::models {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+int line_of(const YAML::Node& n) {
+  const auto m = n.Mark();
+  return m.is_null() ? 0 : m.line + 1;
+}
+
+// A YAML mapping whose keys are checked against the allowed set; typed getters throw
+// SceneError with file, line and dotted field path.
+class Fields {
+ public:
+  Fields(const YAML::Node& node, std::string path, const std::string& file,
+         std::vector<std::string> allowed)
+      : node_(node), path_(std::move(path)), file_(file), allowed_(std::move(allowed)) {
+    if (!node_.IsMap()) fail_at(node_, path_, "expected a mapping of keys to values");
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(allowed_.begin(), allowed_.end(), key) != allowed_.end()) continue;
+      std::string best;
+      size_t best_d = 4;  // suggest only close matches
+      for (const auto& a : allowed_) {
+        const size_t d = edit_distance(key, a);
+        if (d < best_d) best_d = d, best = a;
+      }
+      fail_at(kv.first, join(key), best.empty()
+                                        ? "unknown key"
+                                        : fmt::format("unknown key (did you mean '{}'?)", best));
+    }
+  }
+
+  bool has(const std::string& k) const { return static_cast<bool>(node_[k]); }
+  YAML::Node raw(const std::string& k) const { return node_[k]; }
+  std::string join(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
+  int line() const { return line_of(node_); }
+
+  [[noreturn]] void fail_at(const YAML::Node& n, const std::string& field,
+                            const std::string& msg) const {
+    throw SceneError(file_, line_of(n), field, msg);
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
+    fail_at(has(key) ? node_[key] : node_, join(key), msg);
+  }
+
+  YAML::Node required(const std::string& k) const {
+    if (!has(k)) fail_at(node_, join(k), "missing required field");
+    return node_[k];
+  }
+
+  double num(const std::string& k) const { return to_num(required(k), join(k)); }
+  double num_or(const std::string& k, double def) const { return has(k) ? num(k) : def; }
+  std::string str(const std::string& k) const {
+    const YAML::Node n = required(k);
+    if (!n.IsScalar()) fail_at(n, join(k), "expected a text value");
+    return n.as<std::string>();
+  }
+  std::string str_or(const std::string& k, const std::string& def) const {
+    return has(k) ? str(k) : def;
+  }
+  bool flag_or(const std::string& k, bool def) const {
+    if (!has(k)) return def;
+    const YAML::Node n = node_[k];
+    bool v = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
+      fail_at(n, join(k), "expected true or false");
+    return v;
+  }
+  Vec2 vec2(const std::string& k) const { return to_vec2(required(k), join(k)); }
+
+  double to_num(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail_at(n, field, "expected a number");
+    double v = 0.0;
+    const std::string text = n.Scalar();
+    if (!YAML::convert<double>::decode(n, v) || text.empty())
+      fail_at(n, field, fmt::format("expected a number, got '{}'", text));
+    if (!std::isfinite(v)) fail_at(n, field, fmt::format("must be finite, got '{}'", text));
+    return v;
+  }
+  Vec2 to_vec2(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsSequence() || n.size() != 2) fail_at(n, field, "expected a pair [x, y]");
+    return {to_num(n[0], field + "[0]"), to_num(n[1], field + "[1]")};
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  YAML::Node node_;
+  std::string path_;
+  const std::string& file_;
+  std::vector<std::string> allowed_;
+};
+
+// Reads a list of mappings; each item must have a unique `name` unless `named` is false.
+template <typename F>
+void for_each_item(const Fields& parent, const std::string& key, F&& f) {
+  if (!parent.has(key)) return;
+  const YAML::Node seq = parent.raw(key);
+  if (!seq.IsSequence()) parent.fail(key, "expected a list");
+  for (size_t i = 0; i < seq.size(); ++i) f(seq[i], parent.join(key) + fmt::format("[{}]", i));
+}
+
+// Point on a body: [x, y] or the name of one of the body's (or ground's) points.
+Vec2 read_point(const Fields& f, const std::string& key, const std::string& body, const Scene& s) {
+  const YAML::Node n = f.required(key);
+  if (n.IsSequence()) return f.to_vec2(n, f.join(key));
+  if (!n.IsScalar()) f.fail(key, "expected [x, y] or the name of a point");
+  const std::string name = n.as<std::string>();
+  if (body == kGround) {
+    auto it = s.ground_points.find(name);
+    if (it != s.ground_points.end()) return it->second;
+  } else if (const Body* b = s.find_body(body)) {
+    auto it = b->points.find(name);
+    if (it != b->points.end()) return it->second;
+  }
+  f.fail(key, fmt::format("body '{}' has no point named '{}'", body, name));
+}
+
+void apply_override(YAML::Node root, const Override& o, const std::string& file) {
+  std::vector<std::string> parts;
+  std::stringstream ss(o.path);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  auto fail = [&](const std::string& msg) {
+    throw SceneError(file, 0, "--set " + o.path, msg);
+  };
+  if (parts.empty() || std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
+    fail("malformed key path");
+  YAML::Node cur;
+  cur.reset(root);
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    const std::string& key = parts[i];
+    YAML::Node next;
+    if (cur.IsSequence()) {
+      char* end = nullptr;
+      const long idx = std::strtol(key.c_str(), &end, 10);
+      if (*end == '\0' && idx >= 0 && static_cast<size_t>(idx) < cur.size()) {
+        next.reset(cur[idx]);
+      } else {
+        for (size_t k = 0; k < cur.size(); ++k)
+          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == key) next.reset(cur[k]);
+      }
+      if (!next) fail(fmt::format("no list item '{}'", key));
+    } else if (cur.IsMap()) {
+      if (!cur[key]) {
+        cur[key] = YAML::Node(YAML::NodeType::Map);  // allows setting a generator default
+      }
+      next.reset(cur[key]);
+    } else {
+      fail(fmt::format("'{}' is not a mapping or list", key));
+    }
+    cur.reset(next);
+  }
+  if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
+  const std::string& last = parts.back();
+  if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
+  cur[last] = o.value;
+}
+
+ResistanceLaw read_law(const Fields& f, const std::string& key) {
+  const std::string v = f.str(key);
+  if (v == "constant") return ResistanceLaw::Constant;
+  if (v == "viscous") return ResistanceLaw::Viscous;
+  if (v == "quadratic") return ResistanceLaw::Quadratic;
+  f.fail(key, "expected constant, viscous or quadratic");
+}
+
+void read_bicycle_leg(const Fields& f, Scene& s) {
+  BicycleLegParams p;
+  if (f.has("subject")) {
+    Fields sub(f.raw("subject"), f.join("subject"), f.file(), {"height_m", "mass_kg", "sex"});
+    p.height_m = sub.num_or("height_m", p.height_m);
+    p.mass_kg = sub.num_or("mass_kg", p.mass_kg);
+    p.sex = sub.str_or("sex", p.sex);
+  }
+  const double legs = f.num_or("legs", p.legs);
+  if (legs != 1.0 && legs != 2.0) f.fail("legs", "must be 1 or 2");
+  p.legs = static_cast<int>(legs);
+  p.crank_length_m = f.num_or("crank_length_m", p.crank_length_m);
+  p.crank_mass_kg = f.num_or("crank_mass_kg", p.crank_mass_kg);
+  p.seat_tube_angle_deg = f.num_or("seat_tube_angle_deg", p.seat_tube_angle_deg);
+  p.knee_flexion_at_extension_deg =
+      f.num_or("knee_flexion_at_extension_deg", p.knee_flexion_at_extension_deg);
+  p.ankle_angle_deg = f.num_or("ankle_angle_deg", p.ankle_angle_deg);
+  p.pedal_stack_m = f.num_or("pedal_stack_m", p.pedal_stack_m);
+  p.hip_torque_Nm = f.num_or("hip_torque_Nm", p.hip_torque_Nm);
+  if (f.has("flywheel")) {
+    Fields fw(f.raw("flywheel"), f.join("flywheel"), f.file(),
+              {"gear_ratio", "inertia_kgm2", "mass_kg", "bike_mass_kg", "wheel_radius_m",
+               "wheel_inertia_kgm2"});
+    p.gear_ratio = fw.num_or("gear_ratio", p.gear_ratio);
+    p.flywheel_inertia_kgm2 = fw.num_or("inertia_kgm2", p.flywheel_inertia_kgm2);
+    p.flywheel_mass_kg = fw.num_or("mass_kg", p.flywheel_mass_kg);
+    p.bike_mass_kg = fw.num_or("bike_mass_kg", p.bike_mass_kg);
+    p.wheel_radius_m = fw.num_or("wheel_radius_m", p.wheel_radius_m);
+    p.wheel_inertia_kgm2 = fw.num_or("wheel_inertia_kgm2", p.wheel_inertia_kgm2);
+  }
+  if (f.has("resistance")) {
+    Fields r(f.raw("resistance"), f.join("resistance"), f.file(), {"law", "power_W", "cadence_Hz"});
+    if (r.has("law")) p.resistance_law = read_law(r, "law");
+    p.resistance_power_W = r.num_or("power_W", p.resistance_power_W);
+    p.resistance_cadence_Hz = r.num_or("cadence_Hz", p.resistance_cadence_Hz);
+  }
+  make_bicycle_leg(p, s);
+}
+
+void read_mechanism(const Fields& top, Scene& s) {
+  if (top.has("ground_points")) {
+    const YAML::Node gp = top.raw("ground_points");
+    if (!gp.IsMap()) top.fail("ground_points", "expected a mapping name: [x, y]");
+    for (const auto& kv : gp)
+      s.ground_points[kv.first.as<std::string>()] =
+          top.to_vec2(kv.second, "ground_points." + kv.first.as<std::string>());
+  }
+  for_each_item(top, "bodies", [&](const YAML::Node& n, const std::string& path) {
+    Fields f(n, path, top.file(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"});
+    Body b;
+    b.name = f.str("name");
+    b.mass_kg = f.num("mass_kg");
+    b.com_m = f.has("com_m") ? f.vec2("com_m") : Vec2{};
+    b.inertia_kgm2 = f.num("inertia_kgm2");
+    if (b.mass_kg <= 0.0) f.fail("mass_kg", "mass must be positive");
+    if (b.inertia_kgm2 <= 0.0) f.fail("inertia_kgm2", "inertia must be positive");
+    if (s.find_body(b.name) || b.name == kGround) f.fail("name", "duplicate body name '" + b.name + "'");
+    if (f.has("points")) {
+      const YAML::Node pts = f.raw("points");
+      if (!pts.IsMap()) f.fail("points", "expected a mapping name: [x, y]");
+      for (const auto& kv : pts)
+        b.points[kv.first.as<std::string>()] =
+            f.to_vec2(kv.second, f.join("points." + kv.first.as<std::string>()));
+    }
+    s.bodies.push_back(b);
+  });
+  for_each_item(top, "joints", [&](const YAML::Node& n, const std::string& path) {
+    Fields f(n, path, top.file(),
+             {"name", "type", "parent", "child", "parent_point", "child_point", "axis",
+              "offset_deg", "guess_deg", "guess_m"});
+    Joint j;
+    j.name = f.str("name");
+    const std::string type = f.str("type");
+    if (type == "revolute") j.type = JointType::Revolute;
+    else if (type == "prismatic") j.type = JointType::Prismatic;
+    else f.fail("type", "expected revolute or prismatic");
+    j.parent = f.str("parent");
+    j.child = f.str("child");
+    if (j.parent != kGround && !s.find_body(j.parent)) f.fail("parent", "unknown body '" + j.parent + "'");
+    if (!s.find_body(j.child)) f.fail("child", "unknown body '" + j.child + "'");
+    j.parent_point = f.has("parent_point") ? read_point(f, "parent_point", j.parent, s) : Vec2{};
+    j.child_point = f.has("child_point") ? read_point(f, "child_point", j.child, s) : Vec2{};
+    if (j.type == JointType::Prismatic) {
+      j.axis = f.has("axis") ? f.vec2("axis") : Vec2{1, 0};
+      const double len = std::hypot(j.axis.x, j.axis.y);
+      if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
+      j.axis = {j.axis.x / len, j.axis.y / len};
+      if (f.has("offset_deg") || f.has("guess_deg")) f.fail("type", "prismatic joints take guess_m, not degrees");
+      j.guess = f.num_or("guess_m", 0.0);
+    } else {
+      if (f.has("axis") || f.has("guess_m")) f.fail("type", "revolute joints take guess_deg and no axis");
+      j.offset_rad = f.num_or("offset_deg", 0.0) * kPi / 180.0;
+      j.guess = f.num_or("guess_deg", 0.0) * kPi / 180.0;
+    }
+    s.joints.push_back(j);
+  });
+  for_each_item(top, "loops", [&](const YAML::Node& n, const std::string& path) {
+    Fields f(n, path, top.file(), {"name", "body_a", "point_a", "body_b", "point_b"});
+    Loop l;
+    l.name = f.str("name");
+    l.body_a = f.str("body_a");
+    l.body_b = f.str("body_b");
+    l.point_a = read_point(f, "point_a", l.body_a, s);
+    l.point_b = read_point(f, "point_b", l.body_b, s);
+    s.loops.push_back(l);
+  });
+  for_each_item(top, "gears", [&](const YAML::Node& n, const std::string& path) {
+    Fields f(n, path, top.file(), {"name", "driver", "driven", "ratio"});
+    s.gears.push_back({f.str("name"), f.str("driver"), f.str("driven"), f.num("ratio")});
+  });
+  s.independent = top.str("independent");
+}
+
+struct PendingDissipation {
+  size_t index;
+  double power_W, cadence_Hz;
+  int line;
+};
+
+void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pending) {
+  std::set<std::string> names;
+  for_each_item(top, "loads", [&](const YAML::Node& n, const std::string& path) {
+    if (!n.IsMap() || !n["type"]) throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
+    const std::string type = n["type"].as<std::string>();
+    const std::string name = n["name"] ? n["name"].as<std::string>() : fmt::format("load{}", names.size());
+    if (!names.insert(name).second)
+      throw SceneError(top.file(), line_of(n), path + ".name", "duplicate load name '" + name + "'");
+    if (type == "joint_torque") {
+      Fields f(n, path, top.file(), {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
+      JointTorque t{name, f.str("joint"), 0.0, std::nullopt};
+      if (f.has("torque_Nm") == f.has("force_N")) f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
+      t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num("force_N");
+      if (f.has("active_when")) {
+        Fields g(f.raw("active_when"), f.join("active_when"), top.file(), {"joint", "rate"});
+        const std::string rate = g.str("rate");
+        if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+        t.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
+      }
+      s.joint_torques.push_back(t);
+    } else if (type == "resistance") {
+      Fields f(n, path, top.file(), {"type", "name", "body", "law", "coefficient", "dissipates"});
+      Resistance r{name, f.str("body"), read_law(f, "law"), 0.0};
+      if (f.has("coefficient") == f.has("dissipates"))
+        f.fail("coefficient", "give either coefficient or dissipates: {power_W, cadence_Hz}");
+      if (f.has("coefficient")) {
+        r.coefficient = f.num("coefficient");
+      } else {
+        Fields d(f.raw("dissipates"), f.join("dissipates"), top.file(), {"power_W", "cadence_Hz"});
+        pending.push_back({s.resistances.size(), d.num("power_W"), d.num("cadence_Hz"), d.line()});
+        if (pending.back().power_W < 0.0 || pending.back().cadence_Hz <= 0.0)
+          d.fail("power_W", "power must be non-negative and cadence positive");
+      }
+      s.resistances.push_back(r);
+    } else if (type == "spring") {
+      Fields f(n, path, top.file(),
+               {"type", "name", "body_a", "point_a", "body_b", "point_b", "stiffness_N_per_m", "rest_length_m"});
+      Spring sp;
+      sp.name = name;
+      sp.body_a = f.str("body_a");
+      sp.body_b = f.str("body_b");
+      sp.point_a = read_point(f, "point_a", sp.body_a, s);
+      sp.point_b = read_point(f, "point_b", sp.body_b, s);
+      sp.stiffness_N_per_m = f.num("stiffness_N_per_m");
+      sp.rest_length_m = f.num("rest_length_m");
+      s.springs.push_back(sp);
+    } else if (type == "motor") {
+      Fields f(n, path, top.file(),
+               {"type", "name", "joint", "stall_torque_Nm", "stall_force_N", "no_load_speed_rad_s",
+                "no_load_speed_m_s"});
+      Motor m{name, f.str("joint"), 0.0, 0.0};
+      m.stall_torque = f.has("stall_force_N") ? f.num("stall_force_N") : f.num("stall_torque_Nm");
+      m.no_load_speed = f.has("no_load_speed_m_s") ? f.num("no_load_speed_m_s") : f.num("no_load_speed_rad_s");
+      s.motors.push_back(m);
+    } else {
+      throw SceneError(top.file(), line_of(n["type"]), path + ".type",
+                       "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
+    }
+  });
+}
+
+}  // namespace
+
+Override parse_override(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw SceneError("", 0, "--set", "expected key=value, got '" + text + "'");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+std::string resolve_scene_path(const std::string& name_or_path) {
+  struct stat st {};
+  if (stat(name_or_path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) throw SceneError(name_or_path, 0, "", "is a folder, not a scene file");
+    return name_or_path;
+  }
+  const bool plain_name = name_or_path.find('/') == std::string::npos &&
+                          name_or_path.find('.') == std::string::npos && !name_or_path.empty();
+  if (plain_name) {
+    std::vector<std::string> dirs;
+    if (const char* env = std::getenv("RDYN_SCENES_DIR")) dirs.push_back(env);
+    dirs.push_back(RDYN_SCENES_DIR);
+    for (const auto& d : dirs) {
+      const std::string p = d + "/" + name_or_path + ".yaml";
+      if (stat(p.c_str(), &st) == 0) return p;
+    }
+  }
+  throw SceneError(name_or_path, 0, "", "no such scene file (nor a shipped scene of that name)");
+}
+
+Scene parse_scene(const std::string& text, const std::string& file,
+                  const std::vector<Override>& overrides) {
+  if (text.find('\0') != std::string::npos)
+    throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw SceneError(file, 0, "", "the scene file is empty");
+  if (!root.IsMap()) throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
+  for (const auto& o : overrides) apply_override(root, o, file);
+
+  Scene s;
+  s.source_file = file;
+  try {
+    Fields top(root, "", file,
+               {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops",
+                "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation"});
+    s.name = top.str("name");
+    s.description = top.str_or("description", "");
+
+    // Initial conditions first: the generator places the mechanism at q0.
+    if (top.has("initial")) {
+      Fields f(top.raw("initial"), "initial", file, {"q", "q_deg", "qdot", "cadence_Hz"});
+      if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
+      if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
+      s.initial.q = f.has("q_deg") ? f.num("q_deg") * kPi / 180.0 : f.num_or("q", 0.0);
+      s.initial.qdot = f.has("cadence_Hz") ? f.num("cadence_Hz") * 2.0 * kPi : f.num_or("qdot", 0.0);
+    }
+    if (top.has("bicycle_leg")) {
+      for (const char* k : {"bodies", "joints", "loops", "gears", "independent", "ground_points"})
+        if (top.has(k)) top.fail(k, "a bicycle_leg scene generates its own mechanism; remove this key");
+      Fields f(top.raw("bicycle_leg"), "bicycle_leg", file,
+               {"subject", "legs", "crank_length_m", "crank_mass_kg", "seat_tube_angle_deg",
+                "knee_flexion_at_extension_deg", "ankle_angle_deg", "pedal_stack_m",
+                "hip_torque_Nm", "flywheel", "resistance"});
+      read_bicycle_leg(f, s);
+    } else {
+      read_mechanism(top, s);
+    }
+    std::vector<PendingDissipation> pending;
+    read_loads(top, s, pending);
+    for (const auto& p : pending) {
+      Resistance& r = s.resistances[p.index];
+      if (!s.find_body(r.body))
+        throw SceneError(file, p.line, "loads." + r.name + ".body", "unknown body '" + r.body + "'");
+      const auto ratio = fixed_speed_ratio(s, r.body);
+      if (!ratio)
+        throw SceneError(file, p.line, "loads." + r.name + ".dissipates",
+                         "'dissipates' needs a body turning at a fixed ratio to the independent "
+                         "coordinate (its child, or geared to it); give a coefficient instead");
+      const double omega = std::abs(*ratio) * 2.0 * kPi * p.cadence_Hz;
+      const int power = r.law == ResistanceLaw::Constant ? 1 : r.law == ResistanceLaw::Viscous ? 2 : 3;
+      r.coefficient = p.power_W / std::pow(omega, power);  // P = c·ω^power
+    }
+    if (top.has("gravity")) {
+      Fields f(top.raw("gravity"), "gravity", file, {"enabled", "g_m_s2"});
+      s.gravity.enabled = f.flag_or("enabled", true);
+      if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
+    }
+    if (top.has("outputs")) {
+      Fields f(top.raw("outputs"), "outputs", file, {"constraint_forces", "bodies"});
+      for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
+        Fields c(n, path, file, {"name", "joint", "direction"});
+        ConstraintForceRequest r{c.str("name"), c.str("joint"), {}};
+        const Joint* j = s.find_joint(r.joint);
+        if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
+        const YAML::Node d = c.required("direction");
+        if (d.IsScalar()) {  // toward a named point of the child, from the joint
+          const Vec2 to = read_point(c, "direction", j->child, s);
+          r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
+        } else {
+          r.direction = c.vec2("direction");
+        }
+        const double len = std::hypot(r.direction.x, r.direction.y);
+        if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
+        r.direction = {r.direction.x / len, r.direction.y / len};
+        for (const auto& other : s.outputs.constraint_forces)
+          if (other.name == r.name) c.fail("name", "duplicate constraint force name");
+        s.outputs.constraint_forces.push_back(r);
+      });
+      if (f.has("bodies")) {
+        const YAML::Node b = f.raw("bodies");
+        if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
+        for (const auto& item : b) s.outputs.bodies.push_back(item.as<std::string>());
+      }
+    }
+    if (top.has("simulation")) {
+      Fields f(top.raw("simulation"), "simulation", file, {"duration_s", "output_interval_s", "tolerance"});
+      s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
+      s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
+      s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
+    }
+  } catch (const YAML::Exception& e) {
+    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.msg);
+  }
+  check_scene(s);
+  return s;
+}
+
+Scene load_scene(const std::string& name_or_path, const std::vector<Override>& overrides) {
+  const std::string path = resolve_scene_path(name_or_path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, 0, "", "cannot open for reading");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  return parse_scene(buf.str(), path, overrides);
+}
+
+}  // namespace rdyn::models

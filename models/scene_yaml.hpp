@@ -1,0 +1,34 @@
+// Reading scenes from YAML (format documented in models/README.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "models/scene.hpp"
+
+namespace rdyn::models {
+
+// One `--set key=value` override: a dotted path into the YAML tree. Map keys by name,
+// sequence items by index or by the value of their `name` field
+// (e.g. `loads.brake.coefficient=0.3`, `bicycle_leg.subject.height_m=1.80`).
+struct Override {
+  std::string path;
+  std::string value;
+};
+
+// Parses "key=value"; throws SceneError (field "--set") when malformed.
+Override parse_override(const std::string& text);
+
+// Resolves a shipped scene name (models/scenes/NAME.yaml, also $RDYN_SCENES_DIR) or a
+// path. Throws SceneError when neither exists.
+std::string resolve_scene_path(const std::string& name_or_path);
+
+// Reads, overrides, expands generators (bicycle_leg) and checks a scene.
+// Every problem throws SceneError naming the file (and line and field where known).
+Scene load_scene(const std::string& name_or_path, const std::vector<Override>& overrides = {});
+
+// Same, from YAML text already in memory; `file` is used in messages.
+Scene parse_scene(const std::string& yaml_text, const std::string& file,
+                  const std::vector<Override>& overrides = {});
+
+}  // namespace rdyn::models
