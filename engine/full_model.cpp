@@ -298,8 +298,8 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   m.system.realize(s, Stage::Position);
   const auto [gap, loop] = m.worst_loop_gap(s);
   if (gap > 1e-8) {
-    throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {:.6g}: gap {:.6g} m "
-                                  "(check lengths and ground points)",
+    throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {:.6g}: the best assembly attempt "
+                                  "leaves a gap of {:.6g} m (check lengths and ground points)",
                                   m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
   }
 }

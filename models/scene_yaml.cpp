@@ -166,13 +166,18 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file)
     if (cur.IsSequence()) {
       char* end = nullptr;
       const long idx = std::strtol(key.c_str(), &end, 10);
+      bool found = false;
       if (*end == '\0' && idx >= 0 && static_cast<size_t>(idx) < cur.size()) {
         next.reset(cur[idx]);
+        found = true;
       } else {
-        for (size_t k = 0; k < cur.size(); ++k)
-          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == key) next.reset(cur[k]);
+        for (size_t k = 0; k < cur.size() && !found; ++k)
+          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == key) {
+            next.reset(cur[k]);
+            found = true;
+          }
       }
-      if (!next) fail(fmt::format("no list item '{}'", key));
+      if (!found) fail(fmt::format("no list item '{}'", key));
     } else if (cur.IsMap()) {
       if (!cur[key]) {
         cur[key] = YAML::Node(YAML::NodeType::Map);  // allows setting a generator default
@@ -183,8 +188,16 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file)
     }
     cur.reset(next);
   }
-  if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
   const std::string& last = parts.back();
+  if (cur.IsSequence()) {  // e.g. one coordinate of a point: bodies.rocker.points.C.0=0.2
+    char* end = nullptr;
+    const long idx = std::strtol(last.c_str(), &end, 10);
+    if (*end != '\0' || idx < 0 || static_cast<size_t>(idx) >= cur.size() || !cur[idx].IsScalar())
+      fail(fmt::format("no scalar list item '{}'", last));
+    cur[idx] = o.value;
+    return;
+  }
+  if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
   if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
   cur[last] = o.value;
 }

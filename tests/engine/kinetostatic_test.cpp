@@ -1,0 +1,139 @@
+// Kinetostatic calls against closed forms and against a second route through Simbody.
+#include "engine/kinetostatic.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "models/scene_yaml.hpp"
+#include "test_scenes.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Crank-rocker of models/scenes/fourbar.yaml: the rocker angle from the crank angle by
+// intersecting circle(B, coupler) with circle(D, rocker), C above the line B–D.
+struct FourBarPose {
+  double coupler_abs, rocker;
+};
+FourBarPose fourbar_closed_form(double th) {
+  const double a = 0.08, b = 0.28, c = 0.20, d = 0.30;
+  const double Bx = a * std::cos(th), By = a * std::sin(th);
+  const double dx = d - Bx, dy = -By, L = std::hypot(dx, dy);
+  const double A = (b * b - c * c + L * L) / (2 * L), h = std::sqrt(b * b - A * A);
+  const double ex = dx / L, ey = dy / L;
+  // The left normal (−ey, ex) of B→D keeps C on the assembled side through a full turn.
+  const double Cx = Bx + A * ex - h * ey, Cy = By + A * ey + h * ex;
+  return {std::atan2(Cy - By, Cx - Bx), std::atan2(Cy, Cx - d)};
+}
+
+double wrap(double a) { return std::remainder(a, 2 * kPi); }
+
+TEST(Kinetostatic, FourBarPositionsAndVelocityRatiosMatchClosedForm) {
+  const auto scene = models::load_scene("fourbar");
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  const int crank = scene.joint_index("crank"), coupler = scene.joint_index("coupler"),
+            rocker = scene.joint_index("rocker");
+  for (int deg = 30; deg <= 390; deg += 15) {  // a full turn, continuing from point to point
+    const double th = deg * kPi / 180.0;
+    const auto r = calc_kinetostatic(model, ws, th, 0.0, 0.0, Loads::Off);
+    const auto cf = fourbar_closed_form(th);
+    EXPECT_NEAR(wrap(r.joint_q[rocker] - cf.rocker), 0.0, 1e-10) << deg;
+    EXPECT_NEAR(wrap(r.joint_q[crank] + r.joint_q[coupler] - cf.coupler_abs), 0.0, 1e-10) << deg;
+    const double h = 1e-6;
+    const double dcf = wrap(fourbar_closed_form(th + h).rocker - fourbar_closed_form(th - h).rocker) / (2 * h);
+    const auto vr = calc_velocity_ratios(model, ws, th);
+    EXPECT_NEAR(vr.wrt_q[rocker], dcf, 1e-7) << deg;
+    EXPECT_NEAR(vr.wrt_q[crank], 1.0, 1e-14);
+  }
+}
+
+TEST(Kinetostatic, SliderCrankPositionAndStaticTorqueMatchClosedForm) {
+  const auto scene = models::load_scene("slider-crank");
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  const int slider = scene.joint_index("slider");
+  const double r = 0.05, l = 0.20, F = -40.0, stall = 6.0;
+  for (int deg = 30; deg <= 390; deg += 20) {
+    const double th = deg * kPi / 180.0, s = std::sin(th), c = std::cos(th);
+    const double root = std::sqrt(l * l - r * r * s * s);
+    const double x = r * c + root;
+    const double dx = -r * s - r * r * s * c / root;  // dx/dθ
+    const auto st = calc_kinetostatic(model, ws, th, 0.0, 0.0, Loads::All);
+    EXPECT_NEAR(st.joint_q[slider], x, 1e-11) << deg;
+    // Static equilibrium by virtual work: T_act + stall + F·dx/dθ = 0 (motor at rest gives
+    // its stall torque).
+    EXPECT_NEAR(st.driving_force, -(stall + F * dx), 1e-9) << deg;
+    const auto vr = calc_velocity_ratios(model, ws, th);
+    EXPECT_NEAR(vr.wrt_q[slider], dx, 1e-11) << deg;
+  }
+}
+
+TEST(Kinetostatic, ParallelogramHasConstantClosedFormInertia) {
+  const auto scene = models::parse_scene(test::parallelogram_yaml(0.0, false), "parallelogram.yaml");
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  for (int deg = 40; deg <= 150; deg += 10) {
+    const double q = deg * kPi / 180.0;
+    const auto acc = calc_kinetostatic(model, ws, q, 0.0, 2.0, Loads::Off);   // (ii): m1 = T/α
+    const auto vel = calc_kinetostatic(model, ws, q, 3.0, 0.0, Loads::Off);   // (i): m2 = T/ω²
+    EXPECT_NEAR(acc.driving_force / 2.0, test::parallelogram_m1(), 1e-12) << deg;
+    EXPECT_NEAR(vel.driving_force / 9.0, 0.0, 1e-12) << deg;  // m2 = ½ dm1/dq = 0
+  }
+}
+
+TEST(Kinetostatic, ReducedInertiaEqualsTwiceKineticEnergyAtUnitSpeed) {
+  // Two routes to m1: the actuator torque at q̇ = 0, q̈ = α, and 2·T at q̇ = 1 (T = ½ m1 q̇²).
+  for (const char* name : {"bicycle", "fourbar", "slider-crank"}) {
+    const auto scene = models::load_scene(name);
+    FullModel model(scene);
+    FullWorkspace ws(model);
+    for (int deg = 0; deg < 360; deg += 45) {
+      const double q = scene.initial.q + deg * kPi / 180.0;
+      const double m1_acc = calc_kinetostatic(model, ws, q, 0.0, 1.5, Loads::Off).driving_force / 1.5;
+      const double m1_ke = 2.0 * calc_kinetostatic(model, ws, q, 1.0, 0.0, Loads::Off).kinetic_energy;
+      EXPECT_NEAR(m1_acc, m1_ke, 1e-10 * std::abs(m1_ke)) << name << " " << deg;
+    }
+  }
+}
+
+TEST(Kinetostatic, KneeForceFromActuatorEqualsJointReaction) {
+  const auto scene = models::load_scene("bicycle");
+  FullModelOptions reaction;
+  reaction.route = ConstraintForceRoute::Reaction;
+  FullModel act(scene), rea(scene, reaction);
+  FullWorkspace wa(act), wr(rea);
+  double peak = 0.0;
+  for (int deg = 0; deg < 360; deg += 20) {
+    const double q = deg * kPi / 180.0;
+    for (const auto& [qd, qdd] : {std::pair{6.3, 0.0}, {0.0, 4.0}, {5.0, -3.0}}) {
+      const double fa = calc_kinetostatic(act, wa, q, qd, qdd, Loads::All).constraint_forces.at(0);
+      const double fr = calc_kinetostatic(rea, wr, q, qd, qdd, Loads::All).constraint_forces.at(0);
+      EXPECT_NEAR(fa, fr, 1e-9 * std::max(1.0, std::abs(fr))) << deg << " " << qd << " " << qdd;
+      peak = std::max(peak, std::abs(fr));
+    }
+  }
+  EXPECT_GT(peak, 100.0);  // the comparison is not between zeros
+}
+
+TEST(Kinetostatic, LoopThatCannotCloseIsNamedWithItsGap) {
+  std::string y = test::parallelogram_yaml(0.0, false);
+  y.replace(y.find("points: {C: [0.1, 0]}"), 21, "points: {C: [0.02, 0]}");
+  const auto scene = models::parse_scene(y, "short_rocker.yaml");
+  FullModel model(scene);
+  try {
+    FullWorkspace ws(model);
+    FAIL() << "assembly should fail";
+  } catch (const EngineError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("short_rocker.yaml"), std::string::npos) << m;
+    EXPECT_NE(m.find("loop 'C'"), std::string::npos) << m;
+    EXPECT_NE(m.find("gap"), std::string::npos) << m;
+  }
+}
+
+}  // namespace
+}  // namespace rdyn::engine

@@ -1,0 +1,126 @@
+// The rdyn binary end to end: outputs, exit statuses and messages on bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status;
+  std::string output;  // stdout + stderr
+};
+
+CliRun rdyn(const std::string& args) {
+  const std::string cmd = std::string(RDYN_BINARY) + " " + args + " 2>&1";
+  CliRun r{-1, ""};
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) r.output.append(buf.data(), n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("rdyn_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const auto p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  // Bad input: status 2, a message naming `file`, and no output folder left behind.
+  void expect_refused(const std::string& args, const std::string& file) {
+    const auto out = dir_ / "out";
+    const CliRun r = rdyn(args + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(file), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    for (const auto& e : fs::directory_iterator(dir_))
+      EXPECT_EQ(e.path().filename().string().find(".out.tmp"), std::string::npos) << "temporary left behind";
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cli, SimulateWritesTimeseriesWithKneeForceColumn) {
+  const auto out = dir_ / "bike";
+  const CliRun r = rdyn("simulate bicycle --model full --duration 0.2 --dt-out 0.01 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream f(out / "timeseries.csv");
+  std::string header;
+  std::getline(f, header);
+  EXPECT_EQ(header, "t,q,qdot,qddot,energy,work,F_knee");
+  int rows = 0;
+  for (std::string line; std::getline(f, line);) ++rows;
+  EXPECT_EQ(rows, 21);
+  EXPECT_TRUE(fs::exists(out / "run.json"));
+}
+
+TEST_F(Cli, HelpExplainsItself) {
+  const CliRun r = rdyn("--help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_NE(r.output.find("simulate"), std::string::npos);
+  EXPECT_EQ(rdyn("simulate --help").status, 0);
+}
+
+TEST_F(Cli, MissingSceneFile) { expect_refused("simulate /no/such/scene.yaml", "/no/such/scene.yaml"); }
+
+TEST_F(Cli, EmptyGarbageAndMalformedFiles) {
+  expect_refused("simulate " + write("empty.yaml", ""), "empty.yaml");
+  expect_refused("simulate " + write("garbage.yaml", std::string("\x7f" "ELF\0\x01\x02\xff\xfe", 9)), "garbage.yaml");
+  expect_refused("simulate " + write("bad.yaml", "name: x\nbodies: [\n"), "bad.yaml");
+}
+
+TEST_F(Cli, UnknownKeyAndBadOverride) {
+  const std::string f = write("typo.yaml", "name: x\nbicycle_leg: {hip_torqe_Nm: 50}\n");
+  expect_refused("simulate " + f, "typo.yaml");
+  const CliRun r = rdyn("simulate " + f + " --out " + (dir_ / "o").string());
+  EXPECT_NE(r.output.find("did you mean 'hip_torque_Nm'"), std::string::npos) << r.output;
+  expect_refused("simulate bicycle --set bicycle_leg.subject.mass_kg=-3", "bicycle.yaml");
+  expect_refused("simulate bicycle --set loads.nosuch.value=1", "bicycle.yaml");
+}
+
+TEST_F(Cli, ImpossibleGeometryNamesTheLoop) {
+  // Four-bar whose rocker (0.02 m) cannot reach the coupler: the loop cannot close.
+  const std::string f = write("short.yaml", R"(name: short
+ground_points: {A: [0, 0], D: [0.3, 0]}
+bodies:
+  - {name: crank, mass_kg: 0.5, inertia_kgm2: 4.0e-4, points: {B: [0.1, 0]}}
+  - {name: coupler, mass_kg: 1.2, inertia_kgm2: 9.0e-3, points: {C: [0.3, 0]}}
+  - {name: rocker, mass_kg: 0.7, inertia_kgm2: 6.0e-4, points: {C: [0.02, 0]}}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank}
+  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler}
+  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+independent: crank
+)");
+  const CliRun r = rdyn("simulate " + f + " --out " + (dir_ / "out").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("short.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("loop 'C' cannot close"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(Cli, UnwritableOutputFolder) {
+  const std::string file = write("plainfile", "x");
+  const CliRun r = rdyn("simulate bicycle --duration 0.1 --out " + file + "/sub");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(file), std::string::npos) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,42 @@
+// Small scenes shared by the engine tests, written inline so that each test states
+// the geometry its closed form uses.
+#pragma once
+
+#include <string>
+
+namespace rdyn::test {
+
+// Parallelogram four-bar: crank A→B = rocker D→C = a, coupler B→C = ground A→D = d.
+// On its parallelogram branch the coupler translates, so the reduced inertia is constant:
+// m1 = (I_crank + m_crank·(a/2)²) + (I_rocker + m_rocker·(a/2)²) + m_coupler·a².
+inline std::string parallelogram_yaml(double torque_Nm, bool gravity) {
+  return std::string(R"(
+name: parallelogram
+ground_points: {A: [0, 0], D: [0.3, 0]}
+bodies:
+  - {name: crank, mass_kg: 0.5, com_m: [0.05, 0], inertia_kgm2: 4.0e-4, points: {B: [0.1, 0]}}
+  - {name: coupler, mass_kg: 1.2, com_m: [0.15, 0], inertia_kgm2: 9.0e-3, points: {C: [0.3, 0]}}
+  - {name: rocker, mass_kg: 0.7, com_m: [0.05, 0], inertia_kgm2: 6.0e-4, points: {C: [0.1, 0]}}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank, guess_deg: 40}
+  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler, guess_deg: -40}
+  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 40}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+independent: crank
+loads:
+  - {type: joint_torque, name: drive, joint: crank, torque_Nm: )") +
+         std::to_string(torque_Nm) + R"(}
+gravity: {enabled: )" + (gravity ? "true" : "false") + R"(}
+outputs:
+  constraint_forces:
+    - {name: rocker_axial, joint: rocker, direction: C}
+initial: {q_deg: 40, qdot: 1.0}
+)";
+}
+inline double parallelogram_m1() {
+  const double a = 0.1;
+  return (4.0e-4 + 0.5 * 0.05 * 0.05) + (6.0e-4 + 0.7 * 0.05 * 0.05) + 1.2 * a * a;
+}
+
+}  // namespace rdyn::test
