@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/full_model.hpp"
+#include "models/timeseries.hpp"
 
 namespace rdyn::engine {
 
@@ -16,23 +17,8 @@ struct ForwardOptions {
   std::string integrator = "rkmerson";  // rkmerson | rk3 | cpodes
 };
 
-struct ForwardStats {
-  long steps_taken = 0;
-  long steps_attempted = 0;
-  double smallest_step_s = 0.0;  // smallest step size used [s] (0 when unknown)
-  double max_constraint_error = 0.0;  // largest position-constraint violation seen [m]
-  double wall_time_s = 0.0;
-};
-
-// Samples every output_interval_s from 0 to duration_s inclusive.
-struct TimeSeries {
-  std::vector<std::string> force_names;  // one per requested constraint force
-  std::vector<double> t, q, qdot, qddot;  // [s], [rad or m], [/s], [/s²]
-  std::vector<double> energy;             // kinetic + potential [J]
-  std::vector<double> work;               // cumulative work of non-conservative loads [J]
-  std::vector<std::vector<double>> forces;  // forces[k][i]: force k at sample i [N]
-  ForwardStats stats;
-};
+using models::RunStats;
+using models::TimeSeries;
 
 // Starts at the scene's initial q, q̇ (the rest of the state from the constraints).
 // Throws EngineError on failure.

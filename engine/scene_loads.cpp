@@ -136,6 +136,8 @@ class GateSwitch : public TriggeredEventHandler {
       : TriggeredEventHandler(Stage::Velocity), m_(m), torque_(torque) {
     getTriggerInfo().setTriggerOnRisingSignTransition(true);
     getTriggerInfo().setTriggerOnFallingSignTransition(true);
+    // Locate the switch to a nanosecond: the knee force jumps by hundreds of newtons there.
+    getTriggerInfo().setRequiredLocalizationTimeWindow(1e-9);
   }
   Real getValue(const State& s) const override {
     const auto& gate = *m_.scene.joint_torques[torque_].active_when;

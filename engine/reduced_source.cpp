@@ -1,0 +1,93 @@
+#include "engine/reduced_source.hpp"
+
+#include <cmath>
+
+#include "engine/full_model_impl.hpp"
+#include "engine/kinetostatic.hpp"
+
+namespace rdyn::engine {
+
+using namespace SimTK;
+
+namespace {
+constexpr double kMaxJump = 5.0 * 3.14159265358979323846 / 180.0;
+}
+
+FullKinetostaticSource::FullKinetostaticSource(const FullModel& model)
+    : model_(model), ws_(model), q_now_(model.scene().initial.q) {}
+
+int FullKinetostaticSource::num_constraint_forces() const {
+  return static_cast<int>(model_.scene().outputs.constraint_forces.size());
+}
+int FullKinetostaticSource::num_joints() const { return static_cast<int>(model_.scene().joints.size()); }
+
+void FullKinetostaticSource::approach(double q) {
+  const int steps = static_cast<int>(std::ceil(std::abs(q - q_now_) / kMaxJump));
+  for (int i = 1; i < steps; ++i)
+    calc_kinetostatic(model_, ws_, q_now_ + (q - q_now_) * i / steps, 0, 0, Loads::Off);
+  q_now_ = q;
+}
+
+reduced::ForcePoint FullKinetostaticSource::inertial(double q, double qdot, double qddot) {
+  approach(q);
+  ++calls_;
+  const auto r = calc_kinetostatic(model_, ws_, q, qdot, qddot, Loads::Off);
+  return {r.driving_force, r.constraint_forces};
+}
+
+reduced::ConservativePoint FullKinetostaticSource::conservative(double q) {
+  approach(q);
+  ++calls_;
+  const auto r = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
+  return {{r.driving_force, r.constraint_forces}, r.potential_energy};
+}
+
+reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
+  approach(q);
+  ++calls_;
+  const auto v = calc_velocity_ratios(model_, ws_, q);
+  return {v.wrt_q, v.wrt_x};
+}
+
+std::optional<reduced::ForcePoint> FullKinetostaticSource::harmonic_sweep(const double c[5], double t) {
+  const double q = c[0] + c[1] * t + c[2] * std::cos(c[3] * t + c[4]);
+  approach(q);
+  ++calls_;
+  const auto r = calc_harmonic_sweep_point(model_, ws_, c, t, Loads::Off);
+  return reduced::ForcePoint{r.driving_force, r.constraint_forces};
+}
+
+std::optional<reduced::DirectPoint> FullKinetostaticSource::direct(double q) {
+  approach(q);
+  ++calls_;
+  const auto& m = model_.impl();
+  State& s = ws_.impl().state;
+  const int nx = num_constraint_forces();
+  // Mobility-space velocity-ratio vectors: u (q̇ = 1, x fixed) and u_x,k (ẋ_k = 1, q̇ = 0).
+  std::vector<Vector> ux;
+  for (int k = 0; k < nx; ++k) {
+    s.setTime(0);
+    m.set_law(s, 0, poly_law(q, 0, 0));
+    for (int i = 0; i < nx; ++i) m.set_law(s, 1 + i, poly_law(0, i == k ? 1.0 : 0.0, 0));
+    m.system.realize(s, Stage::Time);
+    m.system.project(s, 1e-12);
+    ux.push_back(s.getU());
+  }
+  // u and the bias acceleration b (q̈ = 0 at q̇ = 1), then M u and M b + c(q, u).
+  calc_kinetostatic(model_, ws_, q, 1.0, 0.0, Loads::Off);
+  m.system.realize(s, Stage::Acceleration);
+  const Vector u = s.getU(), b = s.getUDot();
+  Vector Mu, residual;
+  m.matter.multiplyByM(s, u, Mu);
+  m.matter.calcResidualForceIgnoringConstraints(s, Vector(), Vector_<SpatialVec>(), b, residual);
+  reduced::DirectPoint d;
+  d.m1 = ~u * Mu;        // T = ½ m1 q̇²
+  d.m2 = ~u * residual;  // uᵀ(M b + c)
+  for (int k = 0; k < nx; ++k) {
+    d.me1.push_back(~ux[k] * Mu);
+    d.me2.push_back(~ux[k] * residual);
+  }
+  return d;
+}
+
+}  // namespace rdyn::engine

@@ -1,0 +1,31 @@
+// The full model as a reduced::KinetostaticSource: what reduced/ extraction calls.
+#pragma once
+
+#include "engine/full_model.hpp"
+#include "reduced/kinetostatic_source.hpp"
+
+namespace rdyn::engine {
+
+class FullKinetostaticSource : public reduced::KinetostaticSource {
+ public:
+  explicit FullKinetostaticSource(const FullModel& model);
+  int num_constraint_forces() const override;
+  int num_joints() const override;
+  reduced::ForcePoint inertial(double q, double qdot, double qddot) override;
+  reduced::ConservativePoint conservative(double q) override;
+  reduced::RatioPoint ratios(double q) override;
+  std::optional<reduced::ForcePoint> harmonic_sweep(const double c[5], double t) override;
+  std::optional<reduced::DirectPoint> direct(double q) override;
+  long calls() const { return calls_; }
+
+ private:
+  // Walks the configuration to q in steps of at most 5° so that each Newton projection
+  // starts close (continuation keeps the assembled branch).
+  void approach(double q);
+  const FullModel& model_;
+  FullWorkspace ws_;
+  double q_now_;
+  long calls_ = 0;
+};
+
+}  // namespace rdyn::engine

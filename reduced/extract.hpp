@@ -1,0 +1,31 @@
+// Reduced parameters from kinetostatic calls of a full model (the paper's method).
+#pragma once
+
+#include <string>
+
+#include "models/scene.hpp"
+#include "reduced/kinetostatic_source.hpp"
+#include "reduced/samples.hpp"
+
+namespace rdyn::reduced {
+
+enum class Method {
+  Kinetostatic,  // (i) q̈ = 0, q̇ = ω: m2 = T/ω², me2 = F/ω²; (ii) q̇ = 0, q̈ = α: m1 = T/α, me1 = F/α
+  PaperSweep,    // the same states reached by continuous prescribed laws sampled at the grid
+  Integrated,    // m1 = m1(q_first) + ∫ 2 m2 dq (m2 from (i), one m1 from (ii))
+  Direct,        // m1 = uᵀMu etc. from the mass matrix (engine only)
+};
+Method parse_method(const std::string& name);  // throws TableError
+std::string method_name(Method m);
+
+struct ExtractOptions {
+  double step_rad = 10.0 * 3.14159265358979323846 / 180.0;  // grid step (revolute) [rad]
+  Method method = Method::Kinetostatic;
+};
+
+// Samples one period of a revolute independent coordinate, starting from the grid point
+// nearest the scene's initial q and continuing from point to point (so the full model stays
+// on its assembled branch). The step must divide 360° evenly. Throws TableError.
+Samples extract_samples(KinetostaticSource& source, const models::Scene& scene, const ExtractOptions& options);
+
+}  // namespace rdyn::reduced

@@ -1,0 +1,58 @@
+// The small interface through which reduced/ asks a full model for kinetostatic
+// (inverse-dynamics) answers. engine/ implements it on Simbody; tests implement it on
+// analytic mechanisms. No Simbody here.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+namespace rdyn::reduced {
+
+// Forces a prescribed motion needs (applied loads as requested by the call).
+struct ForcePoint {
+  double driving_force = 0.0;             // T_act on the independent coordinate [N·m or N]
+  std::vector<double> constraint_forces;  // F_E per constraint actuator [N]
+};
+
+// Static call (q̇ = q̈ = 0) with only the conservative loads (gravity, springs) on.
+struct ConservativePoint {
+  ForcePoint forces;
+  double potential_energy = 0.0;  // V(q) [J]
+};
+
+// Joint rates per unit q̇ (every x fixed) and per unit ẋ_k (q̇ = 0): virtual power ratios.
+struct RatioPoint {
+  std::vector<double> wrt_q;               // [joint]
+  std::vector<std::vector<double>> wrt_x;  // [constraint force][joint]
+};
+
+// The cross-check of issue 3, route "direct": m1 = uᵀMu, me1 = u_xᵀMu, m2 = uᵀ(M b + c),
+// me2 = u_xᵀ(M b + c), from the mass matrix and bias forces.
+struct DirectPoint {
+  double m1 = 0.0, m2 = 0.0;
+  std::vector<double> me1, me2;
+};
+
+class KinetostaticSource {
+ public:
+  virtual ~KinetostaticSource() = default;
+  virtual int num_constraint_forces() const = 0;
+  virtual int num_joints() const = 0;
+  // Inverse dynamics with every applied load off (purely inertial).
+  virtual ForcePoint inertial(double q, double qdot, double qddot) = 0;
+  virtual ConservativePoint conservative(double q) = 0;
+  virtual RatioPoint ratios(double q) = 0;
+  // Optional routes; empty when the source cannot offer them.
+  // A sample of the prescribed law q(t) = c1 + c2 t + c3 cos(c4 t + c5) at time t,
+  // continuing from the previous sample (applied loads off).
+  virtual std::optional<ForcePoint> harmonic_sweep(const double c[5], double t) {
+    (void)c, (void)t;
+    return std::nullopt;
+  }
+  virtual std::optional<DirectPoint> direct(double q) {
+    (void)q;
+    return std::nullopt;
+  }
+};
+
+}  // namespace rdyn::reduced

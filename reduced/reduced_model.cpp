@@ -1,0 +1,189 @@
+#include "reduced/reduced_model.hpp"
+
+#include <cmath>
+
+namespace rdyn::reduced {
+
+namespace {
+
+double resistance_torque(models::ResistanceLaw law, double c, double w) {
+  switch (law) {
+    case models::ResistanceLaw::Constant: return w > 0 ? -c : w < 0 ? c : 0.0;
+    case models::ResistanceLaw::Viscous: return -c * w;
+    case models::ResistanceLaw::Quadratic: return -c * w * std::abs(w);
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
+                                bool energy_consistent_m2) {
+  ReducedModel m;
+  m.table = build_table(s, interp, energy_consistent_m2);
+  m.c_m1 = s.require("m1");
+  m.c_m2 = s.require("m2");
+  m.c_V = s.require("V");
+  m.c_Q = s.require("Q_cons");
+  for (const auto& f : scene.outputs.constraint_forces) {
+    m.force_names.push_back(f.name);
+    m.c_me1.push_back(s.require("me1_" + f.name));
+    m.c_me2.push_back(s.require("me2_" + f.name));
+    m.c_Qx.push_back(s.require("Qx_cons_" + f.name));
+  }
+  auto rx_cols = [&](const std::string& prefix, const std::string& what) {
+    std::vector<int> c;
+    for (const auto& f : scene.outputs.constraint_forces) c.push_back(s.require(prefix + f.name + "_" + what));
+    return c;
+  };
+  m.rhs_cols = {m.c_m1, m.c_m2, m.c_Q};
+  for (const auto& t : scene.joint_torques) {
+    ReducedModel::Torque tq{t.value, s.require("r_" + t.joint), rx_cols("rx_", t.joint), -1};
+    if (t.active_when) {
+      tq.gate = static_cast<int>(m.gates.size());
+      ReducedModel::Gate g{s.require("r_" + t.active_when->joint), t.active_when->sign, {}, 1.0};
+      const auto* roots = s.roots_of("r_" + t.active_when->joint);
+      if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
+        // Orient the product of sines like r at the grid sample farthest from any root.
+        g.roots = *roots;
+        double best = -1, q_best = s.q[0];
+        for (double q : s.q) {
+          double d = INFINITY;
+          for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
+          if (d > best) best = d, q_best = q;
+        }
+        const double r_val = m.table.eval(g.c_r, q_best);
+        double prod = 1.0;
+        for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
+        g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
+      }
+      m.gates.push_back(std::move(g));
+    }
+    m.torques.push_back(tq);
+    m.rhs_cols.push_back(tq.c_r);
+  }
+  for (const auto& mo : scene.motors) {
+    m.motors.push_back({mo.stall_torque, mo.no_load_speed, s.require("r_" + mo.joint), rx_cols("rx_", mo.joint)});
+    m.rhs_cols.push_back(m.motors.back().c_r);
+  }
+  for (const auto& r : scene.resistances) {
+    m.brakes.push_back({r.law, r.coefficient, s.require("w_" + r.body), rx_cols("wx_", r.body)});
+    m.rhs_cols.push_back(m.brakes.back().c_w);
+  }
+  return m;
+}
+
+ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)
+    : gate_on(m.gates.size(), 1), scratch(m.rhs_cols.size()) {}
+
+void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                       double& power_nc) {
+  double* v = ws.scratch.data();
+  m.table.eval_cols(q, m.rhs_cols.data(), static_cast<int>(m.rhs_cols.size()), v);
+  const double m1 = v[0], m2 = v[1];
+  double F_nc = 0.0;  // generalized force of the non-conservative loads on q
+  const double* r = v + 3;
+  for (const auto& t : m.torques) {
+    if (t.gate < 0 || ws.gate_on[t.gate]) F_nc += t.value * *r;
+    ++r;
+  }
+  for (const auto& mo : m.motors) {
+    const double u = *r * qdot;  // joint rate
+    F_nc += mo.stall * (1.0 - u / mo.no_load_speed) * *r;
+    ++r;
+  }
+  for (const auto& b : m.brakes) {
+    F_nc += resistance_torque(b.law, b.coefficient, *r * qdot) * *r;
+    ++r;
+  }
+  // Eksergian: m1 q̈ + m2 q̇² = Q_cons + F_nc
+  qddot = (v[2] + F_nc - m2 * qdot * qdot) / m1;
+  power_nc = F_nc * qdot;
+}
+
+double calc_switching(const ReducedModel& m, int g, double q, double qdot) {
+  const auto& gate = m.gates[g];
+  if (gate.roots.empty()) return gate.sign * m.table.eval(gate.c_r, q) * qdot;
+  double prod = gate.root_sign;
+  for (double r : gate.roots) prod *= std::sin(0.5 * (q - r));
+  return gate.sign * prod * qdot;
+}
+
+void init_gates(const ReducedModel& m, ReducedWorkspace& ws) {
+  for (size_t g = 0; g < m.gates.size(); ++g) {
+    const double s = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
+    if (std::abs(s) > 1e-12) {
+      ws.gate_on[g] = s > 0;
+      continue;
+    }
+    // From rest: on if, switched on, it drives its joint the gated way (r·q̈ has its sign).
+    ws.gate_on[g] = 1;
+    double qdd, p;
+    calc_acceleration(m, ws, ws.q, ws.qdot, qdd, p);
+    ws.gate_on[g] = calc_switching(m, static_cast<int>(g), ws.q, qdd) > 0;
+  }
+}
+
+double calc_energy(const ReducedModel& m, double q, double qdot) {
+  return 0.5 * m.table.eval(m.c_m1, q) * qdot * qdot + m.table.eval(m.c_V, q);
+}
+
+void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, double q, double qdot, double qddot,
+                            double* forces) {
+  const auto& T = m.table;
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    // Q_x,k of the applied loads along x_k, by virtual power with q̇ = 0, ẋ_k = 1; the
+    // velocity-dependent loads see the actual joint rates r_j·q̇.
+    double Qx = T.eval(m.c_Qx[k], q);
+    for (const auto& t : m.torques)
+      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += t.value * T.eval(t.c_rx[k], q);
+    for (const auto& mo : m.motors)
+      Qx += mo.stall * (1.0 - T.eval(mo.c_r, q) * qdot / mo.no_load_speed) * T.eval(mo.c_rx[k], q);
+    for (const auto& b : m.brakes)
+      Qx += resistance_torque(b.law, b.coefficient, T.eval(b.c_w, q) * qdot) * T.eval(b.c_wx[k], q);
+    // me1 q̈ + me2 q̇² = F_E + Q_x
+    forces[k] = T.eval(m.c_me1[k], q) * qddot + T.eval(m.c_me2[k], q) * qdot * qdot - Qx;
+  }
+}
+
+namespace {
+
+// Classical RK4 on y = (q, q̇, W) with frozen gates.
+void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
+  const double q = ws.q, v = ws.qdot;
+  double a1, p1, a2, p2, a3, p3, a4, p4;
+  calc_acceleration(m, ws, q, v, a1, p1);
+  calc_acceleration(m, ws, q + 0.5 * h * v, v + 0.5 * h * a1, a2, p2);
+  calc_acceleration(m, ws, q + 0.5 * h * (v + 0.5 * h * a1), v + 0.5 * h * a2, a3, p3);
+  calc_acceleration(m, ws, q + h * (v + 0.5 * h * a2), v + h * a3, a4, p4);
+  ws.q = q + h * (v + h / 6.0 * (a1 + a2 + a3));
+  ws.qdot = v + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4);
+  ws.work += h / 6.0 * (p1 + 2 * p2 + 2 * p3 + p4);
+  ws.t += h;
+}
+
+}  // namespace
+
+void step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
+  const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
+  rk4(m, ws, h);
+  // Earliest gate switch inside the step, by linear interpolation of the switching function.
+  double frac = 2.0;
+  int which = -1;
+  for (size_t g = 0; g < m.gates.size(); ++g) {
+    const double s0 = calc_switching(m, static_cast<int>(g), q0, v0);
+    const double s1 = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
+    if ((s0 > 0) != (s1 > 0) && s0 != s1) {
+      const double f = s0 / (s0 - s1);
+      if (f < frac) frac = f, which = static_cast<int>(g);
+    }
+  }
+  if (which < 0) return;
+  ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
+  const double h1 = std::max(0.0, std::min(1.0, frac)) * h;
+  if (h1 > 0) rk4(m, ws, h1);
+  ws.gate_on[which] = !ws.gate_on[which];
+  if (h - h1 > 0) rk4(m, ws, h - h1);
+}
+
+}  // namespace rdyn::reduced

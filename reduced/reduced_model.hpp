@@ -1,0 +1,97 @@
+// The reduced model: an immutable fused table plus the scene's loads expressed through it,
+// and a small workspace for stepping. No Simbody.
+//
+//   Eksergian:        m1(q) q̈ + m2(q) q̇² = F*(q, q̇, t)
+//   constraint line:  me1_k(q) q̈ + me2_k(q) q̇² = F*_x,k = F_E,k + Q_x,k(loads)
+//
+// F* = Q_cons(q) + Σ torques T·r_j(q)·[gate] + Σ motors τ(r_j q̇)·r_j + Σ brakes T(w_b q̇)·w_b
+// (virtual power), and likewise Q_x,k with the ratios along x_k.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "models/scene.hpp"
+#include "reduced/samples.hpp"
+#include "reduced/table.hpp"
+
+namespace rdyn::reduced {
+
+struct ReducedModel {
+  Table table;
+  std::vector<std::string> force_names;
+  int c_m1 = -1, c_m2 = -1, c_V = -1, c_Q = -1;
+  std::vector<int> c_me1, c_me2, c_Qx;  // per constraint force
+
+  // Load on while sign · r(q) · q̇ > 0. When the table carries the exact zeros ρ_k of r
+  // (located on the full model), the switching function uses c·Π sin((q − ρ_k)/2) instead of
+  // the interpolated r: same sign, zero exactly at the switch angles.
+  struct Gate {
+    int c_r = -1;
+    int sign = +1;
+    std::vector<double> roots;
+    double root_sign = 1.0;  // c
+  };
+  struct Torque {
+    double value = 0.0;   // [N·m or N]
+    int c_r = -1;         // ratio of its joint
+    std::vector<int> c_rx;
+    int gate = -1;        // index into gates, −1 when always on
+  };
+  struct Motor {
+    double stall = 0.0, no_load_speed = 0.0;
+    int c_r = -1;
+    std::vector<int> c_rx;
+  };
+  struct Brake {
+    models::ResistanceLaw law = models::ResistanceLaw::Viscous;
+    double coefficient = 0.0;
+    int c_w = -1;
+    std::vector<int> c_wx;
+  };
+  std::vector<Gate> gates;
+  std::vector<Torque> torques;
+  std::vector<Motor> motors;
+  std::vector<Brake> brakes;
+
+  // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r,
+  // each motor's r, each brake's w.
+  std::vector<int> rhs_cols;
+};
+
+// Joins the sampled parameters with the scene's loads. Throws TableError when a column the
+// loads need is missing (a table extracted from another scene).
+ReducedModel make_reduced_model(const Samples& samples, const models::Scene& scene, Interpolation interp,
+                                bool energy_consistent_m2 = false);
+
+// Per-run state: the ODE state, the load gates, and scratch space sized once.
+struct ReducedWorkspace {
+  double t = 0.0, q = 0.0, qdot = 0.0, work = 0.0;
+  std::vector<char> gate_on;
+  std::vector<double> scratch;  // rhs_cols values
+  explicit ReducedWorkspace(const ReducedModel& m);
+};
+
+// q̈ and the power of the non-conservative loads at (q, q̇) with the workspace's gates.
+// Allocation-free.
+void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                       double& power_nc);
+
+// Switching function of gate g: its sign decides whether the gated load acts.
+double calc_switching(const ReducedModel& m, int gate, double q, double qdot);
+
+// Sets every gate from the state (from rest: from the sign of the acceleration the load
+// would produce, as the full model does).
+void init_gates(const ReducedModel& m, ReducedWorkspace& ws);
+
+// Kinetic + potential energy and the constraint forces F_E,k at (q, q̇, q̈) [J], [N].
+double calc_energy(const ReducedModel& m, double q, double qdot);
+void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, double q, double qdot,
+                            double qddot, double* forces);
+
+// One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside
+// the step is located by linear interpolation of the switching function and the step is
+// split there.
+void step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
+
+}  // namespace rdyn::reduced

@@ -1,0 +1,191 @@
+#include "reduced/table.hpp"
+
+#include <cmath>
+#include <memory>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_spline.h>
+
+namespace rdyn::reduced {
+
+Interpolation parse_interpolation(const std::string& name) {
+  if (name == "cubic") return Interpolation::CubicSpline;
+  if (name == "akima") return Interpolation::Akima;
+  if (name == "linear") return Interpolation::Linear;
+  if (name == "fourier") return Interpolation::Fourier;
+  throw TableError("unknown interpolation '" + name + "' (cubic, akima, linear, fourier)");
+}
+
+std::string interpolation_name(Interpolation i) {
+  switch (i) {
+    case Interpolation::CubicSpline: return "cubic";
+    case Interpolation::Akima: return "akima";
+    case Interpolation::Linear: return "linear";
+    case Interpolation::Fourier: return "fourier";
+  }
+  return "?";
+}
+
+namespace {
+
+// Trigonometric interpolant of N equispaced samples over one period, evaluated on a grid
+// `refine` times finer (direct DFT: N ≤ a few hundred). For even N the Nyquist term is a
+// cosine with half weight, so the interpolant is real and passes through every sample.
+Samples fourier_resample(const Samples& s, int refine) {
+  const int n = static_cast<int>(s.q.size()), m = n * refine;
+  const double period = s.step * n;
+  Samples out = s;
+  out.step = period / m;
+  out.q.resize(m);
+  for (int i = 0; i < m; ++i) out.q[i] = s.q0 + i * out.step;
+  const int kmax = n / 2;
+  for (size_t c = 0; c < s.columns.size(); ++c) {
+    const auto& y = s.columns[c];
+    std::vector<double> a(kmax + 1, 0.0), b(kmax + 1, 0.0);
+    for (int k = 0; k <= kmax; ++k) {
+      for (int i = 0; i < n; ++i) {
+        const double ph = 2 * M_PI * k * i / n;
+        a[k] += y[i] * std::cos(ph);
+        b[k] += y[i] * std::sin(ph);
+      }
+      const double w = (k == 0 || (n % 2 == 0 && k == kmax)) ? 1.0 / n : 2.0 / n;
+      a[k] *= w;
+      b[k] *= w;
+    }
+    if (n % 2 == 0) b[kmax] = 0.0;
+    auto& col = out.columns[c];
+    col.assign(m, 0.0);
+    for (int i = 0; i < m; ++i) {
+      const double x = static_cast<double>(i) / refine;  // in sample units
+      double v = 0.0;
+      for (int k = 0; k <= kmax; ++k) v += a[k] * std::cos(2 * M_PI * k * x / n) + b[k] * std::sin(2 * M_PI * k * x / n);
+      col[i] = v;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+int Table::locate(double q, double& dx) const {
+  double u = (q - q0) / step;
+  if (periodic) {
+    u = std::fmod(u, static_cast<double>(intervals));
+    if (u < 0) u += intervals;
+  }
+  int i = static_cast<int>(u);
+  if (i < 0) i = 0;
+  if (i >= intervals) i = intervals - 1;
+  dx = (u - i) * step;
+  return i;
+}
+
+bool Table::in_range(double q) const {
+  return periodic || (q >= q0 - 1e-12 * step && q <= q0 + intervals * step * (1 + 1e-12));
+}
+
+double Table::eval(int col, double q) const {
+  double dx;
+  const double* c = &coef[(static_cast<size_t>(locate(q, dx)) * cols + col) * 4];
+  return c[0] + dx * (c[1] + dx * (c[2] + dx * c[3]));
+}
+
+double Table::eval_deriv(int col, double q) const {
+  double dx;
+  const double* c = &coef[(static_cast<size_t>(locate(q, dx)) * cols + col) * 4];
+  return c[1] + dx * (2 * c[2] + dx * 3 * c[3]);
+}
+
+void Table::eval_cols(double q, const int* idx, int n, double* out) const {
+  double dx;
+  const double* row = &coef[static_cast<size_t>(locate(q, dx)) * cols * 4];
+  for (int k = 0; k < n; ++k) {
+    const double* c = row + idx[k] * 4;
+    out[k] = c[0] + dx * (c[1] + dx * (c[2] + dx * c[3]));
+  }
+}
+
+int Table::column(const std::string& name) const {
+  for (int c = 0; c < cols; ++c)
+    if (names[c] == name) return c;
+  return -1;
+}
+
+Table build_table(const Samples& samples, Interpolation interp, bool energy_consistent_m2) {
+  if (interp == Interpolation::Fourier) {
+    if (!samples.periodic) throw TableError("fourier interpolation needs a periodic table");
+    const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 180.0) - 1e-9)));
+    return build_table(fourier_resample(samples, refine), Interpolation::CubicSpline, energy_consistent_m2);
+  }
+  const Samples& s = samples;
+  const int n = static_cast<int>(s.q.size());
+  if (n < 4) throw TableError("a reduced table needs at least 4 grid points");
+  Table t;
+  t.periodic = s.periodic;
+  t.q0 = s.q0;
+  t.step = s.step;
+  t.period = s.periodic ? s.step * n : 0.0;
+  t.intervals = s.periodic ? n : n - 1;
+  t.cols = static_cast<int>(s.names.size());
+  t.names = s.names;
+  t.coef.assign(static_cast<size_t>(t.intervals) * t.cols * 4, 0.0);
+
+  const gsl_interp_type* type = nullptr;
+  switch (interp) {
+    case Interpolation::CubicSpline: type = s.periodic ? gsl_interp_cspline_periodic : gsl_interp_cspline; break;
+    case Interpolation::Akima: type = s.periodic ? gsl_interp_akima_periodic : gsl_interp_akima; break;
+    case Interpolation::Linear: type = gsl_interp_linear; break;
+    case Interpolation::Fourier: break;  // handled above
+  }
+  // Periodic interpolants take the first point again at q0 + period.
+  const int m = s.periodic ? n + 1 : n;
+  std::vector<double> x(m), y(m);
+  for (int i = 0; i < m; ++i) x[i] = s.q0 + i * s.step;
+  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(type, m), gsl_spline_free);
+  std::unique_ptr<gsl_interp_accel, decltype(&gsl_interp_accel_free)> acc(gsl_interp_accel_alloc(),
+                                                                         gsl_interp_accel_free);
+  gsl_set_error_handler_off();
+  for (int c = 0; c < t.cols; ++c) {
+    for (int i = 0; i < m; ++i) y[i] = s.columns[c][i % n];
+    if (gsl_spline_init(sp.get(), x.data(), y.data(), m) != GSL_SUCCESS)
+      throw TableError("GSL could not build the interpolant of column '" + s.names[c] + "'");
+    // Exact cubic per interval from four values inside it (s = 0, 1/3, 2/3, 1): the
+    // interpolants are piecewise cubic, so this reproduces them up to rounding.
+    for (int iv = 0; iv < t.intervals; ++iv) {
+      const double h = s.step, xa = x[iv];
+      const double f0 = y[iv], f3 = y[iv + 1];
+      const double f1 = gsl_spline_eval(sp.get(), xa + h / 3, acc.get());
+      const double f2 = gsl_spline_eval(sp.get(), xa + 2 * h / 3, acc.get());
+      // Inverse Vandermonde of s = 0, 1/3, 2/3, 1 (Newton divided differences).
+      const double A = f0;
+      const double B = (-11 * f0 + 18 * f1 - 9 * f2 + 2 * f3) / 2;
+      const double C = (18 * f0 - 45 * f1 + 36 * f2 - 9 * f3) / 2;
+      const double D = (-9 * f0 + 27 * f1 - 27 * f2 + 9 * f3) / 2;
+      double* cf = &t.coef[(static_cast<size_t>(iv) * t.cols + c) * 4];
+      cf[0] = A;
+      cf[1] = B / h;
+      cf[2] = C / (h * h);
+      cf[3] = D / (h * h * h);
+    }
+  }
+  if (energy_consistent_m2) {
+    // target = scale · d/dq source on every interval:
+    // d/dq (a + b dx + c dx² + d dx³) = b + 2c dx + 3d dx².
+    auto set_derivative = [&](int src, int dst, double scale) {
+      for (int iv = 0; iv < t.intervals; ++iv) {
+        const double* a = &t.coef[(static_cast<size_t>(iv) * t.cols + src) * 4];
+        double* b = &t.coef[(static_cast<size_t>(iv) * t.cols + dst) * 4];
+        b[0] = scale * a[1];
+        b[1] = scale * 2 * a[2];
+        b[2] = scale * 3 * a[3];
+        b[3] = 0.0;
+      }
+    };
+    set_derivative(s.require("m1"), s.require("m2"), 0.5);  // Eksergian: m2 = ½ dm1/dq
+    // Q_cons = −dV/dq, so the potential part is exactly conservative too.
+    if (s.column("V") >= 0 && s.column("Q_cons") >= 0) set_derivative(s.require("V"), s.require("Q_cons"), -1.0);
+  }
+  return t;
+}
+
+}  // namespace rdyn::reduced

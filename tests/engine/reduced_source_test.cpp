@@ -1,0 +1,137 @@
+// Reduced parameters read off the Simbody model: closed forms and independent routes.
+#include "engine/reduced_source.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "../reduced/analytic_source.hpp"
+#include "engine/kinetostatic.hpp"
+#include "models/scene_yaml.hpp"
+#include "reduced/extract.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+reduced::Samples extract(const models::Scene& scene, double deg, reduced::Method method) {
+  FullModel model(scene);
+  FullKinetostaticSource src(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = deg * M_PI / 180;
+  opt.method = method;
+  return reduced::extract_samples(src, scene, opt);
+}
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+TEST(ReducedSource, SliderCrankInertiaMatchesClosedForm) {
+  // models/scenes/slider-crank.yaml has the same dimensions as test::SliderCrank.
+  const auto s = extract(models::load_scene("slider-crank"), 10, reduced::Method::Kinetostatic);
+  const test::SliderCrank sc;
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    EXPECT_NEAR(s.columns[s.require("m1")][i], sc.m1(s.q[i]), 1e-12) << s.q[i];
+    EXPECT_NEAR(s.columns[s.require("m2")][i], sc.m2(s.q[i]), 1e-9) << s.q[i];
+  }
+}
+
+TEST(ReducedSource, FourBarInertiaMatchesClosedForm) {
+  // T = ½ m1 θ̇² summed over the crank (about A), coupler (centre of mass and rotation) and
+  // rocker (about D); link velocities by central differences of closed-form positions.
+  const auto scene = models::load_scene("fourbar");
+  const auto s = extract(scene, 15, reduced::Method::Kinetostatic);
+  const double a = 0.08, b = 0.28, c = 0.20, d = 0.30;
+  auto pose = [&](double th, double& cpl, double& rk) {
+    const double Bx = a * std::cos(th), By = a * std::sin(th), dx = d - Bx, dy = -By, L = std::hypot(dx, dy);
+    const double A = (b * b - c * c + L * L) / (2 * L), h = std::sqrt(b * b - A * A);
+    const double Cx = Bx + A * dx / L - h * dy / L, Cy = By + A * dy / L + h * dx / L;
+    cpl = std::atan2(Cy - By, Cx - Bx);
+    rk = std::atan2(Cy, Cx - d);
+  };
+  auto com = [&](double th, double& x, double& y) {
+    double cpl, rk;
+    pose(th, cpl, rk);
+    x = a * std::cos(th) + 0.14 * std::cos(cpl);
+    y = a * std::sin(th) + 0.14 * std::sin(cpl);
+  };
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    const double th = s.q[i], h = 1e-6;
+    double c1, r1, c2, r2, x1, y1, x2, y2;
+    pose(th + h, c1, r1);
+    pose(th - h, c2, r2);
+    com(th + h, x1, y1);
+    com(th - h, x2, y2);
+    const double wc = std::remainder(c1 - c2, 2 * M_PI) / (2 * h), wr = std::remainder(r1 - r2, 2 * M_PI) / (2 * h);
+    const double vx = (x1 - x2) / (2 * h), vy = (y1 - y2) / (2 * h);
+    const double m1 = (2.667e-4 + 0.5 * 0.04 * 0.04) + 1.2 * (vx * vx + vy * vy) + 7.84e-3 * wc * wc +
+                      (3.0e-3 + 0.9 * 0.1 * 0.1) * wr * wr;
+    EXPECT_NEAR(s.columns[s.require("m1")][i], m1, 1e-8 * m1) << th;
+  }
+}
+
+TEST(ReducedSource, FourMethodsAgreeOnTheBicycle) {
+  const auto scene = models::load_scene("bicycle");
+  const auto ks = extract(scene, 10, reduced::Method::Kinetostatic);
+  const auto direct = extract(scene, 10, reduced::Method::Direct);
+  const auto sweep = extract(scene, 10, reduced::Method::PaperSweep);
+  const auto integ = extract(scene, 10, reduced::Method::Integrated);
+  for (const char* col : {"m1", "m2", "me1_knee", "me2_knee"}) {
+    const auto& ref = ks.columns[ks.require(col)];
+    const double scale = max_abs(ref);
+    for (size_t i = 0; i < ref.size(); ++i) {
+      EXPECT_NEAR(direct.columns[direct.require(col)][i], ref[i], 1e-8 * scale) << col;
+      EXPECT_NEAR(sweep.columns[sweep.require(col)][i], ref[i], 1e-6 * scale) << col;
+    }
+  }
+  const auto& m1 = ks.columns[ks.require("m1")];
+  for (size_t i = 0; i < m1.size(); ++i) EXPECT_NEAR(integ.columns[0][i], m1[i], 1e-3 * max_abs(m1));
+}
+
+TEST(ReducedSource, M2IsHalfTheDerivativeOfM1) {
+  // Eksergian: m2 = ½ dm1/dq. Three-point central differences carry an O(h²) truncation error
+  // (1.07e-3 of max|m2| at 1° where m2 bends sharply near 165°, a quarter of that at 0.5°); the
+  // five-point stencil (O(h⁴)) shows the identity itself holds to ~1e-5.
+  auto errors = [](double deg, double& e3, double& e5) {
+    const auto s = extract(models::load_scene("bicycle"), deg, reduced::Method::Kinetostatic);
+    const auto& m1 = s.columns[s.require("m1")];
+    const auto& m2 = s.columns[s.require("m2")];
+    const size_t n = m1.size();
+    e3 = e5 = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double p1 = m1[(i + 1) % n], p2 = m1[(i + 2) % n], n1 = m1[(i + n - 1) % n], n2 = m1[(i + n - 2) % n];
+      e3 = std::max(e3, std::abs(m2[i] - 0.5 * (p1 - n1) / (2 * s.step)));
+      e5 = std::max(e5, std::abs(m2[i] - 0.5 * (-p2 + 8 * p1 - 8 * n1 + n2) / (12 * s.step)));
+    }
+    e3 /= max_abs(m2);
+    e5 /= max_abs(m2);
+  };
+  double e3_1, e5_1, e3_05, e5_05;
+  errors(1.0, e3_1, e5_1);
+  errors(0.5, e3_05, e5_05);
+  EXPECT_LT(e5_1, 1e-5);
+  EXPECT_LT(e3_1, 1.5e-3);
+  EXPECT_NEAR(e3_1 / e3_05, 4.0, 0.2);    // second order: truncation, not a model error
+  EXPECT_NEAR(e5_1 / e5_05, 16.0, 1.5);   // fourth order
+}
+
+TEST(ReducedSource, SwitchAnglesAreZerosOfTheThighRate) {
+  const auto scene = models::load_scene("bicycle");
+  const auto s = extract(scene, 10, reduced::Method::Kinetostatic);
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  const int hip = scene.joint_index("hip_r");
+  const auto* roots = s.roots_of("r_hip_r");
+  ASSERT_NE(roots, nullptr);
+  ASSERT_EQ(roots->size(), 2u);  // the right thigh turns back twice per revolution
+  for (double q : *roots) {
+    for (double p = scene.initial.q; std::abs(p - q) > 0.05; p += (q > p ? 0.05 : -0.05))
+      calc_kinetostatic(model, ws, p, 0, 0, Loads::Off);  // walk there on the branch
+    EXPECT_NEAR(calc_velocity_ratios(model, ws, q).wrt_q[hip], 0.0, 1e-12) << q;
+  }
+}
+
+}  // namespace
+}  // namespace rdyn::engine

@@ -1,0 +1,19 @@
+// Reduced models extracted from the full model of a scene (engine + reduced together).
+#pragma once
+
+#include "models/scene.hpp"
+#include "reduced/extract.hpp"
+#include "reduced/samples.hpp"
+
+namespace rdyn::validate {
+
+struct Extraction {
+  reduced::Samples samples;
+  double extraction_ms = 0.0;  // wall time of the kinetostatic calls [ms]
+  long calls = 0;              // kinetostatic calls made
+};
+
+// Builds the full model of the scene and samples its reduced parameters.
+Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method);
+
+}  // namespace rdyn::validate

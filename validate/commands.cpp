@@ -1,0 +1,133 @@
+#include "validate/commands.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "engine/forward_dynamics.hpp"
+#include "engine/full_model.hpp"
+#include "models/scene_yaml.hpp"
+#include "reduced/reduced_model.hpp"
+#include "reduced/simulate_reduced.hpp"
+#include "validate/build_reduced.hpp"
+#include "validate/output_dir.hpp"
+#include "validate/timeseries_csv.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+models::Scene load(const std::string& scene, const std::vector<std::string>& sets) {
+  std::vector<models::Override> overrides;
+  for (const auto& s : sets) overrides.push_back(models::parse_override(s));
+  return models::load_scene(scene, overrides);
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) {
+  std::ofstream f(path);
+  f << j.dump(2) << "\n";
+  if (!f) throw OutputError(path + ": cannot write");
+}
+
+}  // namespace
+
+int run_simulate(const SimulateArgs& a) {
+  const models::Scene scene = load(a.scene, a.sets);
+  const double duration = std::isnan(a.duration) ? scene.simulation.duration_s : a.duration;
+  const double dt_out = std::isnan(a.dt_out) ? scene.simulation.output_interval_s : a.dt_out;
+  const double tolerance = std::isnan(a.tolerance) ? scene.simulation.tolerance : a.tolerance;
+  if (!(duration > 0) || !(dt_out > 0) || !(tolerance > 0 && tolerance < 1))
+    throw models::SceneError(a.scene, 0, "--duration/--dt-out/--tolerance", "must be positive (tolerance < 1)");
+  OutputDir out(a.out);  // fails early on an unwritable folder
+
+  nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
+                        {"duration_s", duration},  {"output_interval_s", dt_out}};
+  models::TimeSeries ts;
+  if (a.model == "full") {
+    engine::FullModelOptions mo;
+    mo.route = a.route == "reaction" ? engine::ConstraintForceRoute::Reaction : engine::ConstraintForceRoute::Actuator;
+    engine::FullModel model(scene, mo);
+    engine::ForwardOptions opt{duration, dt_out, tolerance, a.integrator};
+    ts = engine::simulate_full(model, opt);
+    run.update({{"tolerance", tolerance},
+                {"integrator", a.integrator},
+                {"constraint_force_route", a.route},
+                {"simbody_bodies", model.num_simbody_bodies()},
+                {"max_loop_gap_m", ts.stats.max_constraint_error}});
+  } else {
+    reduced::Samples samples;
+    double extraction_ms = 0.0;
+    if (!a.table.empty()) {
+      samples = reduced::read_samples_csv(a.table);
+      run["table"] = a.table;
+    } else {
+      auto e = extract_from_full(scene, a.grid_deg, reduced::parse_method(a.method));
+      samples = std::move(e.samples);
+      extraction_ms = e.extraction_ms;
+      run.update({{"grid_deg", a.grid_deg}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
+    }
+    const auto model = reduced::make_reduced_model(samples, scene, reduced::parse_interpolation(a.interpolation),
+                                                   a.energy_consistent);
+    reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
+    ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
+    run.update({{"interpolation", a.interpolation},
+                {"energy_consistent_m2", a.energy_consistent},
+                {"integrator", a.reduced_integrator},
+                {"tolerance", a.reduced_tolerance},
+                {"extraction_ms", extraction_ms},
+                {"events", ts.stats.events}});
+  }
+  write_timeseries_csv(out.file("timeseries.csv"), ts);
+  const auto eb = energy_balance(ts);
+  run.update({{"steps_taken", ts.stats.steps_taken},
+              {"steps_attempted", ts.stats.steps_attempted},
+              {"smallest_step_s", ts.stats.smallest_step_s},
+              {"wall_time_s", ts.stats.wall_time_s},
+              {"wall_time_per_simulated_s", ts.stats.wall_time_s / duration},
+              {"energy_balance_residual_J", eb.max_residual_J},
+              {"energy_scale_J", eb.energy_scale_J}});
+  write_json(out.file("run.json"), run);
+  out.commit();
+  std::fprintf(stderr, "%s\n",
+               fmt::format("rdyn: {} ({} model) {:.3g} s simulated in {:.3g} s wall, {} steps; energy balance "
+                           "residual {:.3g} J of {:.3g} J; wrote {}/timeseries.csv",
+                           scene.name, a.model, duration, ts.stats.wall_time_s, ts.stats.steps_taken,
+                           eb.max_residual_J, eb.energy_scale_J, a.out)
+                   .c_str());
+  return 0;
+}
+
+int run_extract(const ExtractArgs& a) {
+  const models::Scene scene = load(a.scene, a.sets);
+  const auto method = reduced::parse_method(a.method);
+  // Write beside the target and rename, so a failure leaves no half-written table.
+  namespace fs = std::filesystem;
+  const fs::path target = fs::absolute(a.out);
+  std::error_code ec;
+  if (!fs::is_directory(target.parent_path(), ec))
+    throw OutputError(a.out + ": cannot write: folder '" + target.parent_path().string() + "' does not exist");
+  const auto e = extract_from_full(scene, a.grid_deg, method);
+  const std::string tmp = target.string() + ".tmp";
+  try {
+    reduced::write_samples_csv(tmp, e.samples);
+  } catch (const reduced::TableError& err) {
+    fs::remove(tmp, ec);
+    throw OutputError(err.what());
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw OutputError(a.out + ": cannot write: " + ec.message());
+  }
+  std::fprintf(stderr, "%s\n",
+               fmt::format("rdyn: extracted {} ({}, {}° grid, {} points) in {:.3g} ms with {} kinetostatic calls; "
+                           "wrote {}",
+                           scene.name, a.method, a.grid_deg, e.samples.q.size(), e.extraction_ms, e.calls, a.out)
+                   .c_str());
+  return 0;
+}
+
+}  // namespace rdyn::validate

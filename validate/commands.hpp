@@ -1,0 +1,42 @@
+// The rdyn subcommands. Each returns the process exit status; errors are thrown and
+// mapped to statuses by main (2 for bad input).
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace rdyn::validate {
+
+struct SimulateArgs {
+  std::string scene;
+  std::string model = "full";  // full | reduced
+  double duration = NAN;       // NAN: the scene's
+  double dt_out = NAN;
+  double tolerance = NAN;      // full-model integrator accuracy
+  std::string integrator = "rkmerson";
+  std::string route = "actuator";
+  std::vector<std::string> sets;
+  std::string out;
+  // reduced model
+  std::string table;  // CSV from `rdyn extract`; empty: extract now
+  double grid_deg = 10.0;
+  std::string method = "kinetostatic";
+  std::string interpolation = "fourier";  // measured more accurate than cubic (docs/theory.md)
+  bool energy_consistent = false;
+  std::string reduced_integrator = "rk8pd";
+  double reduced_tolerance = 1e-10;
+  double fixed_step = 1e-3;
+};
+int run_simulate(const SimulateArgs& args);
+
+struct ExtractArgs {
+  std::string scene;
+  double grid_deg = 10.0;
+  std::string method = "kinetostatic";
+  std::vector<std::string> sets;
+  std::string out;  // FILE.csv
+};
+int run_extract(const ExtractArgs& args);
+
+}  // namespace rdyn::validate
