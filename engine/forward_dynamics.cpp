@@ -52,6 +52,13 @@ void record(const FullModel::Impl& m, const State& s, TimeSeries& ts) {
   ts.qddot.push_back(mb.getOneUDot(s, MobilizerUIndex(0)));
   ts.energy.push_back(m.system.calcEnergy(s));
   ts.work.push_back(m.work(s));
+  std::uint32_t mask = 0;
+  for (size_t i = 0, g = 0; i < m.scene.joint_torques.size(); ++i)
+    if (m.scene.joint_torques[i].active_when) {
+      if (m.gate(s, static_cast<int>(i)) && g < 32) mask |= 1u << g;
+      ++g;
+    }
+  ts.gates.push_back(mask);
   const auto f = m.constraint_forces(s);
   for (size_t k = 0; k < f.size(); ++k) ts.forces[k].push_back(f[k]);
   ts.stats.max_constraint_error = std::max(ts.stats.max_constraint_error, m.worst_loop_gap(s).first);
@@ -89,6 +96,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     throw EngineError(std::string("cannot start the full model: ") + e.what());
   }
 
+  m.events_handled = 0;
   TimeSeries ts;
   for (const auto& c : m.scene.outputs.constraint_forces) ts.force_names.push_back(c.name);
   ts.forces.resize(ts.force_names.size());
@@ -112,6 +120,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   }
   ts.stats.steps_taken = integ->getNumStepsTaken();
   ts.stats.steps_attempted = integ->getNumStepsAttempted();
+  ts.stats.events = m.events_handled;
   ts.stats.smallest_step_s = std::isfinite(smallest) ? smallest : 0.0;
   ts.stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ts;

@@ -55,6 +55,7 @@ struct FullModel::Impl {
   mutable SimTK::DiscreteVariableIndex load_mode_index;
   mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;  // per joint torque (if gated)
   mutable SimTK::ZIndex work_index;
+  mutable long events_handled = 0;  // gate switches handled (forward dynamics statistics)
 
   SimTK::State default_state;
 

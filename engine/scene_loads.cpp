@@ -149,6 +149,7 @@ class GateSwitch : public TriggeredEventHandler {
     // The state handed over is just past the crossing; at an exact zero keep toggling.
     const bool on = rate != 0.0 ? gate.sign * rate > 0.0 : !m_.gate(s, torque_);
     m_.set_gate(s, torque_, on);
+    ++m_.events_handled;
   }
 
  private:

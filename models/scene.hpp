@@ -152,6 +152,25 @@ struct Simulation {
   double tolerance = 1e-9;  // integrator accuracy of the full model (relative)
 };
 
+// Acceptance threshold for `rdyn validate`: the reduced model at this grid (and
+// interpolation, default the tool's) must reproduce `quantity` ("qdot" or a constraint
+// force's name) within max_error of its peak (max over the steady window).
+struct Threshold {
+  std::string quantity;
+  double grid_deg = 10.0;
+  std::string interpolation;  // empty: the default
+  double max_error = 0.005;
+};
+
+struct Validation {
+  double duration_s = 0.0;  // 0: simulation.duration_s
+  std::vector<Threshold> thresholds;
+  // Calibrate the drive torque so the resistance dissipates power_W at cadence_Hz (0: off).
+  double calibrate_cadence_Hz = 0.0;
+  double calibrate_power_W = 0.0;
+  std::string note;  // why the scene is hard / what it shows (reports quote it)
+};
+
 struct Scene {
   std::string name;
   std::string source_file;  // where it was read from (for messages)
@@ -170,6 +189,7 @@ struct Scene {
   Outputs outputs;
   Initial initial;
   Simulation simulation;
+  Validation validation;
 
   const Body* find_body(const std::string& name) const;
   const Joint* find_joint(const std::string& name) const;

@@ -438,7 +438,8 @@ Scene parse_scene(const std::string& text, const std::string& file,
   try {
     Fields top(root, "", file,
                {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops",
-                "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation"});
+                "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation",
+                "validation"});
     s.name = top.str("name");
     s.description = top.str_or("description", "");
 
@@ -514,6 +515,30 @@ Scene parse_scene(const std::string& text, const std::string& file,
       s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
       s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
     }
+    if (top.has("validation")) {
+      Fields f(top.raw("validation"), "validation", file, {"duration_s", "thresholds", "calibrate", "note"});
+      s.validation.duration_s = f.num_or("duration_s", 0.0);
+      s.validation.note = f.str_or("note", "");
+      if (s.validation.duration_s < 0) f.fail("duration_s", "must be positive");
+      for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
+        Fields t(n, path, file, {"quantity", "grid_deg", "interpolation", "max_error"});
+        Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
+                     t.num("max_error")};
+        bool known = th.quantity == "qdot";
+        for (const auto& c : s.outputs.constraint_forces) known |= c.name == th.quantity;
+        if (!known) t.fail("quantity", "expected qdot or the name of a requested constraint force");
+        if (!(th.max_error > 0)) t.fail("max_error", "must be positive");
+        if (!(th.grid_deg > 0)) t.fail("grid_deg", "must be positive");
+        s.validation.thresholds.push_back(th);
+      });
+      if (f.has("calibrate")) {
+        Fields c(f.raw("calibrate"), "validation.calibrate", file, {"cadence_Hz", "power_W"});
+        s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
+        s.validation.calibrate_power_W = c.num("power_W");
+        if (!(s.validation.calibrate_cadence_Hz > 0) || !(s.validation.calibrate_power_W > 0))
+          c.fail("cadence_Hz", "cadence and power must be positive");
+      }
+    }
   } catch (const YAML::Exception& e) {
     throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.msg);
   }
@@ -521,13 +546,75 @@ Scene parse_scene(const std::string& text, const std::string& file,
   return s;
 }
 
-Scene load_scene(const std::string& name_or_path, const std::vector<Override>& overrides) {
+std::string read_scene_text(const std::string& name_or_path) {
   const std::string path = resolve_scene_path(name_or_path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, 0, "", "cannot open for reading");
   std::stringstream buf;
   buf << in.rdbuf();
-  return parse_scene(buf.str(), path, overrides);
+  return buf.str();
+}
+
+Scene load_scene(const std::string& name_or_path, const std::vector<Override>& overrides) {
+  return parse_scene(read_scene_text(name_or_path), resolve_scene_path(name_or_path), overrides);
+}
+
+namespace {
+// Node at a dotted path (map keys; list items by index or name), or an invalid node.
+bool find_path(YAML::Node root, const std::string& path, YAML::Node& parent, std::string& last) {
+  std::vector<std::string> parts;
+  std::stringstream ss(path);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  if (parts.empty()) return false;
+  YAML::Node cur;
+  cur.reset(root);
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    YAML::Node next;
+    bool found = false;
+    if (cur.IsMap() && cur[parts[i]]) {
+      next.reset(cur[parts[i]]);
+      found = true;
+    } else if (cur.IsSequence()) {
+      for (size_t k = 0; k < cur.size() && !found; ++k)
+        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == parts[i]) next.reset(cur[k]), found = true;
+    }
+    if (!found) return false;
+    cur.reset(next);
+  }
+  parent.reset(cur);
+  last = parts.back();
+  return cur.IsMap() && static_cast<bool>(cur[last]);
+}
+}  // namespace
+
+bool scene_yaml_has(const std::string& text, const std::string& path) {
+  try {
+    YAML::Node root = YAML::Load(text), parent;
+    std::string last;
+    return find_path(root, path, parent, last);
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+std::string rewrite_scene_yaml(const std::string& text, const std::string& file, const std::vector<Override>& overrides,
+                               const std::vector<std::string>& remove) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw SceneError(file, 0, "", "a scene must be a YAML mapping of keys");
+  for (const auto& path : remove) {
+    YAML::Node parent;
+    std::string last;
+    if (find_path(root, path, parent, last)) parent.remove(last);
+  }
+  for (const auto& o : overrides) apply_override(root, o, file);
+  YAML::Emitter out;
+  out << root;
+  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace rdyn::models

@@ -31,4 +31,15 @@ Scene load_scene(const std::string& name_or_path, const std::vector<Override>& o
 Scene parse_scene(const std::string& yaml_text, const std::string& file,
                   const std::vector<Override>& overrides = {});
 
+// The text of a scene file (resolved like load_scene). Throws SceneError.
+std::string read_scene_text(const std::string& name_or_path);
+
+// Whether a dotted key path (as in overrides) exists in the scene's YAML.
+bool scene_yaml_has(const std::string& yaml_text, const std::string& path);
+
+// Removes the key paths that exist, applies the overrides, and returns the YAML re-emitted
+// (comments are not kept). Throws SceneError.
+std::string rewrite_scene_yaml(const std::string& yaml_text, const std::string& file,
+                               const std::vector<Override>& overrides, const std::vector<std::string>& remove);
+
 }  // namespace rdyn::models

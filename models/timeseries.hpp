@@ -2,6 +2,7 @@
 // reduced model (written as timeseries.csv). Plain data.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@ struct TimeSeries {
   std::vector<double> energy;               // kinetic + potential [J]
   std::vector<double> work;                 // cumulative work of non-conservative loads [J]
   std::vector<std::vector<double>> forces;  // forces[k][i]: force k at sample i [N]
+  std::vector<std::uint32_t> gates;         // bit g set: rate-gated load g on at sample i
   RunStats stats;
 };
 

@@ -13,6 +13,8 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/calibrate.hpp"
+#include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/timeseries_csv.hpp"
 
@@ -20,10 +22,37 @@ namespace rdyn::validate {
 
 namespace {
 
-models::Scene load(const std::string& scene, const std::vector<std::string>& sets) {
+std::vector<models::Override> overrides_of(const std::vector<std::string>& sets) {
   std::vector<models::Override> overrides;
   for (const auto& s : sets) overrides.push_back(models::parse_override(s));
-  return models::load_scene(scene, overrides);
+  return overrides;
+}
+
+models::Scene load(const std::string& scene, const std::vector<std::string>& sets) {
+  return models::load_scene(scene, overrides_of(sets));
+}
+
+// Writes text to path through a temporary file and a rename (no half-written output).
+void write_file_atomically(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path target = fs::absolute(path);
+  std::error_code ec;
+  if (!fs::is_directory(target.parent_path(), ec))
+    throw OutputError(path + ": cannot write: folder '" + target.parent_path().string() + "' does not exist");
+  const std::string tmp = target.string() + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    if (!f) {
+      fs::remove(tmp, ec);
+      throw OutputError(path + ": cannot write");
+    }
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw OutputError(path + ": cannot write: " + ec.message());
+  }
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {
@@ -127,6 +156,51 @@ int run_extract(const ExtractArgs& a) {
                            "wrote {}",
                            scene.name, a.method, a.grid_deg, e.samples.q.size(), e.extraction_ms, e.calls, a.out)
                    .c_str());
+  return 0;
+}
+
+int run_calibrate(const CalibrateArgs& a) {
+  const auto base = overrides_of(a.sets);
+  const models::Scene scene = models::load_scene(a.scene, base);
+  if (!a.write_scene.empty()) {  // fail early on an unwritable destination
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(fs::absolute(a.write_scene).parent_path(), ec))
+      throw OutputError(a.write_scene + ": cannot write: its folder does not exist");
+  }
+  CalibrationOptions opt;
+  opt.cadence_hz = a.cadence_hz;
+  opt.power_w = a.power_w;
+  opt.grid_deg = a.grid_deg;
+  opt.interpolation = a.interpolation;
+  Progress progress;
+  const auto r = calibrate(scene, opt, progress);
+  nlohmann::json j = {
+      {"scene", scene.name},
+      {"target_cadence_hz", a.cadence_hz},
+      {"target_power_w", a.power_w},
+      {"hip_torque_Nm", r.torque_Nm},
+      {"initial_guess_Nm", r.initial_guess_Nm},
+      {"resistance_coefficient", r.resistance_coefficient},
+      {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
+      {"mean_cadence_hz_full", r.mean_cadence_hz_full},
+      {"mean_power_w", r.mean_power_w},
+      {"peak_knee_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
+      {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_full_N)},
+      {"force_name", r.force_name},
+      {"speed_fluctuation", r.speed_fluctuation},
+      {"speed_fluctuation_full", r.speed_fluctuation_full},
+      {"drive_work_per_rev_per_Nm", r.drive_work_per_rev_per_Nm},
+      {"steady_q", r.steady_q},
+      {"steady_qdot", r.steady_qdot},
+      {"steady_cycles_computed", r.evaluations},
+      {"wall_time_s", r.wall_time_s},
+  };
+  if (!a.write_scene.empty()) {
+    write_file_atomically(a.write_scene, calibrated_scene_yaml(a.scene, base, scene, opt, r));
+    j["written_scene"] = a.write_scene;
+  }
+  std::printf("%s\n", j.dump(2).c_str());
   return 0;
 }
 

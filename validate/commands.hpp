@@ -39,4 +39,15 @@ struct ExtractArgs {
 };
 int run_extract(const ExtractArgs& args);
 
+struct CalibrateArgs {
+  std::string scene;
+  double cadence_hz = 1.0;
+  double power_w = 125.0;
+  std::vector<std::string> sets;
+  std::string write_scene;  // optional output YAML
+  double grid_deg = 10.0;
+  std::string interpolation = "fourier";
+};
+int run_calibrate(const CalibrateArgs& args);
+
 }  // namespace rdyn::validate

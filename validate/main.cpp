@@ -68,6 +68,22 @@ int main(int argc, char** argv) {
   extract->add_option("--set", ext.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   extract->add_option("--out", ext.out, "Output CSV file")->required();
 
+  CalibrateArgs cal;
+  auto* calibrate = app.add_subcommand(
+      "calibrate",
+      "Set the scene's resistance to dissipate P watts at cadence F, then find (GSL Brent) the constant drive "
+      "torque that holds the mean steady cadence at F with the reduced model, confirmed with the full model. "
+      "Prints JSON on standard output (hip_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
+      "mean_power_w, peak_knee_force_N, speed_fluctuation, ...); progress goes to standard error.");
+  calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
+  calibrate->add_option("--cadence-hz", cal.cadence_hz, "Target cadence [Hz] (default 1)");
+  calibrate->add_option("--power-w", cal.power_w, "Power the resistance dissipates at that cadence [W] (default 125)");
+  calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
+  calibrate->add_option("--set", cal.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  calibrate->add_option("--grid-deg", cal.grid_deg, "Reduced table grid [deg] (default 10)");
+  calibrate->add_option("--interp", cal.interpolation, "Reduced table interpolation (default fourier)")
+      ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -82,6 +98,7 @@ int main(int argc, char** argv) {
   try {
     if (*simulate) return run_simulate(sim);
     if (*extract) return run_extract(ext);
+    if (*calibrate) return run_calibrate(cal);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

@@ -1,0 +1,97 @@
+#include "validate/compare.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace rdyn::validate {
+
+const SignalError* Comparison::find(const std::string& name) const {
+  for (const auto& s : signals)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, double tol) {
+  SteadyWindow w;
+  const double T = ref.t.back();
+  std::vector<double> crossings;  // times where q passes q0 + 2πk
+  if (rotating) {
+    const double q0 = ref.q.front();
+    for (size_t i = 1; i < ref.t.size(); ++i) {
+      const double k0 = std::floor((ref.q[i - 1] - q0) / (2 * M_PI) + 1e-12);
+      const double k1 = std::floor((ref.q[i] - q0) / (2 * M_PI) + 1e-12);
+      if (k1 > k0 && k1 >= 1) {
+        const double target = q0 + 2 * M_PI * k1;
+        const double f = (target - ref.q[i - 1]) / (ref.q[i] - ref.q[i - 1]);
+        crossings.push_back(ref.t[i - 1] + f * (ref.t[i] - ref.t[i - 1]));
+      }
+    }
+  }
+  if (crossings.size() < 3) {
+    w.t_start = 0.2 * T;
+    w.revolutions = 0;
+    w.how = fmt::format("fewer than three full revolutions: the first 20 % ({:.3g} s) is skipped", w.t_start);
+    return w;
+  }
+  // Mean speed of revolution k (from crossing k−1 to k; the first one starts at t = 0).
+  std::vector<double> start{0.0}, mean;
+  for (size_t k = 0; k < crossings.size(); ++k) {
+    const double t0 = k == 0 ? 0.0 : crossings[k - 1];
+    mean.push_back(2 * M_PI / (crossings[k] - t0));
+    if (k > 0) start.push_back(t0);
+  }
+  const double last = mean.back();
+  size_t first_steady = mean.size() - 1;
+  while (first_steady > 0 && std::abs(mean[first_steady - 1] - last) <= tol * std::abs(last)) --first_steady;
+  first_steady = std::max<size_t>(first_steady, 1);  // always skip the first revolution
+  w.t_start = start[first_steady];
+  w.revolutions = static_cast<int>(mean.size() - first_steady);
+  w.how = fmt::format(
+      "revolution-mean speeds: the transient ends at the first revolution after which every revolution's mean "
+      "speed stays within {:.1g} of the last one's (always skipping the first revolution): t ≥ {:.3f} s, {} "
+      "revolutions compared",
+      tol, w.t_start, w.revolutions);
+  return w;
+}
+
+Comparison compare_series(const models::TimeSeries& ref, const models::TimeSeries& run, double t_start) {
+  if (ref.t.size() != run.t.size()) throw std::runtime_error("compared runs have different output times");
+  for (size_t i = 0; i < ref.t.size(); ++i)
+    if (std::abs(ref.t[i] - run.t[i]) > 1e-9) throw std::runtime_error("compared runs have different output times");
+  Comparison c;
+  const size_t nf = ref.forces.size();
+  std::vector<const std::vector<double>*> a{&ref.qdot}, b{&run.qdot};
+  c.signals.push_back({"qdot"});
+  for (size_t k = 0; k < nf; ++k) {
+    a.push_back(&ref.forces[k]);
+    b.push_back(&run.forces[k]);
+    c.signals.push_back({ref.force_names[k]});
+  }
+  std::vector<double> sum2(a.size(), 0.0);
+  const bool masks = ref.gates.size() == ref.t.size() && run.gates.size() == run.t.size();
+  for (size_t i = 0; i < ref.t.size(); ++i) {
+    if (ref.t[i] < t_start - 1e-12) continue;
+    if (masks && ref.gates[i] != run.gates[i]) {
+      ++c.excluded;
+      continue;
+    }
+    ++c.samples;
+    for (size_t s = 0; s < a.size(); ++s) {
+      const double d = (*b[s])[i] - (*a[s])[i];
+      c.signals[s].peak = std::max(c.signals[s].peak, std::abs((*a[s])[i]));
+      c.signals[s].max_rel = std::max(c.signals[s].max_rel, std::abs(d));
+      sum2[s] += d * d;
+    }
+  }
+  for (size_t s = 0; s < a.size(); ++s) {
+    auto& sig = c.signals[s];
+    const double peak = sig.peak > 0 ? sig.peak : 1.0;
+    sig.max_rel /= peak;
+    sig.rms_rel = c.samples ? std::sqrt(sum2[s] / c.samples) / peak : 0.0;
+  }
+  return c;
+}
+
+}  // namespace rdyn::validate
