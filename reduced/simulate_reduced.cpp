@@ -83,6 +83,7 @@ AdaptiveIntegrator::AdaptiveIntegrator(const ReducedModel& m, double tolerance, 
 AdaptiveIntegrator::~AdaptiveIntegrator() = default;
 const ReducedWorkspace& AdaptiveIntegrator::state() const { return impl_->ws; }
 long AdaptiveIntegrator::steps() const { return impl_->steps; }
+long AdaptiveIntegrator::rejected() const { return static_cast<long>(impl_->evolve->failed_steps); }
 long AdaptiveIntegrator::events() const { return impl_->events; }
 double AdaptiveIntegrator::smallest_step() const { return std::isfinite(impl_->smallest) ? impl_->smallest : 0.0; }
 
@@ -211,7 +212,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       record(m, ws, ts, f);
     }
     ts.stats.steps_taken = integ.steps();
-    ts.stats.steps_attempted = integ.steps();
+    ts.stats.steps_attempted = integ.steps() + integ.rejected();
     ts.stats.events = integ.events();
     ts.stats.smallest_step_s = integ.smallest_step();
   }

@@ -34,6 +34,7 @@ class AdaptiveIntegrator {
   bool advance(double t_end, double q_stop = NAN);
   const ReducedWorkspace& state() const;
   long steps() const;
+  long rejected() const;  // steps refused by the error control
   long events() const;
   double smallest_step() const;
 

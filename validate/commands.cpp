@@ -1,5 +1,6 @@
 #include "validate/commands.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,8 @@
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/harness.hpp"
+#include "validate/report.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/timeseries_csv.hpp"
@@ -202,6 +205,98 @@ int run_calibrate(const CalibrateArgs& a) {
   }
   std::printf("%s\n", j.dump(2).c_str());
   return 0;
+}
+
+namespace {
+
+// One scene's validation into `dir`; the scene-level summary entry for a suite.
+nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
+                            Progress& progress, bool& pass) {
+  const ValidationResult v = run_validation(scene, opt, progress);
+  write_validation_report(v, dir);
+  pass = v.pass;
+  nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
+                      {"note", v.note}};
+  const nlohmann::json full = summary_json(v);
+  for (const char* k : {"speedup_at_matched_error", "extraction_ms", "thresholds", "reference", "steady_window",
+                        "headline", "matched_full", "matched_reduced"})
+    if (full.contains(k)) j[k] = full[k];
+  if (v.showcase_run >= 0) {
+    nlohmann::json sc = full["runs"][v.showcase_run];
+    j["reduced_10deg"] = sc;
+  }
+  return j;
+}
+
+}  // namespace
+
+int run_validate(const ValidateArgs& a) {
+  namespace fs = std::filesystem;
+  Progress progress;
+  ValidationOptions opt;
+  if (!a.suite.empty() && !a.scene.empty()) throw models::SceneError(a.scene, 0, "", "give a scene or --suite, not both");
+  if (a.suite.empty() && a.scene.empty()) throw models::SceneError("", 0, "", "give a scene or --suite FOLDER");
+  if (a.scene.empty()) {
+    std::error_code ec;
+    if (!fs::is_directory(a.suite, ec)) throw models::SceneError(a.suite, 0, "", "not a folder of scenes");
+    std::vector<std::string> files;
+    for (const auto& e : fs::directory_iterator(a.suite))
+      if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw models::SceneError(a.suite, 0, "", "the folder has no .yaml scenes");
+    OutputDir out(a.out);
+    opt.quick = !a.thorough;
+    nlohmann::json scenes = nlohmann::json::array();
+    bool all_pass = true;
+    std::string rows;
+    for (size_t i = 0; i < files.size(); ++i) {
+      const std::string stem = fs::path(files[i]).stem().string();
+      progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
+      nlohmann::json entry;
+      try {
+        const auto scene = models::load_scene(files[i], overrides_of(a.sets));
+        fs::create_directory(out.file(stem));
+        bool pass = false;
+        entry = validate_one(scene, opt, out.file(stem), progress, pass);
+        all_pass &= pass;
+      } catch (const std::exception& e) {  // a failing scene does not stop the others
+        entry = {{"name", stem}, {"file", files[i]}, {"status", "error"}, {"error", e.what()}};
+        all_pass = false;
+      }
+      entry["report"] = stem + "/report.html";
+      const std::string status = entry["status"];
+      rows += fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td></tr>",
+                          stem, status, entry.contains("error") ? std::string(entry["error"]) : std::string(entry.value("note", "")));
+      scenes.push_back(entry);
+    }
+    nlohmann::json summary = {{"suite", a.suite}, {"status", all_pass ? "pass" : "fail"}, {"scenes", scenes}};
+    {
+      std::ofstream f(out.file("summary.json"));
+      f << summary.dump(2) << "\n";
+    }
+    {
+      std::ofstream f(out.file("index.html"));
+      f << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:sans-serif;"
+           "max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{border-collapse:collapse}"
+           ".pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn validation suite: "
+        << a.suite << "</h1><table><tr><th>scene</th><th>status</th><th>what it tests / error</th></tr>" << rows
+        << "</table></body></html>\n";
+    }
+    out.commit();
+    std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(), all_pass ? "all scenes pass" : "FAILURES",
+                 a.out.c_str());
+    return all_pass ? 0 : 1;
+  }
+  const auto scene = load(a.scene, a.sets);
+  OutputDir out(a.out);
+  opt.quick = a.quick;
+  bool pass = false;
+  const ValidationResult v = run_validation(scene, opt, progress);
+  write_validation_report(v, out.file(""));
+  pass = v.pass;
+  out.commit();
+  std::printf("%s\n\nReport: %s/report.html\n", headline(v).c_str(), a.out.c_str());
+  return pass ? 0 : 1;
 }
 
 }  // namespace rdyn::validate

@@ -50,4 +50,14 @@ struct CalibrateArgs {
 };
 int run_calibrate(const CalibrateArgs& args);
 
+struct ValidateArgs {
+  std::string scene;  // or suite
+  std::string suite;  // folder of scenes
+  std::string out;
+  std::vector<std::string> sets;
+  bool quick = false;     // short ladders (default for --suite)
+  bool thorough = false;  // full ladders even for --suite
+};
+int run_validate(const ValidateArgs& args);
+
 }  // namespace rdyn::validate

@@ -84,6 +84,21 @@ int main(int argc, char** argv) {
   calibrate->add_option("--interp", cal.interpolation, "Reduced table interpolation (default fourier)")
       ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
 
+  ValidateArgs val;
+  auto* validate = app.add_subcommand(
+      "validate",
+      "Validate the reduced model against full forward dynamics: a converged reference, a ladder of full-model "
+      "tolerances and of reduced models (grid × interpolation × integrator), errors over the steady cycles, median "
+      "timings, the matched-error speedup, calibration when the scene declares an operating point. Writes "
+      "DIR/summary.json, the CSVs and gnuplot scripts behind every figure, and DIR/report.html. With --suite, "
+      "every scene of a folder (exit status 1 if any fails its thresholds).");
+  validate->add_option("scene", val.scene, "Scene name or YAML file");
+  validate->add_option("--suite", val.suite, "Folder of scenes to validate (each may declare thresholds)");
+  validate->add_option("--out", val.out, "Output folder (written atomically)")->required();
+  validate->add_option("--set", val.sets, "Override a scalar of the scene(s): key.path=value (repeatable)");
+  validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
+  validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -99,6 +114,7 @@ int main(int argc, char** argv) {
     if (*simulate) return run_simulate(sim);
     if (*extract) return run_extract(ext);
     if (*calibrate) return run_calibrate(cal);
+    if (*validate) return run_validate(val);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

@@ -1,0 +1,56 @@
+// Steady-window detection and run comparison on synthetic series with known answers.
+#include "validate/compare.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace rdyn::validate {
+namespace {
+
+// Speed relaxing from 5 to 2π rad/s with time constant tau, q its integral.
+models::TimeSeries relaxing(double tau, double T = 10, double dt = 1e-3) {
+  models::TimeSeries ts;
+  const double w = 2 * M_PI, w0 = 5.0;
+  for (int i = 0; i * dt <= T + 1e-12; ++i) {
+    const double t = i * dt;
+    ts.t.push_back(t);
+    ts.qdot.push_back(w + (w0 - w) * std::exp(-t / tau));
+    ts.q.push_back(w * t + (w0 - w) * tau * (1 - std::exp(-t / tau)));
+    ts.forces.resize(1);
+    ts.forces[0].push_back(100 * std::sin(ts.q.back()));
+    ts.gates.push_back(std::sin(ts.q.back()) > 0 ? 1u : 0u);
+  }
+  ts.force_names = {"F"};
+  return ts;
+}
+
+TEST(Compare, SteadyWindowSkipsTheTransient) {
+  const auto ts = relaxing(0.5);
+  const auto w = detect_steady_window(ts, true, 1e-3);
+  // The revolution means settle to 1e-3 of the final one after about τ·ln(|5 − 2π|/(2π·1e-3)) ≈ 2.7 s.
+  EXPECT_GT(w.t_start, 2.0);
+  EXPECT_LT(w.t_start, 4.0);
+  EXPECT_GE(w.revolutions, 5);
+  const auto rocking = detect_steady_window(ts, false);
+  EXPECT_NEAR(rocking.t_start, 2.0, 1e-9);  // 20 % of 10 s
+}
+
+TEST(Compare, RelativeErrorsAndGateExclusion) {
+  auto ref = relaxing(0.5), run = ref;
+  for (auto& v : run.qdot) v += 0.01;
+  for (auto& v : run.forces[0]) v *= 1.02;
+  // One sample where the run has switched and the reference not yet: excluded.
+  run.gates[5000] ^= 1u;
+  run.forces[0][5000] += 1e6;
+  const auto c = compare_series(ref, run, 3.0);
+  EXPECT_EQ(c.excluded, 1);
+  EXPECT_NEAR(c.find("qdot")->max_rel, 0.01 / c.find("qdot")->peak, 1e-12);
+  EXPECT_NEAR(c.find("F")->max_rel, 0.02, 1e-9);
+  EXPECT_NEAR(c.find("F")->rms_rel, 0.02 / std::sqrt(2.0), 1e-3);
+  run.t.pop_back();
+  EXPECT_THROW(compare_series(ref, run, 0), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace rdyn::validate
