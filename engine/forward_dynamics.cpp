@@ -88,6 +88,10 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   integ->setAccuracy(opt.tolerance);
   integ->setConstraintTolerance(std::min(1e-10, opt.tolerance));
   integ->setReturnEveryInternalStep(true);  // to track the smallest step
+  // Step freely and interpolate (then project) the states at output times, rather than
+  // shortening steps to land on them: the full model's cheapest honest setting.
+  integ->setAllowInterpolation(true);
+  integ->setProjectInterpolatedStates(true);
   TimeStepper stepper(m.system, *integ);
   stepper.setReportAllSignificantStates(false);
   try {

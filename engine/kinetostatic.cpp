@@ -68,7 +68,24 @@ KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, 
   return collect(m, s);
 }
 
-VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q) {
+void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  m.set_law(s, 0, poly_law(q, 0.0, 0.0));
+  try {
+    m.system.realize(s, Stage::Time);
+    m.system.prescribeQ(s);
+    m.system.projectQ(s, 1e-12);
+  } catch (const std::exception& e) {
+    throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                  "(dead point or a loop that cannot close): {}",
+                                  m.scene.source_file, m.scene.independent, q, e.what()));
+  }
+}
+
+VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q, bool with_q, bool with_x) {
   const auto& m = model.impl();
   State& s = ws.impl().state;
   ensure_kinetostatic_mode(m, s);
@@ -80,11 +97,13 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
     return u;
   };
   VelocityRatios out;
-  m.set_law(s, 0, poly_law(q, 1.0, 0.0));
-  for (size_t k = 0; k < nx; ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
-  project(m, s, q);
-  out.wrt_q = rates();
-  for (size_t k = 0; k < nx; ++k) {
+  if (with_q) {
+    m.set_law(s, 0, poly_law(q, 1.0, 0.0));
+    for (size_t k = 0; k < nx; ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+    project(m, s, q);
+    out.wrt_q = rates();
+  }
+  for (size_t k = 0; k < nx && with_x; ++k) {
     m.set_law(s, 0, poly_law(q, 0.0, 0.0));
     for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, i == k ? 1.0 : 0.0, 0));
     project(m, s, q);

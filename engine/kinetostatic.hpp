@@ -30,13 +30,20 @@ struct KinetostaticResult {
 KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, double q, double qdot,
                                      double qddot, Loads loads);
 
+// Moves the workspace's configuration to q (position projection only): the cheap step of
+// continuation sweeps.
+void move_configuration(const FullModel& model, FullWorkspace& ws, double q);
+
 // Velocity ratios at q: every joint rate per unit q̇ with every x fixed (wrt_q), and per
 // unit ẋ_k with q̇ = 0 and the other x fixed (wrt_x[k]); folded joints through their gear.
 struct VelocityRatios {
   std::vector<double> wrt_q;
   std::vector<std::vector<double>> wrt_x;
 };
-VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q);
+// `with_q` / `with_x` select which parts to compute (each part is one velocity projection
+// per coordinate).
+VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q, bool with_q = true,
+                                    bool with_x = true);
 
 // Sample of a prescribed time law q(t) = c1 + c2 t + c3 cos(c4 t + c5) at time t (the
 // original authors' sweep); same outputs as calc_kinetostatic.

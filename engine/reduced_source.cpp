@@ -22,9 +22,17 @@ int FullKinetostaticSource::num_constraint_forces() const {
 int FullKinetostaticSource::num_joints() const { return static_cast<int>(model_.scene().joints.size()); }
 
 void FullKinetostaticSource::approach(double q) {
-  const int steps = static_cast<int>(std::ceil(std::abs(q - q_now_) / kMaxJump));
-  for (int i = 1; i < steps; ++i)
-    calc_kinetostatic(model_, ws_, q_now_ + (q - q_now_) * i / steps, 0, 0, Loads::Off);
+  // A revolute independent coordinate repeats the configuration every turn: walk to the
+  // periodic image of q nearest the current configuration, then the call itself prescribes q
+  // (the same configuration; the projection only relabels the angle).
+  double target = q;
+  const auto& jt = *model_.scene().find_joint(model_.scene().independent);
+  if (jt.type == models::JointType::Revolute) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
+  const int steps = static_cast<int>(std::ceil(std::abs(target - q_now_) / kMaxJump - 1e-9));
+  for (int i = 1; i < steps; ++i) {
+    move_configuration(model_, ws_, q_now_ + (target - q_now_) * i / steps);
+    ++calls_;
+  }
   q_now_ = q;
 }
 
@@ -32,14 +40,41 @@ reduced::ForcePoint FullKinetostaticSource::inertial(double q, double qdot, doub
   approach(q);
   ++calls_;
   const auto r = calc_kinetostatic(model_, ws_, q, qdot, qddot, Loads::Off);
-  return {r.driving_force, r.constraint_forces};
+  return {r.driving_force, r.constraint_forces, r.joint_u};
+}
+
+reduced::GridSample FullKinetostaticSource::sample(double q, bool with_conservative) {
+  approach(q);
+  ++calls_;
+  reduced::GridSample g;
+  // (i) q̇ = 1, q̈ = 0: its joint rates are the velocity ratios wrt q (x fixed).
+  const auto vel = calc_kinetostatic(model_, ws_, q, 1.0, 0.0, Loads::Off);
+  g.velocity = {vel.driving_force, vel.constraint_forces, vel.joint_u};
+  g.ratios.wrt_q = vel.joint_u;
+  // (ii) q̇ = 0, q̈ = 1.
+  const auto acc = calc_kinetostatic(model_, ws_, q, 0.0, 1.0, Loads::Off);
+  g.acceleration = {acc.driving_force, acc.constraint_forces, acc.joint_u};
+  if (with_conservative) {
+    const auto c = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
+    g.conservative = {{c.driving_force, c.constraint_forces, {}}, c.potential_energy};
+  } else {
+    g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
+  }
+  g.ratios.wrt_x = calc_velocity_ratios(model_, ws_, q, false, true).wrt_x;
+  return g;
+}
+
+double FullKinetostaticSource::ratio(double q, int joint) {
+  approach(q);
+  ++calls_;
+  return calc_velocity_ratios(model_, ws_, q, true, false).wrt_q[joint];
 }
 
 reduced::ConservativePoint FullKinetostaticSource::conservative(double q) {
   approach(q);
   ++calls_;
   const auto r = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
-  return {{r.driving_force, r.constraint_forces}, r.potential_energy};
+  return {{r.driving_force, r.constraint_forces, {}}, r.potential_energy};
 }
 
 reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
@@ -54,7 +89,7 @@ std::optional<reduced::ForcePoint> FullKinetostaticSource::harmonic_sweep(const 
   approach(q);
   ++calls_;
   const auto r = calc_harmonic_sweep_point(model_, ws_, c, t, Loads::Off);
-  return reduced::ForcePoint{r.driving_force, r.constraint_forces};
+  return reduced::ForcePoint{r.driving_force, r.constraint_forces, {}};
 }
 
 std::optional<reduced::DirectPoint> FullKinetostaticSource::direct(double q) {

@@ -16,6 +16,8 @@ class FullKinetostaticSource : public reduced::KinetostaticSource {
   reduced::RatioPoint ratios(double q) override;
   std::optional<reduced::ForcePoint> harmonic_sweep(const double c[5], double t) override;
   std::optional<reduced::DirectPoint> direct(double q) override;
+  reduced::GridSample sample(double q, bool with_conservative) override;
+  double ratio(double q, int joint) override;
   long calls() const { return calls_; }
 
  private:

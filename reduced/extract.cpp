@@ -51,28 +51,29 @@ struct RatioRootContext {
 
 double ratio_at(double q, void* p) {
   auto* c = static_cast<RatioRootContext*>(p);
-  return c->src->ratios(q).wrt_q[c->joint];
+  return c->src->ratio(q, c->joint);
 }
 
-// Zeros of joint j's velocity ratio over one period, bracketed by sign changes between
-// grid samples and refined on the full model with Brent's method (GSL). A pair of zeros
-// inside one grid interval is not seen: refine the grid if a gate switches that quickly.
+// Zeros of joint j's velocity ratio over one period, located on the full model: each sign
+// change between grid samples is first located on the periodic cubic spline of the samples,
+// then bracketed tightly around that estimate on the full model and refined with Brent's
+// method (GSL). A pair of zeros inside one grid interval is not seen: refine the grid if a
+// gate switches that quickly.
 std::vector<double> ratio_roots(KinetostaticSource& src, int j, const std::vector<double>& q,
                                 const std::vector<double>& r, double period) {
   std::vector<double> roots;
   const size_t n = q.size();
+  std::vector<double> x(q), y(r);
+  x.push_back(q[0] + period);
+  y.push_back(r[0]);
+  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(gsl_interp_cspline_periodic, n + 1),
+                                                             gsl_spline_free);
+  gsl_spline_init(sp.get(), x.data(), y.data(), n + 1);
   std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
       gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
   RatioRootContext ctx{&src, j};
   gsl_function fn{ratio_at, &ctx};
-  for (size_t i = 0; i < n; ++i) {
-    const double a = q[i], b = i + 1 < n ? q[i + 1] : q[0] + period;
-    const double ra = r[i], rb = r[(i + 1) % n];
-    if (ra == 0.0) {
-      roots.push_back(a);
-      continue;
-    }
-    if ((ra > 0) == (rb > 0) || rb == 0.0) continue;
+  auto brent = [&](double a, double b) {
     gsl_root_fsolver_set(solver.get(), &fn, a, b);
     double root = 0.5 * (a + b);
     for (int it = 0; it < 100; ++it) {
@@ -82,7 +83,32 @@ std::vector<double> ratio_roots(KinetostaticSource& src, int j, const std::vecto
                                  1e-14, 0.0) == GSL_SUCCESS)
         break;
     }
-    roots.push_back(root);
+    return root;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    const double a = x[i], b = x[i + 1], ra = y[i], rb = y[i + 1];
+    if (ra == 0.0) {
+      roots.push_back(a);
+      continue;
+    }
+    if ((ra > 0) == (rb > 0) || rb == 0.0) continue;
+    // Estimate on the spline (bisection: no full-model calls).
+    double lo = a, hi = b;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      ((gsl_spline_eval(sp.get(), mid, nullptr) > 0) == (ra > 0) ? lo : hi) = mid;
+    }
+    const double est = 0.5 * (lo + hi);
+    // Tight bracket on the full model, widened until the sign changes (within the interval).
+    double w = 1e-3 * (b - a), root = NAN;
+    for (int k = 0; k < 12 && std::isnan(root); ++k, w *= 4) {
+      const double l = std::max(a, est - w), h = std::min(b, est + w);
+      const double fl = l == a ? ra : src.ratio(l, j), fh = h == b ? rb : src.ratio(h, j);
+      if (fl == 0.0) root = l;
+      else if (fh == 0.0) root = h;
+      else if ((fl > 0) != (fh > 0)) root = brent(l, h);
+    }
+    roots.push_back(std::isnan(root) ? brent(a, b) : root);
   }
   return roots;
 }
@@ -168,35 +194,40 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       m2[i] = d->m2;
       for (int k = 0; k < nk; ++k) me1[k][i] = d->me1[k], me2[k][i] = d->me2[k];
     }
-  } else {
-    for (long i = 0; i < n; ++i) {
-      const auto vel = src.inertial(s.q[i], 1.0, 0.0);  // (i) q̇ = 1, q̈ = 0
-      const auto acc = src.inertial(s.q[i], 0.0, 1.0);  // (ii) q̇ = 0, q̈ = 1
-      m2[i] = vel.driving_force;
-      m1[i] = acc.driving_force;
-      for (int k = 0; k < nk; ++k) me2[k][i] = vel.constraint_forces[k], me1[k][i] = acc.constraint_forces[k];
-    }
-    if (opt.method == Method::Integrated) {
-      // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).
-      std::vector<double> two_m2(n);
-      for (long i = 0; i < n; ++i) two_m2[i] = 2 * m2[i];
-      const auto integral = periodic_integral(s.q, two_m2, 2 * kPi);
-      for (long i = 1; i < n; ++i) m1[i] = m1[0] + integral[i];
-    }
   }
 
-  // Generalized forces of position-only loads (static call) and velocity ratios.
+  // One visit per grid point: (i) and (ii) when the method needs them, the static call for
+  // position-only loads (only when the scene has some), and the velocity ratios.
+  const bool conservative_loads = scene.gravity.enabled || !scene.springs.empty();
+  const bool inertial_here = opt.method == Method::Kinetostatic || opt.method == Method::Integrated;
   for (long i = 0; i < n; ++i) {
-    const auto c = src.conservative(s.q[i]);
-    // At rest: T_act + Q = 0 and F_E + Qx = 0.
-    Q[i] = -c.forces.driving_force;
-    V[i] = c.potential_energy;
-    for (int k = 0; k < nk; ++k) Qx[k][i] = -c.forces.constraint_forces[k];
-    const auto rp = src.ratios(s.q[i]);
-    for (int j = 0; j < nj; ++j) {
-      r[j][i] = rp.wrt_q[j];
-      for (int k = 0; k < nk; ++k) rx[k][j][i] = rp.wrt_x[k][j];
+    GridSample g;
+    if (inertial_here) {
+      g = src.sample(s.q[i], conservative_loads);
+      m2[i] = g.velocity.driving_force;      // (i) q̇ = 1, q̈ = 0
+      m1[i] = g.acceleration.driving_force;  // (ii) q̇ = 0, q̈ = 1
+      for (int k = 0; k < nk; ++k)
+        me2[k][i] = g.velocity.constraint_forces[k], me1[k][i] = g.acceleration.constraint_forces[k];
+    } else {
+      if (conservative_loads) g.conservative = src.conservative(s.q[i]);
+      else g.conservative.forces.constraint_forces.assign(nk, 0.0);
+      g.ratios = src.ratios(s.q[i]);
     }
+    // At rest: T_act + Q = 0 and F_E + Qx = 0.
+    Q[i] = -g.conservative.forces.driving_force;
+    V[i] = g.conservative.potential_energy;
+    for (int k = 0; k < nk; ++k) Qx[k][i] = -g.conservative.forces.constraint_forces[k];
+    for (int j = 0; j < nj; ++j) {
+      r[j][i] = g.ratios.wrt_q[j];
+      for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
+    }
+  }
+  if (opt.method == Method::Integrated) {
+    // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).
+    std::vector<double> two_m2(n);
+    for (long i = 0; i < n; ++i) two_m2[i] = 2 * m2[i];
+    const auto integral = periodic_integral(s.q, two_m2, 2 * kPi);
+    for (long i = 1; i < n; ++i) m1[i] = m1[0] + integral[i];
   }
 
   s.add("m1", m1);

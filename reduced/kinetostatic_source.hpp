@@ -12,6 +12,7 @@ namespace rdyn::reduced {
 struct ForcePoint {
   double driving_force = 0.0;             // T_act on the independent coordinate [N·m or N]
   std::vector<double> constraint_forces;  // F_E per constraint actuator [N]
+  std::vector<double> joint_rates;        // every joint's rate in this call (optional) [rad/s or m/s]
 };
 
 // Static call (q̇ = q̈ = 0) with only the conservative loads (gravity, springs) on.
@@ -31,6 +32,14 @@ struct RatioPoint {
 struct DirectPoint {
   double m1 = 0.0, m2 = 0.0;
   std::vector<double> me1, me2;
+};
+
+// Everything the kinetostatic method needs at one grid point, gathered in one visit.
+struct GridSample {
+  ForcePoint velocity;      // (i) q̇ = 1, q̈ = 0, loads off
+  ForcePoint acceleration;  // (ii) q̇ = 0, q̈ = 1, loads off
+  ConservativePoint conservative;  // zero when not requested
+  RatioPoint ratios;
 };
 
 class KinetostaticSource {
@@ -53,6 +62,19 @@ class KinetostaticSource {
     (void)q;
     return std::nullopt;
   }
+  // One grid point. The default makes the separate calls; a source may share work between
+  // them (the engine takes the q-ratios from call (i), where q̇ = 1).
+  virtual GridSample sample(double q, bool with_conservative) {
+    GridSample g;
+    g.velocity = inertial(q, 1.0, 0.0);
+    g.acceleration = inertial(q, 0.0, 1.0);
+    if (with_conservative) g.conservative = conservative(q);
+    else g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
+    g.ratios = ratios(q);
+    return g;
+  }
+  // Rate of one joint per unit q̇ at q (root finding of switch angles).
+  virtual double ratio(double q, int joint) { return ratios(q).wrt_q[joint]; }
 };
 
 }  // namespace rdyn::reduced

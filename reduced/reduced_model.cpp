@@ -70,11 +70,18 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     m.brakes.push_back({r.law, r.coefficient, s.require("w_" + r.body), rx_cols("wx_", r.body)});
     m.rhs_cols.push_back(m.brakes.back().c_w);
   }
+  m.out_cols = {m.c_m1, m.c_V};
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
+    for (const auto& t : m.torques) m.out_cols.push_back(t.c_rx[k]);
+    for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
+    for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
+  }
   return m;
 }
 
 ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)
-    : gate_on(m.gates.size(), 1), scratch(m.rhs_cols.size()) {}
+    : gate_on(m.gates.size(), 1), scratch(m.rhs_cols.size()), scratch_out(m.out_cols.size()) {}
 
 void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                        double& power_nc) {
@@ -146,6 +153,33 @@ void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, d
   }
 }
 
+double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot,
+                    double* forces) {
+  double* v = ws.scratch_out.data();
+  m.table.eval_cols(q, m.out_cols.data(), static_cast<int>(m.out_cols.size()), v);
+  const double energy = 0.5 * v[0] * qdot * qdot + v[1];  // ½ m1 q̇² + V
+  const double* c = v + 2;
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    const double me1 = c[0], me2 = c[1];
+    double Qx = c[2];  // Q_x,k: loads along x_k by virtual power (q̇ = 0, ẋ_k = 1)
+    c += 3;
+    for (const auto& t : m.torques) {
+      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += t.value * *c;
+      ++c;
+    }
+    for (const auto& mo : m.motors) {
+      Qx += mo.stall * (1.0 - c[0] * qdot / mo.no_load_speed) * c[1];
+      c += 2;
+    }
+    for (const auto& b : m.brakes) {
+      Qx += resistance_torque(b.law, b.coefficient, c[0] * qdot) * c[1];
+      c += 2;
+    }
+    forces[k] = me1 * qddot + me2 * qdot * qdot - Qx;  // me1 q̈ + me2 q̇² = F_E + Q_x
+  }
+  return energy;
+}
+
 namespace {
 
 // Classical RK4 on y = (q, q̇, W) with frozen gates.
@@ -164,7 +198,7 @@ void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
 
 }  // namespace
 
-void step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
+double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
   const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
   rk4(m, ws, h);
   // Earliest gate switch inside the step, by linear interpolation of the switching function.
@@ -178,12 +212,14 @@ void step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
       if (f < frac) frac = f, which = static_cast<int>(g);
     }
   }
-  if (which < 0) return;
+  if (which < 0) return NAN;
   ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
   const double h1 = std::max(0.0, std::min(1.0, frac)) * h;
   if (h1 > 0) rk4(m, ws, h1);
+  const double t_switch = ws.t;
   ws.gate_on[which] = !ws.gate_on[which];
   if (h - h1 > 0) rk4(m, ws, h - h1);
+  return t_switch;
 }
 
 }  // namespace rdyn::reduced

@@ -57,6 +57,9 @@ struct ReducedModel {
   // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r,
   // each motor's r, each brake's w.
   std::vector<int> rhs_cols;
+  // Columns the outputs need (one fused lookup): m1, V, then per constraint force k:
+  // me1, me2, Qx_cons, each torque's rx, each motor's r and rx, each brake's w and wx.
+  std::vector<int> out_cols;
 };
 
 // Joins the sampled parameters with the scene's loads. Throws TableError when a column the
@@ -68,7 +71,8 @@ ReducedModel make_reduced_model(const Samples& samples, const models::Scene& sce
 struct ReducedWorkspace {
   double t = 0.0, q = 0.0, qdot = 0.0, work = 0.0;
   std::vector<char> gate_on;
-  std::vector<double> scratch;  // rhs_cols values
+  std::vector<double> scratch;      // rhs_cols values
+  std::vector<double> scratch_out;  // out_cols values
   explicit ReducedWorkspace(const ReducedModel& m);
 };
 
@@ -88,10 +92,13 @@ void init_gates(const ReducedModel& m, ReducedWorkspace& ws);
 double calc_energy(const ReducedModel& m, double q, double qdot);
 void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, double q, double qdot,
                             double qddot, double* forces);
+// Both at once with one fused table lookup (allocation-free).
+double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot,
+                    double* forces);
 
 // One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside
 // the step is located by linear interpolation of the switching function and the step is
-// split there.
-void step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
+// split there. Returns the time of that switch, or NaN when none happened.
+double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
 
 }  // namespace rdyn::reduced

@@ -50,11 +50,13 @@ struct AdaptiveIntegrator::Impl {
   std::unique_ptr<gsl_odeiv2_step, Deleter<gsl_odeiv2_step, gsl_odeiv2_step_free>> step, probe;
   std::unique_ptr<gsl_odeiv2_control, Deleter<gsl_odeiv2_control, gsl_odeiv2_control_free>> control;
   std::unique_ptr<gsl_odeiv2_evolve, Deleter<gsl_odeiv2_evolve, gsl_odeiv2_evolve_free>> evolve;
-  std::vector<double> s_before;
+  std::vector<double> s_before, s_after;
   double y[3] = {0, 0, 0};
   double h = 1e-3;
   long steps = 0, events = 0;
   double smallest = INFINITY;
+  int pending_flip = -1;  // gate to flip before the next step
+  Point start{}, end{};
 
   Impl(const ReducedModel& model, double tol, const std::string& method) : m(model), ws(model), ctx{&m, &ws} {
     const gsl_odeiv2_step_type* type = step_type(method);
@@ -67,6 +69,13 @@ struct AdaptiveIntegrator::Impl {
     control.reset(gsl_odeiv2_control_standard_new(tol, tol, 1.0, 1.0));
     evolve.reset(gsl_odeiv2_evolve_alloc(3));
     s_before.resize(m.gates.size());
+    s_after.resize(m.gates.size());
+  }
+
+  Point point(double t, const double yy[3]) {
+    Point p{t, yy[0], yy[1], 0, yy[2], 0};
+    calc_acceleration(m, ws, p.q, p.qdot, p.qddot, p.power);
+    return p;
   }
 
   // One single step of size dt from (t0, y0) with the current gates.
@@ -75,6 +84,29 @@ struct AdaptiveIntegrator::Impl {
     for (int k = 0; k < 3; ++k) out[k] = y0[k];
     gsl_odeiv2_step_reset(probe.get());
     gsl_odeiv2_step_apply(probe.get(), t0, dt, out, err, nullptr, nullptr, &sys);
+  }
+
+  // Illinois (modified regula falsi) on f(h) over [0, H] with f(0) = f0, f(H) = fH of
+  // opposite signs; returns an h just past the crossing (the end whose sign differs from f0).
+  template <typename F>
+  double locate(F&& f, double H, double f0, double fH, double t0) {
+    double a = 0, fa = f0, b = H, fb = fH;
+    const double tol = 1e-13 * std::max(1.0, std::abs(t0));
+    for (int it = 0; it < 100 && std::abs(b - a) > tol; ++it) {
+      double c = b - fb * (b - a) / (fb - fa);
+      if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
+      const double fc = f(c);
+      if (fc == 0.0) return c;
+      if ((fc > 0) != (fb > 0)) {
+        a = b;
+        fa = fb;
+      } else {
+        fa *= 0.5;
+      }
+      b = c;
+      fb = fc;
+    }
+    return (fa > 0) != (f0 > 0) ? a : b;
   }
 };
 
@@ -86,88 +118,125 @@ long AdaptiveIntegrator::steps() const { return impl_->steps; }
 long AdaptiveIntegrator::rejected() const { return static_cast<long>(impl_->evolve->failed_steps); }
 long AdaptiveIntegrator::events() const { return impl_->events; }
 double AdaptiveIntegrator::smallest_step() const { return std::isfinite(impl_->smallest) ? impl_->smallest : 0.0; }
+const AdaptiveIntegrator::Point& AdaptiveIntegrator::step_start() const { return impl_->start; }
+const AdaptiveIntegrator::Point& AdaptiveIntegrator::step_end() const { return impl_->end; }
 
 void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
   auto& d = *impl_;
   d.ws.t = t, d.ws.q = q, d.ws.qdot = qdot, d.ws.work = work;
   init_gates(d.m, d.ws);
   d.y[0] = q, d.y[1] = qdot, d.y[2] = work;
+  d.pending_flip = -1;
+  d.start = d.end = d.point(t, d.y);
   gsl_odeiv2_evolve_reset(d.evolve.get());
 }
 
-bool AdaptiveIntegrator::advance(double t_end, double q_stop) {
+bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   auto& d = *impl_;
   const auto& m = d.m;
+  if (d.pending_flip >= 0) {
+    d.ws.gate_on[d.pending_flip] = !d.ws.gate_on[d.pending_flip];
+    d.pending_flip = -1;
+    gsl_odeiv2_evolve_reset(d.evolve.get());
+  }
   const size_t ng = m.gates.size();
   const bool stop_at_q = std::isfinite(q_stop);
   double t = d.ws.t;
-  while (t < t_end) {
-    const double t_prev = t, y_prev[3] = {d.y[0], d.y[1], d.y[2]};
-    for (size_t g = 0; g < ng; ++g) d.s_before[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
-    const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
-    const int st = gsl_odeiv2_evolve_apply(d.evolve.get(), d.control.get(), d.step.get(), &d.sys, &t, t_end, &d.h, d.y);
-    if (st != GSL_SUCCESS)
-      throw TableError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
-    ++d.steps;
-    // Anything that happened in this step: a gate's switching function or q − q_stop
-    // changing sign. Locate the earliest by bisection on single steps.
-    auto happened = [&](const double yy[3], int& which) {
-      bool any = false;
-      for (size_t g = 0; g < ng; ++g) {
-        const double s = calc_switching(m, static_cast<int>(g), yy[0], yy[1]);
-        if (d.s_before[g] != 0.0 && (d.s_before[g] > 0) != (s > 0)) any = true, which = static_cast<int>(g);
-      }
-      if (stop_at_q && stop_before != 0.0 && (stop_before > 0) != (yy[0] - q_stop > 0)) any = true, which = -2;
-      return any;
-    };
-    int which = -1;
-    if (happened(d.y, which)) {
-      double lo = 0.0, hi = t - t_prev;
-      for (int it = 0; it < 200 && hi - lo > 1e-13 * std::max(1.0, t); ++it) {
-        const double mid = 0.5 * (lo + hi);
-        double yt[3];
-        d.probe_step(t_prev, y_prev, mid, yt);
-        int w = -1;
-        if (happened(yt, w)) hi = mid, which = w;
-        else lo = mid;
-      }
-      d.probe_step(t_prev, y_prev, hi, d.y);
-      t = t_prev + hi;
-      gsl_odeiv2_evolve_reset(d.evolve.get());
-      if (which >= 0) {
-        d.ws.gate_on[which] = !d.ws.gate_on[which];
-        ++d.events;
-      }
-    }
-    if (t - t_prev > 0 && t < t_end && which == -1) d.smallest = std::min(d.smallest, t - t_prev);
-    d.ws.q = d.y[0], d.ws.qdot = d.y[1], d.ws.work = d.y[2], d.ws.t = t;
-    if (!std::isfinite(d.ws.q) || !std::isfinite(d.ws.qdot))
-      throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", t));
-    if (!m.table.in_range(d.ws.q))
-      throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
-                                   t, d.ws.q));
-    if (which == -2) return true;
+  const double t_prev = t, y_prev[3] = {d.y[0], d.y[1], d.y[2]};
+  d.start = d.point(t_prev, y_prev);
+  for (size_t g = 0; g < ng; ++g) d.s_before[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+  const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
+  const int st = gsl_odeiv2_evolve_apply(d.evolve.get(), d.control.get(), d.step.get(), &d.sys, &t, t_end, &d.h, d.y);
+  if (st != GSL_SUCCESS)
+    throw TableError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
+  ++d.steps;
+  // What changed sign in this step: a gate's switching function (index ≥ 0) or q − q_stop (−2).
+  // The earliest crossing, located on single steps from the start of the step, ends the step.
+  const double H = t - t_prev;
+  double h_cut = INFINITY;
+  int which = -1;
+  for (size_t g = 0; g < ng; ++g) {
+    d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+    if (d.s_before[g] == 0.0 || (d.s_before[g] > 0) == (d.s_after[g] > 0)) continue;
+    const double hc = d.locate(
+        [&](double hh) {
+          double yt[3];
+          d.probe_step(t_prev, y_prev, hh, yt);
+          return calc_switching(m, static_cast<int>(g), yt[0], yt[1]);
+        },
+        H, d.s_before[g], d.s_after[g], t_prev);
+    if (hc < h_cut) h_cut = hc, which = static_cast<int>(g);
   }
+  if (stop_at_q && stop_before != 0.0 && (stop_before > 0) != (d.y[0] - q_stop > 0)) {
+    const double hc = d.locate(
+        [&](double hh) {
+          double yt[3];
+          d.probe_step(t_prev, y_prev, hh, yt);
+          return yt[0] - q_stop;
+        },
+        H, stop_before, d.y[0] - q_stop, t_prev);
+    if (hc <= h_cut) h_cut = hc, which = -2;
+  }
+  if (which != -1) {
+    d.probe_step(t_prev, y_prev, h_cut, d.y);
+    t = t_prev + h_cut;
+    gsl_odeiv2_evolve_reset(d.evolve.get());
+    if (which >= 0) {
+      d.pending_flip = which;
+      ++d.events;
+    }
+  } else if (t < t_end) {
+    d.smallest = std::min(d.smallest, H);
+  }
+  d.ws.q = d.y[0], d.ws.qdot = d.y[1], d.ws.work = d.y[2], d.ws.t = t;
+  if (!std::isfinite(d.ws.q) || !std::isfinite(d.ws.qdot))
+    throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", t));
+  if (!m.table.in_range(d.ws.q))
+    throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
+                                 t, d.ws.q));
+  d.end = d.point(t, d.y);
+  return which == -2;
+}
+
+bool AdaptiveIntegrator::advance(double t_end, double q_stop) {
+  while (impl_->ws.t < t_end)
+    if (step(t_end, q_stop)) return true;
   return false;
 }
 
 namespace {
 
-void record(const ReducedModel& m, ReducedWorkspace& ws, models::TimeSeries& ts, std::vector<double>& f) {
+// Appends one output sample at (t, q, q̇, W) with the workspace's gates.
+void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, double qdot, double work,
+            models::TimeSeries& ts, std::vector<double>& f) {
   double qdd, p;
-  calc_acceleration(m, ws, ws.q, ws.qdot, qdd, p);
-  ts.t.push_back(ws.t);
-  ts.q.push_back(ws.q);
-  ts.qdot.push_back(ws.qdot);
+  calc_acceleration(m, ws, q, qdot, qdd, p);
+  ts.t.push_back(t);
+  ts.q.push_back(q);
+  ts.qdot.push_back(qdot);
   ts.qddot.push_back(qdd);
-  ts.energy.push_back(calc_energy(m, ws.q, ws.qdot));
-  ts.work.push_back(ws.work);
+  ts.energy.push_back(calc_outputs(m, ws, q, qdot, qdd, f.data()));
+  ts.work.push_back(work);
   std::uint32_t mask = 0;
   for (size_t g = 0; g < ws.gate_on.size() && g < 32; ++g)
     if (ws.gate_on[g]) mask |= 1u << g;
   ts.gates.push_back(mask);
-  calc_constraint_forces(m, ws, ws.q, ws.qdot, qdd, f.data());
   for (size_t k = 0; k < f.size(); ++k) ts.forces[k].push_back(f[k]);
+}
+
+// Quintic Hermite through (q, q̇, q̈) at both ends of a step of length H, at fraction s;
+// cubic Hermite for W through (W, P). q̈ at the sample is recomputed from the model.
+void hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point& b, double s, double& q,
+             double& qdot, double& work) {
+  const double H = b.t - a.t;
+  const double V0 = a.qdot * H, A0 = a.qddot * H * H, V1 = b.qdot * H, A1 = b.qddot * H * H;
+  const double d0 = b.q - a.q - V0 - 0.5 * A0, d1 = V1 - V0 - A0, d2 = A1 - A0;
+  const double c3 = 10 * d0 - 4 * d1 + 0.5 * d2, c4 = -15 * d0 + 7 * d1 - d2, c5 = 6 * d0 - 3 * d1 + 0.5 * d2;
+  q = a.q + s * (V0 + s * (0.5 * A0 + s * (c3 + s * (c4 + s * c5))));
+  qdot = (V0 + s * (A0 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))) / H;
+  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
+               h11 = s * s * s - s * s;
+  work = h00 * a.work + h10 * H * a.power + h01 * b.work + h11 * H * b.power;
 }
 
 }  // namespace
@@ -181,35 +250,64 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
   ts.forces.resize(m.force_names.size());
   std::vector<double> f(m.force_names.size());
   const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
+  auto t_out = [&](long i) { return std::min(opt.duration_s, i * opt.output_interval_s); };
 
   if (opt.integrator == "rk4-fixed") {
+    // Fixed steps regardless of the outputs; outputs by quintic Hermite inside each step.
     if (!(opt.fixed_step_s > 0)) throw TableError("fixed step must be positive");
     ReducedWorkspace ws(m);
     ws.q = q0, ws.qdot = qdot0;
     init_gates(m, ws);
-    record(m, ws, ts, f);
-    for (long i = 1; i <= n; ++i) {
-      const double t_out = std::min(opt.duration_s, i * opt.output_interval_s);
-      while (ws.t < t_out - 1e-12) {
-        step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, t_out - ws.t));
-        ++ts.stats.steps_taken;
-        if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot))
-          throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
+    auto point = [&](const ReducedWorkspace& w) {
+      AdaptiveIntegrator::Point p{w.t, w.q, w.qdot, 0, w.work, 0};
+      calc_acceleration(m, ws, p.q, p.qdot, p.qddot, p.power);
+      return p;
+    };
+    record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
+    long i = 1;
+    AdaptiveIntegrator::Point a = point(ws);
+    std::vector<char> before(ws.gate_on.size());
+    while (i <= n) {
+      std::copy(ws.gate_on.begin(), ws.gate_on.end(), before.begin());
+      const double t_switch = step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, opt.duration_s - ws.t));
+      ++ts.stats.steps_taken;
+      if (!std::isnan(t_switch)) ++ts.stats.events;
+      if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot))
+        throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
+      const AdaptiveIntegrator::Point b = point(ws);
+      // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
+      // interpolation there, with the gates that held at each sample's time (the fixed-step
+      // path is the real-time one; accuracy is secondary).
+      for (; i <= n && t_out(i) <= b.t + 1e-12; ++i) {
+        const double s = (t_out(i) - a.t) / (b.t - a.t);
+        double q, v, w;
+        if (!std::isnan(t_switch)) q = a.q + s * (b.q - a.q), v = a.qdot + s * (b.qdot - a.qdot), w = a.work + s * (b.work - a.work);
+        else hermite(a, b, s, q, v, w);
+        if (t_out(i) < t_switch) ws.gate_on.swap(before);
+        record(m, ws, t_out(i), q, v, w, ts, f);
+        if (t_out(i) < t_switch) ws.gate_on.swap(before);
       }
-      ws.t = t_out;
-      record(m, ws, ts, f);
+      a = b;
+      if (ws.t >= opt.duration_s - 1e-12) break;
     }
     ts.stats.steps_attempted = ts.stats.steps_taken;
     ts.stats.smallest_step_s = opt.fixed_step_s;
   } else {
     AdaptiveIntegrator integ(m, opt.tolerance, opt.integrator);
     integ.reset(0.0, q0, qdot0);
-    ReducedWorkspace ws = integ.state();
-    record(m, ws, ts, f);
-    for (long i = 1; i <= n; ++i) {
-      integ.advance(std::min(opt.duration_s, i * opt.output_interval_s));
-      ws = integ.state();
-      record(m, ws, ts, f);
+    ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
+    record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
+    long i = 1;
+    while (i <= n) {
+      integ.step(opt.duration_s);
+      const auto& a = integ.step_start();
+      const auto& b = integ.step_end();
+      for (; i <= n && t_out(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
+        double q, v, w;
+        if (b.t - a.t <= 0) q = b.q, v = b.qdot, w = b.work;
+        else hermite(a, b, std::min(1.0, (t_out(i) - a.t) / (b.t - a.t)), q, v, w);
+        record(m, ws, t_out(i), q, v, w, ts, f);
+      }
     }
     ts.stats.steps_taken = integ.steps();
     ts.stats.steps_attempted = integ.steps() + integ.rejected();

@@ -13,15 +13,15 @@ namespace rdyn::reduced {
 struct ReducedOptions {
   double duration_s = 5.0;
   double output_interval_s = 0.01;
-  double tolerance = 1e-10;          // adaptive: relative and absolute error per step
+  double tolerance = 1e-8;           // adaptive: relative and absolute error per step
   std::string integrator = "rk8pd";  // rk8pd | rkf45 | rkck (GSL odeiv2) | rk4-fixed
   double fixed_step_s = 1e-3;        // rk4-fixed only
 };
 
 // Adaptive GSL odeiv2 integration of y = (q, q̇, W) with load switches located as events:
-// after each step the switching functions are checked, a sign change is located by
-// bisection on single steps from the start of the step (to ~1e-13 s), the gate flipped
-// and the integration restarted there.
+// after each step the switching functions are checked; a sign change is located by the
+// Illinois (regula falsi) method on single steps from the start of the step (to ~1e-13 s),
+// the step is cut there and the gate flips before the next step.
 class AdaptiveIntegrator {
  public:
   AdaptiveIntegrator(const ReducedModel& m, double tolerance, const std::string& method = "rk8pd");
@@ -32,6 +32,15 @@ class AdaptiveIntegrator {
   // Returns true when it stopped at q_stop. Throws TableError on a non-finite state or when
   // q leaves a non-periodic table.
   bool advance(double t_end, double q_stop = NAN);
+  // One accepted step toward t_end (cut at an event or at q_stop). Returns true when it
+  // stopped at q_stop. After it, step_start()/state() bound the step and the gates are still
+  // those used inside it (a located switch is applied at the start of the next step).
+  bool step(double t_end, double q_stop = NAN);
+  struct Point {
+    double t, q, qdot, qddot, work, power;
+  };
+  const Point& step_start() const;
+  const Point& step_end() const;
   const ReducedWorkspace& state() const;
   long steps() const;
   long rejected() const;  // steps refused by the error control

@@ -68,16 +68,25 @@ Samples fourier_resample(const Samples& s, int refine) {
 }  // namespace
 
 int Table::locate(double q, double& dx) const {
-  double u = (q - q0) / step;
+  const double u = (q - q0) / step;
+  const double fl = std::floor(u);
+  long i = static_cast<long>(fl);
+  dx = (u - fl) * step;
   if (periodic) {
-    u = std::fmod(u, static_cast<double>(intervals));
-    if (u < 0) u += intervals;
+    // Wrap the interval index (integer arithmetic: no fmod on the hot path).
+    i %= intervals;
+    if (i < 0) i += intervals;
+    return static_cast<int>(i);
   }
-  int i = static_cast<int>(u);
-  if (i < 0) i = 0;
-  if (i >= intervals) i = intervals - 1;
-  dx = (u - i) * step;
-  return i;
+  if (i < 0) {
+    dx = (u - 0.0) * step;  // extrapolate the first cubic (callers check in_range)
+    return 0;
+  }
+  if (i >= intervals) {
+    dx = (u - (intervals - 1)) * step;
+    return intervals - 1;
+  }
+  return static_cast<int>(i);
 }
 
 bool Table::in_range(double q) const {

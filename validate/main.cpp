@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   red->add_flag("--energy-consistent", sim.energy_consistent, "Use m2 = ½ dm1/dq of the m1 interpolant");
   red->add_option("--reduced-integrator", sim.reduced_integrator, "rk8pd, rkf45, rkck (adaptive) or rk4-fixed")
       ->check(CLI::IsMember({"rk8pd", "rkf45", "rkck", "rk4-fixed"}));
-  red->add_option("--reduced-tolerance", sim.reduced_tolerance, "Adaptive integrator tolerance (default 1e-10)");
+  red->add_option("--reduced-tolerance", sim.reduced_tolerance, "Adaptive integrator tolerance (default 1e-8)");
   red->add_option("--fixed-step", sim.fixed_step, "rk4-fixed step [s] (default 1e-3)");
 
   ExtractArgs ext;

@@ -47,12 +47,12 @@ class AnalyticSource : public reduced::KinetostaticSource {
   static double me2(double q) { return 0.2 * std::sin(2 * q); }
   reduced::ForcePoint inertial(double q, double qd, double qdd) override {
     ++calls;
-    return {sc.m1(q) * qdd + sc.m2(q) * qd * qd, {me1(q) * qdd + me2(q) * qd * qd}};
+    return {sc.m1(q) * qdd + sc.m2(q) * qd * qd, {me1(q) * qdd + me2(q) * qd * qd}, {qd, std::cos(q) * qd}};
   }
   reduced::ConservativePoint conservative(double q) override {
     ++calls;
     // At rest the actuators balance the loads: T_act = −Q, F_E = −Qx.
-    return {{k * std::sin(q), {-0.4 * std::cos(q)}}, k * (1 - std::cos(q))};
+    return {{k * std::sin(q), {-0.4 * std::cos(q)}, {0.0, 0.0}}, k * (1 - std::cos(q))};
   }
   reduced::RatioPoint ratios(double q) override {
     ++calls;
@@ -69,6 +69,9 @@ inline models::Scene analytic_scene() {
               {"lever", models::JointType::Revolute, models::kGround, "lever", {}, {}, {1, 0}, 0, 0}};
   s.independent = "crank";
   s.outputs.constraint_forces = {{"F", "lever", {1, 0}}};
+  // The source supplies a potential: declare position-only loads so extraction asks for
+  // them (it skips the static call for scenes without gravity or springs).
+  s.gravity.enabled = true;
   return s;
 }
 

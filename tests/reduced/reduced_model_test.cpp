@@ -46,11 +46,13 @@ TEST(ReducedModel, ConservesEnergyWithoutNonConservativeLoads) {
     const auto ts = simulate_reduced(m, 0.3, 12.0, opt);
     double drift = 0;
     for (double e : ts.energy) drift = std::max(drift, std::abs(e - ts.energy[0]));
+    // Outputs are quintic-Hermite samples between steps (~1e-7 relative): the consistent
+    // variant conserves to that level, the inconsistent one drifts two orders more.
     if (consistent) {
-      EXPECT_LT(drift, 1e-9 * ts.energy[0]);
+      EXPECT_LT(drift, 3e-7 * ts.energy[0]);
     } else {
       EXPECT_LT(drift, 1e-3 * ts.energy[0]);  // m1, m2 interpolated apart: small drift
-      EXPECT_GT(drift, 1e-7 * ts.energy[0]);  // ... which the consistent variant removes
+      EXPECT_GT(drift, 1e-6 * ts.energy[0]);  // ... which the consistent variant removes
     }
     EXPECT_GT(ts.q.back(), 10.0);                // it really turned
   }
@@ -67,6 +69,7 @@ TEST(ReducedModel, SmallOscillationsHaveThePendulumPeriod) {
   ReducedOptions opt;
   opt.duration_s = 1.0;
   opt.output_interval_s = 1e-4;
+  opt.tolerance = 1e-13;  // also an absolute tolerance: tight against a 1e-4 rad amplitude
   const auto ts = simulate_reduced(m, 1e-4, 0.0, opt);
   // First return to the start through a maximum: the period.
   double period = 0;
