@@ -77,16 +77,22 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
     for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
   }
+  m.record_cols = m.rhs_cols;
+  m.record_cols.insert(m.record_cols.end(), m.out_cols.begin(), m.out_cols.end());
   return m;
 }
 
 ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)
-    : gate_on(m.gates.size(), 1), scratch(m.rhs_cols.size()), scratch_out(m.out_cols.size()) {}
+    : gate_on(m.gates.size(), 1),
+      scratch(m.rhs_cols.size()),
+      scratch_out(m.out_cols.size()),
+      scratch_rec(m.record_cols.size()) {}
 
-void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
-                       double& power_nc) {
-  double* v = ws.scratch.data();
-  m.table.eval_cols(q, m.rhs_cols.data(), static_cast<int>(m.rhs_cols.size()), v);
+namespace {
+
+// Eksergian's right-hand side from the rhs_cols values v.
+void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const double* v, double qdot,
+                       double& qddot, double& power_nc) {
   const double m1 = v[0], m2 = v[1];
   double F_nc = 0.0;  // generalized force of the non-conservative loads on q
   const double* r = v + 3;
@@ -108,11 +114,28 @@ void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, do
   power_nc = F_nc * qdot;
 }
 
+// Energy and constraint forces from the out_cols values v.
+double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const double* v, double qdot, double qddot,
+                    double* forces);
+
+}  // namespace
+
+void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                       double& power_nc) {
+  double* v = ws.scratch.data();
+  m.table.eval_cols(q, m.rhs_cols.data(), static_cast<int>(m.rhs_cols.size()), v);
+  acceleration_from(m, ws, v, qdot, qddot, power_nc);
+}
+
 double calc_switching(const ReducedModel& m, int g, double q, double qdot) {
   const auto& gate = m.gates[g];
   if (gate.roots.empty()) return gate.sign * m.table.eval(gate.c_r, q) * qdot;
+  // Wrap q into the table's period first (even root count: the product is 2π-periodic), so
+  // long runs keep small sine arguments.
+  const double P = m.table.period;
+  const double qw = q - P * std::floor((q - m.table.q0) / P);
   double prod = gate.root_sign;
-  for (double r : gate.roots) prod *= std::sin(0.5 * (q - r));
+  for (double r : gate.roots) prod *= std::sin(0.5 * (qw - r));
   return gate.sign * prod * qdot;
 }
 
@@ -157,6 +180,20 @@ double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, doubl
                     double* forces) {
   double* v = ws.scratch_out.data();
   m.table.eval_cols(q, m.out_cols.data(), static_cast<int>(m.out_cols.size()), v);
+  return outputs_from(m, ws, v, qdot, qddot, forces);
+}
+
+double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                   double& power_nc, double* forces) {
+  double* v = ws.scratch_rec.data();
+  m.table.eval_cols(q, m.record_cols.data(), static_cast<int>(m.record_cols.size()), v);
+  acceleration_from(m, ws, v, qdot, qddot, power_nc);
+  return outputs_from(m, ws, v + m.rhs_cols.size(), qdot, qddot, forces);
+}
+
+namespace {
+double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const double* v, double qdot, double qddot,
+                    double* forces) {
   const double energy = 0.5 * v[0] * qdot * qdot + v[1];  // ½ m1 q̇² + V
   const double* c = v + 2;
   for (size_t k = 0; k < m.c_me1.size(); ++k) {
@@ -179,6 +216,7 @@ double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, doubl
   }
   return energy;
 }
+}  // namespace
 
 namespace {
 

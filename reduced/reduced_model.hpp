@@ -60,6 +60,7 @@ struct ReducedModel {
   // Columns the outputs need (one fused lookup): m1, V, then per constraint force k:
   // me1, me2, Qx_cons, each torque's rx, each motor's r and rx, each brake's w and wx.
   std::vector<int> out_cols;
+  std::vector<int> record_cols;  // rhs_cols then out_cols: one lookup per output sample
 };
 
 // Joins the sampled parameters with the scene's loads. Throws TableError when a column the
@@ -73,6 +74,7 @@ struct ReducedWorkspace {
   std::vector<char> gate_on;
   std::vector<double> scratch;      // rhs_cols values
   std::vector<double> scratch_out;  // out_cols values
+  std::vector<double> scratch_rec;  // record_cols values
   explicit ReducedWorkspace(const ReducedModel& m);
 };
 
@@ -95,6 +97,10 @@ void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, d
 // Both at once with one fused table lookup (allocation-free).
 double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot,
                     double* forces);
+// Everything an output sample needs — q̈, non-conservative power, energy and constraint
+// forces — from one table lookup. Returns the energy.
+double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                   double& power_nc, double* forces);
 
 // One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside
 // the step is located by linear interpolation of the switching function and the step is

@@ -40,6 +40,21 @@ struct Deleter {
   void operator()(T* p) const { F(p); }
 };
 
+// Quintic Hermite through (q, q̇, q̈) at both ends of a step of length H, at fraction s;
+// cubic Hermite for W through (W, P). q̈ at the sample is recomputed from the model.
+void hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point& b, double s, double& q,
+             double& qdot, double& work) {
+  const double H = b.t - a.t;
+  const double V0 = a.qdot * H, A0 = a.qddot * H * H, V1 = b.qdot * H, A1 = b.qddot * H * H;
+  const double d0 = b.q - a.q - V0 - 0.5 * A0, d1 = V1 - V0 - A0, d2 = A1 - A0;
+  const double c3 = 10 * d0 - 4 * d1 + 0.5 * d2, c4 = -15 * d0 + 7 * d1 - d2, c5 = 6 * d0 - 3 * d1 + 0.5 * d2;
+  q = a.q + s * (V0 + s * (0.5 * A0 + s * (c3 + s * (c4 + s * c5))));
+  qdot = (V0 + s * (A0 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))) / H;
+  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
+               h11 = s * s * s - s * s;
+  work = h00 * a.work + h10 * H * a.power + h01 * b.work + h11 * H * b.power;
+}
+
 }  // namespace
 
 struct AdaptiveIntegrator::Impl {
@@ -56,6 +71,7 @@ struct AdaptiveIntegrator::Impl {
   long steps = 0, events = 0;
   double smallest = INFINITY;
   int pending_flip = -1;  // gate to flip before the next step
+  bool flipped = false;   // a gate flipped since `end` was computed
   Point start{}, end{};
 
   Impl(const ReducedModel& model, double tol, const std::string& method) : m(model), ws(model), ctx{&m, &ws} {
@@ -86,12 +102,10 @@ struct AdaptiveIntegrator::Impl {
     gsl_odeiv2_step_apply(probe.get(), t0, dt, out, err, nullptr, nullptr, &sys);
   }
 
-  // Illinois (modified regula falsi) on f(h) over [0, H] with f(0) = f0, f(H) = fH of
-  // opposite signs; returns an h just past the crossing (the end whose sign differs from f0).
+  // Illinois (modified regula falsi) on f over [a, b] with fa, fb of opposite signs; returns
+  // the end of the final bracket on the side whose sign differs from f0.
   template <typename F>
-  double locate(F&& f, double H, double f0, double fH, double t0) {
-    double a = 0, fa = f0, b = H, fb = fH;
-    const double tol = 1e-13 * std::max(1.0, std::abs(t0));
+  double illinois(F&& f, double a, double fa, double b, double fb, double f0, double tol) {
     for (int it = 0; it < 100 && std::abs(b - a) > tol; ++it) {
       double c = b - fb * (b - a) / (fb - fa);
       if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
@@ -107,6 +121,55 @@ struct AdaptiveIntegrator::Impl {
       fb = fc;
     }
     return (fa > 0) != (f0 > 0) ? a : b;
+  }
+
+  // Crossing of g (a function of q, q̇) inside the last step [0, H]: estimated on the step's
+  // quintic Hermite interpolant (no model calls), refined by Newton's method along the
+  // trajectory with single steps from the start of the step (dg/dt = g_q q̇ + g_q̇ q̈, the
+  // partials by central differences of g), then moved just past the crossing so the sign
+  // has changed where the step is cut. Typically three single steps per crossing.
+  struct Cut {
+    double h = 0.0;
+    double y[3] = {0, 0, 0};
+  };
+  template <typename G>
+  Cut locate(G&& g, double t0, const double y0[3], double H, double g0, double gH) {
+    const double tol = 1e-13 * std::max(1.0, std::abs(t0));
+    auto on_hermite = [&](double hh) {
+      double q, v, w;
+      hermite(start, end, hh / H, q, v, w);
+      return g(q, v);
+    };
+    auto crossed = [&](double gv) { return gv != 0.0 && (gv > 0) != (g0 > 0); };
+    Cut c;
+    c.h = illinois(on_hermite, 0.0, g0, H, gH, g0, tol);
+    // Newton to the crossing (accept a point already past it once the correction is tiny).
+    for (int it = 0; it < 8; ++it) {
+      probe_step(t0, y0, c.h, c.y);
+      const double gv = g(c.y[0], c.y[1]);
+      double a, p;
+      calc_acceleration(m, ws, c.y[0], c.y[1], a, p);
+      const double dq = 1e-7 * std::max(1.0, std::abs(c.y[0])), dv = 1e-7 * std::max(1.0, std::abs(c.y[1]));
+      const double gq = (g(c.y[0] + dq, c.y[1]) - g(c.y[0] - dq, c.y[1])) / (2 * dq);
+      const double gw = (g(c.y[0], c.y[1] + dv) - g(c.y[0], c.y[1] - dv)) / (2 * dv);
+      const double rate = gq * c.y[1] + gw * a;
+      const double dh = std::isfinite(rate) && rate != 0.0 ? -gv / rate : 0.0;
+      if (std::abs(dh) <= 1e3 * tol) {
+        if (crossed(gv)) return c;  // just past the crossing
+        break;                      // at (or just before) it: step over below
+      }
+      c.h = std::min(H, std::max(0.0, c.h + dh));
+    }
+    // Step just over the crossing.
+    const double root = c.h;
+    for (double nudge = tol; c.h < H; nudge *= 4) {
+      c.h = std::min(H, root + nudge);
+      probe_step(t0, y0, c.h, c.y);
+      if (crossed(g(c.y[0], c.y[1]))) return c;
+    }
+    c.h = H;  // the step's end has crossed by construction
+    probe_step(t0, y0, H, c.y);
+    return c;
   }
 };
 
@@ -127,6 +190,7 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
   init_gates(d.m, d.ws);
   d.y[0] = q, d.y[1] = qdot, d.y[2] = work;
   d.pending_flip = -1;
+  d.flipped = true;  // recompute the start point and switching values
   d.start = d.end = d.point(t, d.y);
   gsl_odeiv2_evolve_reset(d.evolve.get());
 }
@@ -137,54 +201,57 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   if (d.pending_flip >= 0) {
     d.ws.gate_on[d.pending_flip] = !d.ws.gate_on[d.pending_flip];
     d.pending_flip = -1;
+    d.flipped = true;
     gsl_odeiv2_evolve_reset(d.evolve.get());
   }
   const size_t ng = m.gates.size();
   const bool stop_at_q = std::isfinite(q_stop);
   double t = d.ws.t;
   const double t_prev = t, y_prev[3] = {d.y[0], d.y[1], d.y[2]};
-  d.start = d.point(t_prev, y_prev);
-  for (size_t g = 0; g < ng; ++g) d.s_before[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+  // The previous step's end is this step's start (same state, same gates) unless a gate
+  // flipped or the integrator was reset.
+  if (!(d.end.t == t_prev && d.end.q == y_prev[0] && d.end.qdot == y_prev[1] && !d.flipped)) {
+    d.start = d.point(t_prev, y_prev);
+    for (size_t g = 0; g < ng; ++g) d.s_before[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+  } else {
+    d.start = d.end;
+    d.s_before = d.s_after;
+  }
+  d.flipped = false;
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
   const int st = gsl_odeiv2_evolve_apply(d.evolve.get(), d.control.get(), d.step.get(), &d.sys, &t, t_end, &d.h, d.y);
   if (st != GSL_SUCCESS)
     throw TableError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
   ++d.steps;
+  d.end = d.point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)
   // What changed sign in this step: a gate's switching function (index ≥ 0) or q − q_stop (−2).
   // The earliest crossing, located on single steps from the start of the step, ends the step.
   const double H = t - t_prev;
-  double h_cut = INFINITY;
+  Impl::Cut cut;
+  cut.h = INFINITY;
   int which = -1;
   for (size_t g = 0; g < ng; ++g) {
     d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
     if (d.s_before[g] == 0.0 || (d.s_before[g] > 0) == (d.s_after[g] > 0)) continue;
-    const double hc = d.locate(
-        [&](double hh) {
-          double yt[3];
-          d.probe_step(t_prev, y_prev, hh, yt);
-          return calc_switching(m, static_cast<int>(g), yt[0], yt[1]);
-        },
-        H, d.s_before[g], d.s_after[g], t_prev);
-    if (hc < h_cut) h_cut = hc, which = static_cast<int>(g);
+    const auto c = d.locate([&](double q, double v) { return calc_switching(m, static_cast<int>(g), q, v); },
+                            t_prev, y_prev, H, d.s_before[g], d.s_after[g]);
+    if (c.h < cut.h) cut = c, which = static_cast<int>(g);
   }
   if (stop_at_q && stop_before != 0.0 && (stop_before > 0) != (d.y[0] - q_stop > 0)) {
-    const double hc = d.locate(
-        [&](double hh) {
-          double yt[3];
-          d.probe_step(t_prev, y_prev, hh, yt);
-          return yt[0] - q_stop;
-        },
-        H, stop_before, d.y[0] - q_stop, t_prev);
-    if (hc <= h_cut) h_cut = hc, which = -2;
+    const auto c = d.locate([&](double q, double) { return q - q_stop; }, t_prev, y_prev, H, stop_before,
+                            d.y[0] - q_stop);
+    if (c.h <= cut.h) cut = c, which = -2;
   }
   if (which != -1) {
-    d.probe_step(t_prev, y_prev, h_cut, d.y);
-    t = t_prev + h_cut;
+    for (int k = 0; k < 3; ++k) d.y[k] = cut.y[k];
+    t = t_prev + cut.h;
     gsl_odeiv2_evolve_reset(d.evolve.get());
     if (which >= 0) {
       d.pending_flip = which;
       ++d.events;
     }
+    d.end = d.point(t, d.y);
+    for (size_t g = 0; g < ng; ++g) d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
   } else if (t < t_end) {
     d.smallest = std::min(d.smallest, H);
   }
@@ -194,7 +261,6 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   if (!m.table.in_range(d.ws.q))
     throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
                                  t, d.ws.q));
-  d.end = d.point(t, d.y);
   return which == -2;
 }
 
@@ -210,33 +276,18 @@ namespace {
 void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, double qdot, double work,
             models::TimeSeries& ts, std::vector<double>& f) {
   double qdd, p;
-  calc_acceleration(m, ws, q, qdot, qdd, p);
+  const double energy = calc_sample(m, ws, q, qdot, qdd, p, f.data());
   ts.t.push_back(t);
   ts.q.push_back(q);
   ts.qdot.push_back(qdot);
   ts.qddot.push_back(qdd);
-  ts.energy.push_back(calc_outputs(m, ws, q, qdot, qdd, f.data()));
+  ts.energy.push_back(energy);
   ts.work.push_back(work);
   std::uint32_t mask = 0;
   for (size_t g = 0; g < ws.gate_on.size() && g < 32; ++g)
     if (ws.gate_on[g]) mask |= 1u << g;
   ts.gates.push_back(mask);
   for (size_t k = 0; k < f.size(); ++k) ts.forces[k].push_back(f[k]);
-}
-
-// Quintic Hermite through (q, q̇, q̈) at both ends of a step of length H, at fraction s;
-// cubic Hermite for W through (W, P). q̈ at the sample is recomputed from the model.
-void hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point& b, double s, double& q,
-             double& qdot, double& work) {
-  const double H = b.t - a.t;
-  const double V0 = a.qdot * H, A0 = a.qddot * H * H, V1 = b.qdot * H, A1 = b.qddot * H * H;
-  const double d0 = b.q - a.q - V0 - 0.5 * A0, d1 = V1 - V0 - A0, d2 = A1 - A0;
-  const double c3 = 10 * d0 - 4 * d1 + 0.5 * d2, c4 = -15 * d0 + 7 * d1 - d2, c5 = 6 * d0 - 3 * d1 + 0.5 * d2;
-  q = a.q + s * (V0 + s * (0.5 * A0 + s * (c3 + s * (c4 + s * c5))));
-  qdot = (V0 + s * (A0 + s * (3 * c3 + s * (4 * c4 + s * 5 * c5)))) / H;
-  const double h00 = 2 * s * s * s - 3 * s * s + 1, h10 = s * s * s - 2 * s * s + s, h01 = -2 * s * s * s + 3 * s * s,
-               h11 = s * s * s - s * s;
-  work = h00 * a.work + h10 * H * a.power + h01 * b.work + h11 * H * b.power;
 }
 
 }  // namespace
@@ -251,6 +302,9 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
   std::vector<double> f(m.force_names.size());
   const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
   auto t_out = [&](long i) { return std::min(opt.duration_s, i * opt.output_interval_s); };
+  for (auto* v : {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work}) v->reserve(n + 1);
+  for (auto& v : ts.forces) v.reserve(n + 1);
+  ts.gates.reserve(n + 1);
 
   if (opt.integrator == "rk4-fixed") {
     // Fixed steps regardless of the outputs; outputs by quintic Hermite inside each step.
