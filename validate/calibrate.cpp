@@ -173,6 +173,11 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   }
 
   // Confirmation with the full model from the same point of the steady cycle.
+  r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
+  if (!(opt.full_check_s > 0)) {
+    r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return r;
+  }
   progress.note("calibrate: confirming with the full model");
   models::Scene sf = with_loads(scene, T, r.resistance_coefficient);
   sf.initial.q = r.steady_q;
@@ -188,8 +193,10 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   while (i1 < ts.t.size() && ts.t[i1] < 1.0) ++i1;
   r.mean_cadence_hz_full = (ts.q.back() - ts.q[i1]) / (2 * M_PI * (ts.t.back() - ts.t[i1]));
   r.speed_fluctuation_full = fluct(ts.qdot, i1);
-  if (!ts.forces.empty())
+  if (!ts.forces.empty()) {
+    r.peak_force_full_N = 0.0;
     for (size_t i = i1; i < ts.t.size(); ++i) r.peak_force_full_N = std::max(r.peak_force_full_N, std::abs(ts.forces[0][i]));
+  }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -18,7 +18,7 @@ struct CalibrationOptions {
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
   double tolerance = 1e-10;    // reduced integrator
-  double full_check_s = 6.0;   // full-model confirmation run, from the steady cycle
+  double full_check_s = 6.0;   // full-model confirmation run, from the steady cycle (0: skip)
 };
 
 struct CalibrationResult {
@@ -26,7 +26,7 @@ struct CalibrationResult {
   double initial_guess_Nm = 0.0;        // from the energy balance per revolution
   double resistance_coefficient = 0.0;  // c0, c1 or c2 of the scene's resistance
   double mean_cadence_hz_reduced = 0.0;
-  double mean_cadence_hz_full = 0.0;
+  double mean_cadence_hz_full = 0.0;     // NaN when the full-model check was skipped
   double mean_power_w = 0.0;            // mean power of the drive = dissipated power (steady)
   std::string force_name;               // first requested constraint force (empty if none)
   double peak_force_N = 0.0;            // max |F| over the steady cycle (reduced)

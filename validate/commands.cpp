@@ -17,6 +17,7 @@
 #include "validate/calibrate.hpp"
 #include "validate/harness.hpp"
 #include "validate/report.hpp"
+#include "validate/sweep.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/timeseries_csv.hpp"
@@ -229,6 +230,30 @@ nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions&
 }
 
 }  // namespace
+
+int run_sweep_command(const SweepArgs& a) {
+  SweepOptions o;
+  o.scene = a.scene;
+  o.sets = a.sets;
+  o.cadence_hz = a.cadence_hz;
+  o.power_w = a.power_w;
+  o.threads = a.threads;
+  o.grid_deg = a.grid_deg;
+  if (std::sscanf(a.shard.c_str(), "%d/%d", &o.shard, &o.shards) != 2)
+    throw models::SceneError("", 0, "--shard", "expected i/N, got '" + a.shard + "'");
+  if (a.vary.empty()) throw models::SceneError("", 0, "--vary", "give at least one key=a:b:n");
+  for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
+  {  // fail early on an unwritable destination
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(fs::absolute(a.out).parent_path(), ec))
+      throw OutputError(a.out + ": cannot write: its folder does not exist");
+  }
+  const std::string csv = run_sweep(o, Progress().enabled());
+  write_file_atomically(a.out, csv);
+  std::fprintf(stderr, "rdyn: sweep shard %s wrote %s\n", a.shard.c_str(), a.out.c_str());
+  return 0;
+}
 
 int run_validate(const ValidateArgs& a) {
   namespace fs = std::filesystem;

@@ -60,4 +60,16 @@ struct ValidateArgs {
 };
 int run_validate(const ValidateArgs& args);
 
+struct SweepArgs {
+  std::string scene;
+  std::vector<std::string> vary;
+  std::vector<std::string> sets;
+  std::string out;
+  std::string shard = "0/1";
+  int threads = 0;
+  double cadence_hz = 0.0, power_w = 0.0;
+  double grid_deg = 10.0;
+};
+int run_sweep_command(const SweepArgs& args);
+
 }  // namespace rdyn::validate

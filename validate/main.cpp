@@ -99,6 +99,24 @@ int main(int argc, char** argv) {
   validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
   validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
 
+  SweepArgs sw;
+  auto* sweep = app.add_subcommand(
+      "sweep",
+      "Population sweep: calibrate the drive torque of many cases with the reduced model, in parallel threads. "
+      "One CSV row per case: the varied parameters, the calibrated hip torque, the peak of the first constraint "
+      "force (e.g. the knee) and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
+      "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
+  sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
+  sweep->add_option("--vary", sw.vary, "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)")
+      ->required();
+  sweep->add_option("--set", sw.sets, "Fixed override key.path=value (repeatable)");
+  sweep->add_option("--out", sw.out, "Output CSV file")->required();
+  sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
+  sweep->add_option("--threads", sw.threads, "Worker threads (default: hardware threads)");
+  sweep->add_option("--cadence-hz", sw.cadence_hz, "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
+  sweep->add_option("--power-w", sw.power_w, "Calibration power [W] (default: the scene's validation.calibrate)");
+  sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -115,6 +133,7 @@ int main(int argc, char** argv) {
     if (*extract) return run_extract(ext);
     if (*calibrate) return run_calibrate(cal);
     if (*validate) return run_validate(val);
+    if (*sweep) return run_sweep_command(sw);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

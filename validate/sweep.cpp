@@ -1,0 +1,109 @@
+#include "validate/sweep.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "models/scene_yaml.hpp"
+#include "validate/calibrate.hpp"
+#include "validate/progress.hpp"
+
+namespace rdyn::validate {
+
+SweepAxis parse_sweep_axis(const std::string& text) {
+  auto fail = [&](const std::string& msg) { throw models::SceneError("", 0, "--vary " + text, msg); };
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0) fail("expected key=a:b:n");
+  SweepAxis a;
+  a.key = text.substr(0, eq);
+  const std::string range = text.substr(eq + 1);
+  double lo = 0, hi = 0;
+  long n = 0;
+  char extra = 0;
+  if (std::sscanf(range.c_str(), "%lf:%lf:%ld%c", &lo, &hi, &n, &extra) != 3 || n < 1 || !std::isfinite(lo) ||
+      !std::isfinite(hi))
+    fail("expected a:b:n with finite a, b and a whole n ≥ 1");
+  if (n > 100000) fail("at most 100000 values per axis");
+  for (long i = 0; i < n; ++i) a.values.push_back(n == 1 ? lo : lo + (hi - lo) * i / (n - 1));
+  return a;
+}
+
+std::string run_sweep(const SweepOptions& opt, bool show_progress) {
+  if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
+    throw models::SceneError("", 0, "--shard", "expected i/N with 0 ≤ i < N");
+  std::vector<models::Override> fixed;
+  for (const auto& s : opt.sets) fixed.push_back(models::parse_override(s));
+  // The base scene must load (fails early, before any thread starts).
+  const models::Scene base = models::load_scene(opt.scene, fixed);
+  CalibrationOptions copt;
+  copt.cadence_hz = opt.cadence_hz > 0 ? opt.cadence_hz : base.validation.calibrate_cadence_Hz;
+  copt.power_w = opt.power_w > 0 ? opt.power_w : base.validation.calibrate_power_W;
+  copt.grid_deg = opt.grid_deg;
+  copt.full_check_s = 0.0;  // reduced model only: this is what sweeps are for
+  if (!(copt.cadence_hz > 0) || !(copt.power_w > 0))
+    throw models::SceneError(base.source_file, 0, "--cadence-hz/--power-w",
+                             "give them, or a validation.calibrate block in the scene");
+
+  long total = 1;
+  for (const auto& a : opt.axes) total *= static_cast<long>(a.values.size());
+  const long per = (total + opt.shards - 1) / opt.shards;
+  const long first = std::min(total, per * opt.shard), last = std::min(total, first + per);
+  const long n = last - first;
+
+  std::vector<std::string> rows(n);
+  std::atomic<long> next{0}, done{0};
+  std::mutex progress_mutex;
+  Progress progress(show_progress);
+  const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
+  auto work = [&] {
+    Progress quiet(false);
+    for (long k; (k = next.fetch_add(1)) < n;) {
+      const long index = first + k;
+      std::vector<models::Override> o = fixed;
+      std::string params;
+      long rest = index;
+      for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
+        const double v = it->values[rest % it->values.size()];
+        rest /= static_cast<long>(it->values.size());
+        o.push_back({it->key, fmt::format("{:.17g}", v)});
+        params = fmt::format(",{:.10g}", v) + params;
+      }
+      std::string row;
+      try {
+        const auto scene = models::load_scene(opt.scene, o);
+        const auto r = calibrate(scene, copt, quiet);
+        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},", index, params, r.torque_Nm,
+                          r.mean_cadence_hz_reduced, r.mean_power_w, force.empty() ? NAN : r.peak_force_N,
+                          r.speed_fluctuation);
+      } catch (const std::exception& e) {
+        std::string msg = e.what();
+        for (char& c : msg)
+          if (c == '"' || c == '\n' || c == ',') c = ' ';
+        row = fmt::format("{}{},error,,,,,,\"{}\"", index, params, msg);
+      }
+      rows[k] = row;
+      const long d = ++done;
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      progress.count("sweep", d, n);
+    }
+  };
+  const int threads = std::max(1, opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+  for (auto& t : pool) t.join();
+
+  std::string csv;
+  if (opt.shard == 0) {
+    csv = "case";
+    for (const auto& a : opt.axes) csv += "," + a.key;
+    csv += fmt::format(",status,hip_torque_Nm,mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n",
+                       force.empty() ? "constraint" : force);
+  }
+  for (const auto& r : rows) csv += r + "\n";
+  return csv;
+}
+
+}  // namespace rdyn::validate

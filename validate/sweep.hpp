@@ -1,0 +1,35 @@
+// Population sweeps: many reduced-model cases in parallel threads, one CSV row per case
+// (parameters, calibrated drive torque, peak constraint force, speed fluctuation), shardable
+// across machines (Slurm job arrays, GNU parallel): `--shard i/N` runs the i-th of N
+// contiguous blocks of cases, and the shards' CSVs concatenate (only shard 0 writes the header).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace rdyn::validate {
+
+struct SweepAxis {
+  std::string key;  // a scene key path, as for --set
+  std::vector<double> values;
+};
+
+// "key=a:b:n" → n values from a to b (n ≥ 1; n = 1 gives a). Throws models::SceneError.
+SweepAxis parse_sweep_axis(const std::string& text);
+
+struct SweepOptions {
+  std::string scene;
+  std::vector<std::string> sets;  // fixed overrides
+  std::vector<SweepAxis> axes;
+  double cadence_hz = 0.0;  // 0: the scene's validation.calibrate
+  double power_w = 0.0;
+  int shard = 0, shards = 1;
+  int threads = 0;          // 0: hardware threads
+  double grid_deg = 10.0;
+};
+
+// Runs the cases of this shard and returns the CSV text (header only on shard 0). A failing
+// case gives a row with status "error" and its message, and does not stop the others.
+std::string run_sweep(const SweepOptions& opt, bool show_progress);
+
+}  // namespace rdyn::validate
