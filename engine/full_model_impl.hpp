@@ -56,6 +56,7 @@ struct FullModel::Impl {
   mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;  // per joint torque (if gated)
   mutable SimTK::ZIndex work_index;
   mutable long events_handled = 0;  // gate switches handled (forward dynamics statistics)
+  mutable long near_singular_projections = 0;  // kinetostatic projections that needed 1e-9
 
   SimTK::State default_state;
 

@@ -19,7 +19,14 @@ LoadMode mode_of(Loads l) {
 void project(const FullModel::Impl& m, State& s, double q_for_message) {
   try {
     m.system.realize(s, Stage::Time);
-    m.system.project(s, 1e-12);
+    try {
+      m.system.project(s, 1e-12);
+    } catch (const std::exception&) {
+      // At a singular configuration (e.g. a parallelogram's aligned position) the constraint
+      // Jacobian loses rank and the projection stalls a little above 1e-12; accept 1e-9 there.
+      m.system.project(s, 1e-9);
+      ++m.near_singular_projections;
+    }
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
@@ -111,6 +118,32 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
   }
   for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, 0, 0));
   return out;
+}
+
+double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  m.system.realize(s, Stage::Position);
+  Matrix G;
+  m.matter.calcG(s, G);
+  if (G.nrow() == 0) return 1.0;
+  // Columns of the prescribed mobilities (independent coordinate, constraint actuators) go.
+  std::vector<bool> keep(G.ncol(), true);
+  keep[m.joint_mobod[m.independent].getFirstUIndex(s)] = false;
+  for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
+  std::vector<int> cols;
+  for (int c = 0; c < G.ncol(); ++c)
+    if (keep[c]) cols.push_back(c);
+  Matrix Gf(G.nrow(), static_cast<int>(cols.size()));
+  for (int r = 0; r < G.nrow(); ++r)
+    for (size_t c = 0; c < cols.size(); ++c) Gf(r, static_cast<int>(c)) = G(r, cols[c]);
+  FactorSVD svd(Gf);
+  Vector sv;
+  svd.getSingularValues(sv);
+  if (sv.size() == 0 || !(sv[0] > 0)) return 0.0;
+  // Rank deficiency shows as missing or tiny singular values (min(nrow, ncol) of them).
+  const int expected = std::min(Gf.nrow(), Gf.ncol());
+  return sv.size() < expected ? 0.0 : sv[sv.size() - 1] / sv[0];
 }
 
 KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws, const double c[5],

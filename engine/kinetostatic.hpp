@@ -45,6 +45,13 @@ struct VelocityRatios {
 VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q, bool with_q = true,
                                     bool with_x = true);
 
+// Conditioning of the loop closure at the workspace's configuration: smallest over largest
+// singular value of the constraint Jacobian restricted to the mobilities the constraints
+// must determine (all but the prescribed ones). Near 0 at a singular configuration
+// (e.g. a parallelogram's aligned position), where velocities are not determined; 1 when
+// the mechanism has no loop or gear constraint.
+double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws);
+
 // Sample of a prescribed time law q(t) = c1 + c2 t + c3 cos(c4 t + c5) at time t (the
 // original authors' sweep); same outputs as calc_kinetostatic.
 KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws,

@@ -21,14 +21,32 @@ int FullKinetostaticSource::num_constraint_forces() const {
 }
 int FullKinetostaticSource::num_joints() const { return static_cast<int>(model_.scene().joints.size()); }
 
-void FullKinetostaticSource::approach(double q) {
+template <typename F>
+auto FullKinetostaticSource::at(double q, F&& call) {
+  const double q_start = q_now_;
+  const Vector q_backup = ws_.impl().state.getQ();  // the last good configuration
+  for (double jump : {kMaxJump, kMaxJump / 5, kMaxJump / 50}) {
+    try {
+      approach(q, jump);
+      ++calls_;
+      return call();
+    } catch (const EngineError&) {
+      if (jump == kMaxJump / 50) throw;
+      ws_.impl().state.updQ() = q_backup;  // back to the last good configuration
+      q_now_ = q_start;
+    }
+  }
+  throw EngineError("unreachable");
+}
+
+void FullKinetostaticSource::approach(double q, double max_jump) {
   // A revolute independent coordinate repeats the configuration every turn: walk to the
   // periodic image of q nearest the current configuration, then the call itself prescribes q
   // (the same configuration; the projection only relabels the angle).
   double target = q;
   const auto& jt = *model_.scene().find_joint(model_.scene().independent);
   if (jt.type == models::JointType::Revolute) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
-  const int steps = static_cast<int>(std::ceil(std::abs(target - q_now_) / kMaxJump - 1e-9));
+  const int steps = static_cast<int>(std::ceil(std::abs(target - q_now_) / max_jump - 1e-9));
   for (int i = 1; i < steps; ++i) {
     move_configuration(model_, ws_, q_now_ + (target - q_now_) * i / steps);
     ++calls_;
@@ -37,15 +55,18 @@ void FullKinetostaticSource::approach(double q) {
 }
 
 reduced::ForcePoint FullKinetostaticSource::inertial(double q, double qdot, double qddot) {
-  approach(q);
-  ++calls_;
-  const auto r = calc_kinetostatic(model_, ws_, q, qdot, qddot, Loads::Off);
-  return {r.driving_force, r.constraint_forces, r.joint_u};
+  return at(q, [&] {
+    const auto r = calc_kinetostatic(model_, ws_, q, qdot, qddot, Loads::Off);
+    return reduced::ForcePoint{r.driving_force, r.constraint_forces, r.joint_u};
+  });
 }
 
 reduced::GridSample FullKinetostaticSource::sample(double q, bool with_conservative) {
-  approach(q);
-  ++calls_;
+  return at(q, [&] { return sample_here(q, with_conservative); });
+}
+
+reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_conservative) {
+  const long singular_before = model_.impl().near_singular_projections;
   reduced::GridSample g;
   // (i) q̇ = 1, q̈ = 0: its joint rates are the velocity ratios wrt q (x fixed).
   const auto vel = calc_kinetostatic(model_, ws_, q, 1.0, 0.0, Loads::Off);
@@ -61,40 +82,44 @@ reduced::GridSample FullKinetostaticSource::sample(double q, bool with_conservat
     g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
   }
   g.ratios.wrt_x = calc_velocity_ratios(model_, ws_, q, false, true).wrt_x;
+  // Singular configuration: the loop Jacobian lost rank (or the projection needed its
+  // fallback tolerance). The constraints do not determine the velocities there.
+  g.singular = model_.impl().near_singular_projections > singular_before ||
+               calc_loop_conditioning(model_, ws_) < 1e-5;  // ≈ 0.3·(distance in rad) near an aligned position
   return g;
 }
 
 double FullKinetostaticSource::ratio(double q, int joint) {
-  approach(q);
-  ++calls_;
-  return calc_velocity_ratios(model_, ws_, q, true, false).wrt_q[joint];
+  return at(q, [&] { return calc_velocity_ratios(model_, ws_, q, true, false).wrt_q[joint]; });
 }
 
 reduced::ConservativePoint FullKinetostaticSource::conservative(double q) {
-  approach(q);
-  ++calls_;
-  const auto r = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
-  return {{r.driving_force, r.constraint_forces, {}}, r.potential_energy};
+  return at(q, [&] {
+    const auto r = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
+    return reduced::ConservativePoint{{r.driving_force, r.constraint_forces, {}}, r.potential_energy};
+  });
 }
 
 reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
-  approach(q);
-  ++calls_;
-  const auto v = calc_velocity_ratios(model_, ws_, q);
-  return {v.wrt_q, v.wrt_x};
+  return at(q, [&] {
+    const auto v = calc_velocity_ratios(model_, ws_, q);
+    return reduced::RatioPoint{v.wrt_q, v.wrt_x};
+  });
 }
 
 std::optional<reduced::ForcePoint> FullKinetostaticSource::harmonic_sweep(const double c[5], double t) {
   const double q = c[0] + c[1] * t + c[2] * std::cos(c[3] * t + c[4]);
-  approach(q);
-  ++calls_;
-  const auto r = calc_harmonic_sweep_point(model_, ws_, c, t, Loads::Off);
-  return reduced::ForcePoint{r.driving_force, r.constraint_forces, {}};
+  return at(q, [&] {
+    const auto r = calc_harmonic_sweep_point(model_, ws_, c, t, Loads::Off);
+    return std::optional<reduced::ForcePoint>(reduced::ForcePoint{r.driving_force, r.constraint_forces, {}});
+  });
 }
 
 std::optional<reduced::DirectPoint> FullKinetostaticSource::direct(double q) {
-  approach(q);
-  ++calls_;
+  return at(q, [&] { return direct_here(q); });
+}
+
+std::optional<reduced::DirectPoint> FullKinetostaticSource::direct_here(double q) {
   const auto& m = model_.impl();
   State& s = ws_.impl().state;
   const int nx = num_constraint_forces();

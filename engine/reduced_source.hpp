@@ -21,9 +21,16 @@ class FullKinetostaticSource : public reduced::KinetostaticSource {
   long calls() const { return calls_; }
 
  private:
-  // Walks the configuration to q in steps of at most 5° so that each Newton projection
-  // starts close (continuation keeps the assembled branch).
-  void approach(double q);
+  // Walks the configuration to q in steps of at most max_jump so that each Newton
+  // projection starts close (continuation keeps the assembled branch).
+  void approach(double q, double max_jump);
+  // Runs `call` at q after approaching it; when a projection fails (close to a singular
+  // configuration Newton can stall from 5° away), goes back to the last good configuration
+  // and approaches again in finer steps (1°, then 0.1°).
+  template <typename F>
+  auto at(double q, F&& call);
+  reduced::GridSample sample_here(double q, bool with_conservative);
+  std::optional<reduced::DirectPoint> direct_here(double q);
   const FullModel& model_;
   FullWorkspace ws_;
   double q_now_;

@@ -153,8 +153,9 @@ struct Simulation {
 };
 
 // Acceptance threshold for `rdyn validate`: the reduced model at this grid (and
-// interpolation, default the tool's) must reproduce `quantity` ("qdot" or a constraint
-// force's name) within max_error of its peak (max over the steady window).
+// interpolation, default the tool's) must reproduce `quantity` ("qdot", a constraint force's
+// name — max error over the steady window relative to the peak — or "mean_qdot", the
+// relative error of the mean speed) within max_error.
 struct Threshold {
   std::string quantity;
   double grid_deg = 10.0;
@@ -164,6 +165,8 @@ struct Threshold {
 
 struct Validation {
   double duration_s = 0.0;  // 0: simulation.duration_s
+  double reference_tolerance = 1e-10;  // full-model reference accuracy (halved to show convergence)
+  std::string reference_integrator = "rkmerson";  // rkmerson | rk3 | cpodes
   std::vector<Threshold> thresholds;
   // Calibrate the drive torque so the resistance dissipates power_W at cadence_Hz (0: off).
   double calibrate_cadence_Hz = 0.0;

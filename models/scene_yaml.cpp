@@ -516,17 +516,25 @@ Scene parse_scene(const std::string& text, const std::string& file,
       s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
     }
     if (top.has("validation")) {
-      Fields f(top.raw("validation"), "validation", file, {"duration_s", "thresholds", "calibrate", "note"});
+      Fields f(top.raw("validation"), "validation", file,
+               {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance", "reference_integrator"});
       s.validation.duration_s = f.num_or("duration_s", 0.0);
+      s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
+      if (!(s.validation.reference_tolerance > 0 && s.validation.reference_tolerance < 1e-3))
+        f.fail("reference_tolerance", "must be in (0, 1e-3)");
+      s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
+      const auto& ri = s.validation.reference_integrator;
+      if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
+        f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
       s.validation.note = f.str_or("note", "");
       if (s.validation.duration_s < 0) f.fail("duration_s", "must be positive");
       for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
         Fields t(n, path, file, {"quantity", "grid_deg", "interpolation", "max_error"});
         Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
                      t.num("max_error")};
-        bool known = th.quantity == "qdot";
+        bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
         for (const auto& c : s.outputs.constraint_forces) known |= c.name == th.quantity;
-        if (!known) t.fail("quantity", "expected qdot or the name of a requested constraint force");
+        if (!known) t.fail("quantity", "expected qdot, mean_qdot or the name of a requested constraint force");
         if (!(th.max_error > 0)) t.fail("max_error", "must be positive");
         if (!(th.grid_deg > 0)) t.fail("grid_deg", "must be positive");
         s.validation.thresholds.push_back(th);

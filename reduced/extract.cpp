@@ -1,5 +1,6 @@
 #include "reduced/extract.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -200,6 +201,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   // position-only loads (only when the scene has some), and the velocity ratios.
   const bool conservative_loads = scene.gravity.enabled || !scene.springs.empty();
   const bool inertial_here = opt.method == Method::Kinetostatic || opt.method == Method::Integrated;
+  std::vector<char> singular(n, 0);
   for (long i = 0; i < n; ++i) {
     GridSample g;
     if (inertial_here) {
@@ -221,6 +223,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       r[j][i] = g.ratios.wrt_q[j];
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
     }
+    singular[i] = g.singular;
   }
   if (opt.method == Method::Integrated) {
     // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).
@@ -228,6 +231,38 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     for (long i = 0; i < n; ++i) two_m2[i] = 2 * m2[i];
     const auto integral = periodic_integral(s.q, two_m2, 2 * kPi);
     for (long i = 1; i < n; ++i) m1[i] = m1[0] + integral[i];
+  }
+
+  // Samples at singular configurations (loop Jacobian lost rank) carry velocities the
+  // constraints do not determine: replace every column there by a periodic cubic spline
+  // through the regular samples, i.e. the limit along the branch the sweep follows.
+  auto repair = [&](std::vector<double>& col) {
+    std::vector<double> x, y;
+    for (long i = 0; i < n; ++i)
+      if (!singular[i]) x.push_back(s.q[i]), y.push_back(col[i]);
+    if (x.size() < 4 || x.size() == static_cast<size_t>(n)) return;
+    x.push_back(x[0] + 2 * kPi);
+    y.push_back(y[0]);
+    std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(gsl_interp_cspline_periodic, x.size()),
+                                                               gsl_spline_free);
+    gsl_spline_init(sp.get(), x.data(), y.data(), x.size());
+    for (long i = 0; i < n; ++i)
+      if (singular[i]) {
+        double q = s.q[i];
+        while (q < x.front()) q += 2 * kPi;
+        while (q > x.back()) q -= 2 * kPi;
+        col[i] = gsl_spline_eval(sp.get(), q, nullptr);
+      }
+  };
+  if (std::count(singular.begin(), singular.end(), 1) > 0) {
+    for (long i = 0; i < n; ++i)
+      if (singular[i]) s.singular_q.push_back(s.q[i]);
+    for (auto* col : {&m1, &m2, &Q, &V}) repair(*col);
+    for (int k = 0; k < nk; ++k) repair(me1[k]), repair(me2[k]), repair(Qx[k]);
+    for (int j = 0; j < nj; ++j) {
+      repair(r[j]);
+      for (int k = 0; k < nk; ++k) repair(rx[k][j]);
+    }
   }
 
   s.add("m1", m1);

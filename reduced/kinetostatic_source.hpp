@@ -40,6 +40,9 @@ struct GridSample {
   ForcePoint acceleration;  // (ii) q̇ = 0, q̈ = 1, loads off
   ConservativePoint conservative;  // zero when not requested
   RatioPoint ratios;
+  // The configuration is singular (the loop Jacobian lost rank): velocities and forces there
+  // are not determined by the constraints, so the sample is not trustworthy.
+  bool singular = false;
 };
 
 class KinetostaticSource {

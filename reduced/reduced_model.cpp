@@ -1,6 +1,9 @@
 #include "reduced/reduced_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <fmt/format.h>
 
 namespace rdyn::reduced {
 
@@ -77,6 +80,17 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
     for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
   }
+  // The interpolated reduced inertia must stay positive (Eksergian divides by it); a coarse
+  // grid over a sharp inertia peak can undershoot.
+  for (int iv = 0; iv < m.table.intervals; ++iv)
+    for (int k = 0; k < 16; ++k) {
+      const double q = m.table.q0 + (iv + k / 16.0) * m.table.step;
+      const double m1 = m.table.eval(m.c_m1, q);
+      if (!(m1 > 0))
+        throw TableError(fmt::format("the interpolated reduced inertia m1 = {:.3g} is not positive at q = {:.4g} "
+                                     "(outside the validity domain): use a finer grid or another interpolation",
+                                     m1, q));
+    }
   m.record_cols = m.rhs_cols;
   m.record_cols.insert(m.record_cols.end(), m.out_cols.begin(), m.out_cols.end());
   return m;
@@ -237,27 +251,37 @@ void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
 }  // namespace
 
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
-  const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
-  rk4(m, ws, h);
-  // Earliest gate switch inside the step, by linear interpolation of the switching function.
-  double frac = 2.0;
-  int which = -1;
-  for (size_t g = 0; g < m.gates.size(); ++g) {
-    const double s0 = calc_switching(m, static_cast<int>(g), q0, v0);
-    const double s1 = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
-    if ((s0 > 0) != (s1 > 0) && s0 != s1) {
-      const double f = s0 / (s0 - s1);
-      if (f < frac) frac = f, which = static_cast<int>(g);
+  // Switches are handled one after another inside the step: a gate needs a flip in the
+  // remaining interval exactly when it disagrees with the sign of its switching function at
+  // the interval's end (as the full model's gates agree with their witnesses after events).
+  // Each switch instant is estimated by linear interpolation of the switching function and
+  // the step is split there. Allocation-free: at most 32 gates are tracked.
+  const size_t ng = std::min<size_t>(m.gates.size(), 32);
+  double t_first = NAN;
+  double remaining = h;
+  for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
+    const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
+    double s0[32], fr[32];
+    for (size_t g = 0; g < ng; ++g) s0[g] = calc_switching(m, static_cast<int>(g), q0, v0);
+    rk4(m, ws, remaining);
+    double frac = 2.0;
+    for (size_t g = 0; g < ng; ++g) {
+      const double s1 = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
+      fr[g] = 2.0;
+      if (s1 == 0.0 || static_cast<bool>(ws.gate_on[g]) == (s1 > 0)) continue;  // agrees at the end
+      fr[g] = ((s0[g] > 0) != (s1 > 0) && s0[g] != s1) ? s0[g] / (s0[g] - s1) : 0.0;
+      frac = std::min(frac, fr[g]);
     }
+    if (frac > 1.0) break;
+    ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
+    const double h1 = std::max(0.0, std::min(1.0, frac)) * remaining;
+    if (h1 > 0) rk4(m, ws, h1);
+    if (std::isnan(t_first)) t_first = ws.t;
+    for (size_t g = 0; g < ng; ++g)
+      if (fr[g] <= frac + 1e-9) ws.gate_on[g] = !ws.gate_on[g];
+    remaining -= h1;
   }
-  if (which < 0) return NAN;
-  ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
-  const double h1 = std::max(0.0, std::min(1.0, frac)) * h;
-  if (h1 > 0) rk4(m, ws, h1);
-  const double t_switch = ws.t;
-  ws.gate_on[which] = !ws.gate_on[which];
-  if (h - h1 > 0) rk4(m, ws, h - h1);
-  return t_switch;
+  return t_first;
 }
 
 }  // namespace rdyn::reduced

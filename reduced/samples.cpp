@@ -42,6 +42,11 @@ void write_samples_csv(const std::string& path, const Samples& s) {
   if (!f) throw TableError(path + ": cannot open for writing");
   fmt::print(f, "# rdyn reduced table: scene={} method={} periodic={} q0={:.17g} step={:.17g}\n", s.scene,
              s.method, s.periodic ? 1 : 0, s.q0, s.step);
+  if (!s.singular_q.empty()) {
+    fmt::print(f, "# singular:");
+    for (double q : s.singular_q) fmt::print(f, " {:.17g}", q);
+    std::fputc('\n', f);
+  }
   for (const auto& [col, rs] : s.roots) {
     fmt::print(f, "# roots {}:", col);
     for (double r : rs) fmt::print(f, " {:.17g}", r);
@@ -88,7 +93,13 @@ Samples read_samples_csv(const std::string& path) {
   }
   ++ln;
   // Optional "# roots <column>: r1 r2 ..." lines.
-  while (std::getline(in, line) && line.rfind("# roots ", 0) == 0) {
+  while (std::getline(in, line) && (line.rfind("# roots ", 0) == 0 || line.rfind("# singular:", 0) == 0)) {
+    if (line.rfind("# singular:", 0) == 0) {
+      std::istringstream vals(line.substr(11));
+      for (double x; vals >> x;) s.singular_q.push_back(x);
+      ++ln;
+      continue;
+    }
     const auto colon = line.find(':');
     if (colon == std::string::npos) fail(ln, "malformed roots line");
     std::vector<double> rs;

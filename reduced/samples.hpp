@@ -36,6 +36,9 @@ struct Samples {
   // Exact zeros of some ratio columns within the table's span, located on the full model
   // (the switch angles of rate-gated loads): column name → sorted roots [rad or m].
   std::vector<std::pair<std::string, std::vector<double>>> roots;
+  // Grid points at singular configurations, whose values were replaced by interpolation
+  // through the regular samples of the same branch [rad or m].
+  std::vector<double> singular_q;
   const std::vector<double>* roots_of(const std::string& column) const;  // null when absent
 
   int column(const std::string& name) const;  // −1 when absent

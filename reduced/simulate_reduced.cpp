@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
 
 #include <fmt/format.h>
@@ -70,7 +71,7 @@ struct AdaptiveIntegrator::Impl {
   double h = 1e-3;
   long steps = 0, events = 0;
   double smallest = INFINITY;
-  int pending_flip = -1;  // gate to flip before the next step
+  std::vector<char> pending;  // gates to flip before the next step
   bool flipped = false;   // a gate flipped since `end` was computed
   Point start{}, end{};
 
@@ -86,6 +87,7 @@ struct AdaptiveIntegrator::Impl {
     evolve.reset(gsl_odeiv2_evolve_alloc(3));
     s_before.resize(m.gates.size());
     s_after.resize(m.gates.size());
+    pending.assign(m.gates.size(), 0);
   }
 
   Point point(double t, const double yy[3]) {
@@ -189,7 +191,7 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
   d.ws.t = t, d.ws.q = q, d.ws.qdot = qdot, d.ws.work = work;
   init_gates(d.m, d.ws);
   d.y[0] = q, d.y[1] = qdot, d.y[2] = work;
-  d.pending_flip = -1;
+  std::fill(d.pending.begin(), d.pending.end(), 0);
   d.flipped = true;  // recompute the start point and switching values
   d.start = d.end = d.point(t, d.y);
   gsl_odeiv2_evolve_reset(d.evolve.get());
@@ -198,9 +200,9 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
 bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   auto& d = *impl_;
   const auto& m = d.m;
-  if (d.pending_flip >= 0) {
-    d.ws.gate_on[d.pending_flip] = !d.ws.gate_on[d.pending_flip];
-    d.pending_flip = -1;
+  if (std::find(d.pending.begin(), d.pending.end(), 1) != d.pending.end()) {
+    for (size_t g = 0; g < d.pending.size(); ++g)
+      if (d.pending[g]) d.ws.gate_on[g] = !d.ws.gate_on[g], d.pending[g] = 0;
     d.flipped = true;
     gsl_odeiv2_evolve_reset(d.evolve.get());
   }
@@ -246,12 +248,16 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
     for (int k = 0; k < 3; ++k) d.y[k] = cut.y[k];
     t = t_prev + cut.h;
     gsl_odeiv2_evolve_reset(d.evolve.get());
-    if (which >= 0) {
-      d.pending_flip = which;
-      ++d.events;
-    }
     d.end = d.point(t, d.y);
-    for (size_t g = 0; g < ng; ++g) d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+    // Every gate whose switching function has changed sign by the cut flips — several do at
+    // once when q̇ itself crosses zero (the crank stalls and turns back).
+    for (size_t g = 0; g < ng; ++g) {
+      d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
+      if (which >= 0 && d.s_before[g] != 0.0 && (d.s_before[g] > 0) != (d.s_after[g] > 0)) {
+        d.pending[g] = 1;
+        ++d.events;
+      }
+    }
   } else if (t < t_end) {
     d.smallest = std::min(d.smallest, H);
   }
@@ -318,6 +324,8 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       return p;
     };
     record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
+    const double E0 = ts.energy.front();
+    double E_scale = std::abs(E0);
     long i = 1;
     AdaptiveIntegrator::Point a = point(ws);
     std::vector<char> before(ws.gate_on.size());
@@ -329,6 +337,12 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot))
         throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
       const AdaptiveIntegrator::Point b = point(ws);
+      const double E = calc_energy(m, b.q, b.qdot);  // divergence guard, as for the adaptive path
+      E_scale = std::max(E_scale, std::abs(E));
+      if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
+        throw TableError(fmt::format("reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J "
+                                     "— the table or the fixed step is too coarse for this run",
+                                     b.t, E - E0 - b.work));
       // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
       // interpolation there, with the gates that held at each sample's time (the fixed-step
       // path is the real-time one; accuracy is secondary).
@@ -351,11 +365,23 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
     integ.reset(0.0, q0, qdot0);
     ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
     record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
+    const double E0 = ts.energy.front();
+    double E_scale = std::abs(E0);
     long i = 1;
     while (i <= n) {
       integ.step(opt.duration_s);
       const auto& a = integ.step_start();
       const auto& b = integ.step_end();
+      // Divergence guard: the reduced equation's own energy balance E − E0 = W must hold to
+      // interpolation accuracy; a gross failure means the table is too coarse to be stable.
+      const double E = calc_energy(m, b.q, b.qdot);
+      E_scale = std::max(E_scale, std::abs(E));
+      if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
+        throw TableError(fmt::format(
+            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
+            "initially {:.3g} J) — the table is too coarse for this run (refine the grid, or use "
+            "--energy-consistent)",
+            b.t, E - E0 - b.work, E, E0));
       for (; i <= n && t_out(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
         double q, v, w;
         if (b.t - a.t <= 0) q = b.q, v = b.qdot, w = b.work;

@@ -226,6 +226,10 @@ nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions&
     nlohmann::json sc = full["runs"][v.showcase_run];
     j["reduced_10deg"] = sc;
   }
+  // Stability metrics of both models: the reference's and the default reduced run's energy
+  // balance, drift per cycle, constraint violation, accepted/rejected steps, smallest step.
+  j["stability"] = {{"full", full["reference"]["stability"]},
+                    {"reduced", v.showcase_run >= 0 ? full["runs"][v.showcase_run] : nlohmann::json(nullptr)}};
   return j;
 }
 

@@ -91,6 +91,16 @@ Comparison compare_series(const models::TimeSeries& ref, const models::TimeSerie
     sig.max_rel /= peak;
     sig.rms_rel = c.samples ? std::sqrt(sum2[s] / c.samples) / peak : 0.0;
   }
+  // Mean speed over the window, from the displacement: insensitive to the phase that builds
+  // up over long runs (pointwise errors then measure the phase, not the model).
+  size_t i0 = 0;
+  while (i0 < ref.t.size() && ref.t[i0] < t_start - 1e-12) ++i0;
+  if (i0 + 1 < ref.t.size()) {
+    const double T = ref.t.back() - ref.t[i0];
+    const double mean_ref = (ref.q.back() - ref.q[i0]) / T, mean_run = (run.q.back() - run.q[i0]) / T;
+    const double rel = std::abs(mean_run - mean_ref) / std::max(std::abs(mean_ref), 1e-300);
+    c.signals.push_back({"mean_qdot", std::abs(mean_ref), rel, rel});
+  }
   return c;
 }
 

@@ -29,7 +29,7 @@ struct SignalError {
 };
 
 struct Comparison {
-  std::vector<SignalError> signals;  // qdot first, then the constraint forces
+  std::vector<SignalError> signals;  // qdot, the constraint forces, then mean_qdot (mean speed)
   long samples = 0;   // compared
   long excluded = 0;  // skipped because a load gate differed (between two switch instants)
   const SignalError* find(const std::string& name) const;

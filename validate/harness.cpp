@@ -28,6 +28,9 @@ double median(std::vector<double> v) {
 }
 
 void fill_stats(RunRecord& r, const models::TimeSeries& ts) {
+  r.cycles = std::abs(ts.q.back() - ts.q.front()) / (2 * M_PI);
+  const double end_residual = std::abs(ts.energy.back() - ts.energy.front() - ts.work.back());
+  r.energy_drift_per_cycle_J = r.cycles >= 1 ? end_residual / r.cycles : end_residual;
   r.steps = ts.stats.steps_taken;
   r.rejected = std::max(0L, ts.stats.steps_attempted - ts.stats.steps_taken);
   r.smallest_step_s = ts.stats.smallest_step_s;
@@ -87,13 +90,14 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
 
   // 1. Reference: full model at a tight tolerance, and the change when it is halved.
-  v.reference_tolerance = 1e-10;
+  v.reference_tolerance = scene.validation.reference_tolerance;
   engine::FullModel full(scene);
   auto full_run = [&](double tol) {
     engine::ForwardOptions fo;
     fo.duration_s = v.duration_s;
     fo.output_interval_s = v.output_interval_s;
     fo.tolerance = tol;
+    fo.integrator = scene.validation.reference_integrator;
     return engine::simulate_full(full, fo);
   };
   progress.count(scene.name + ": reference (full model)", 0, 2);
@@ -101,7 +105,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   v.reference = full_run(v.reference_tolerance);
   v.reference_wall_s = seconds_since(t_ref);
   v.reference_run.model = "full";
-  v.reference_run.integrator = "rkmerson";
+  v.reference_run.integrator = scene.validation.reference_integrator;
   v.reference_run.tolerance = v.reference_tolerance;
   v.reference_run.wall_s = v.reference_wall_s;
   v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
@@ -207,10 +211,22 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
         ro.fixed_step_s = h;
         std::vector<double> walls;
         models::TimeSeries ts;
-        for (int k = 0; k < red_repeats; ++k) {
-          const auto t0 = Clock::now();
-          ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
-          walls.push_back(seconds_since(t0));
+        try {
+          for (int k = 0; k < red_repeats; ++k) {
+            const auto t0 = Clock::now();
+            ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
+            walls.push_back(seconds_since(t0));
+          }
+        } catch (const reduced::TableError& e) {
+          // A run that stops (divergence, validity domain) is recorded as failed, with its reason.
+          r.failure = e.what();
+          r.errors.signals.push_back({"qdot", 0.0, INFINITY, INFINITY});
+          for (const auto& c : scene.outputs.constraint_forces) r.errors.signals.push_back({c.name, 0.0, INFINITY, INFINITY});
+          r.errors.signals.push_back({"mean_qdot", 0.0, INFINITY, INFINITY});
+          r.repeats = 0;
+          r.wall_s = r.per_simulated_s = INFINITY;
+          v.runs.push_back(r);
+          return;
         }
         r.repeats = red_repeats;
         r.wall_s = median(walls);

@@ -32,8 +32,11 @@ struct RunRecord {
   double constraint_violation_m = 0.0;  // full model: largest loop gap seen
   long events = 0;                   // load switches
   double energy_residual_rel = 0.0;  // max|E − E0 − W| / max|E|
+  double cycles = 0.0;                // revolutions of the independent coordinate in the run
+  double energy_drift_per_cycle_J = 0.0;  // |E − E0 − W| at the end / cycles
   Comparison errors;
   bool pareto = false;
+  std::string failure;  // why the run stopped (empty when it completed)
   std::string label() const;
 };
 

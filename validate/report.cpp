@@ -56,7 +56,10 @@ nlohmann::json run_json(const RunRecord& r) {
                       {"smallest_step_s", r.smallest_step_s},
                       {"events", r.events},
                       {"energy_balance_residual_rel", r.energy_residual_rel},
+                      {"cycles", r.cycles},
+                      {"energy_drift_per_cycle_J", r.energy_drift_per_cycle_J},
                       {"pareto", r.pareto}};
+  if (!r.failure.empty()) j["failure"] = r.failure;
   if (r.model == "full") j["constraint_violation_m"] = r.constraint_violation_m;
   if (r.model == "reduced") {
     j["grid_deg"] = r.grid_deg;
@@ -138,9 +141,10 @@ std::string headline(const ValidationResult& v) {
     s += ". ";
   }
   s += fmt::format(
-      "Reference: the full model (Simbody, Runge–Kutta–Merson) at tolerance {:.0e}; halving that tolerance changed "
+      "Reference: the full model (Simbody, {}) at tolerance {:.0e}; halving that tolerance changed "
       "the speed by {}",
-      v.reference_tolerance, pct(v.reference_change.signals[0].max_rel));
+      v.reference_run.integrator == "rkmerson" ? "Runge–Kutta–Merson" : v.reference_run.integrator, v.reference_tolerance,
+      pct(v.reference_change.signals[0].max_rel));
   for (size_t k = 1; k < v.reference_change.signals.size(); ++k)
     s += fmt::format(" and {} by {}", v.reference_change.signals[k].name, pct(v.reference_change.signals[k].max_rel));
   s += " of their peaks. Errors are maxima over the steady cycles.";
@@ -154,7 +158,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
   j["machine"] = v.machine;
   j["duration_s"] = v.duration_s;
   j["output_interval_s"] = v.output_interval_s;
-  j["reference"] = {{"integrator", "rkmerson"},
+  j["reference"] = {{"integrator", v.reference_run.integrator},
                     {"tolerance", v.reference_tolerance},
                     {"wall_s", v.reference_wall_s},
                     {"stability", run_json(v.reference_run)},
@@ -307,6 +311,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
     std::string red = "wall_s_per_simulated_s,error,label\n", front = red, full = red;
     std::vector<const RunRecord*> fr;
     for (const auto& r : v.runs) {
+      if (!r.failure.empty()) continue;  // stopped runs have no error to plot
       const double e = std::max(err(r, Q), 1e-12);
       const std::string line = fmt::format("{:.6g},{:.6g},\"{}\"\n", r.per_simulated_s, e, r.label());
       (r.model == "full" ? full : red) += line;
@@ -456,6 +461,11 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
   for (const auto& sig : v.reference_change.signals) h += "<th>" + sig.name + "</th>";
   h += "</tr>";
   for (const auto& r : v.runs) {
+    if (!r.failure.empty()) {
+      h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>", r.label(),
+                       3 + v.reference_change.signals.size(), r.failure);
+      continue;
+    }
     h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{:.1e}</td>", r.pareto ? "★ " : "", r.label(),
                      secs(r.per_simulated_s), r.steps, r.energy_residual_rel);
     for (const auto& sig : r.errors.signals) h += fmt::format("<td>{:.2e}</td>", sig.max_rel);
