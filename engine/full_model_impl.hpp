@@ -85,6 +85,11 @@ struct FullModel::Impl {
 struct FullWorkspace::Impl {
   const FullModel::Impl& model;
   SimTK::State state;
+  // The last two converged configurations (independent coordinate, all q): the secant
+  // predictor that starts each projection on the branch being followed.
+  double hist_x[2] = {0, 0};
+  SimTK::Vector hist_q[2];
+  int hist_n = 0;
   explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
 };
 

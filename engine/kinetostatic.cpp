@@ -14,8 +14,41 @@ LoadMode mode_of(Loads l) {
   return l == Loads::Off ? kLoadsOff : l == Loads::Conservative ? kLoadsConservative : kLoadsInstant;
 }
 
+// Secant predictor: extrapolate every coordinate along the branch from the last two
+// converged configurations to the new value of the independent coordinate (a revolute one is
+// compared modulo a turn, since continuation relabels the angle by 2π).
+void predict(FullWorkspace::Impl& w, double q_new) {
+  if (w.hist_n < 2) return;
+  const auto& m = w.model;
+  const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  auto wrap = [&](double d) { return revolute ? std::remainder(d, 2 * M_PI) : d; };
+  const double d_last = wrap(w.hist_x[1] - w.hist_x[0]);
+  const double d_new = wrap(q_new - w.hist_x[1]);
+  if (std::abs(d_last) < 1e-9 || std::abs(d_new) < 1e-12 || std::abs(d_new) > 4 * std::abs(d_last) + 0.2) return;
+  const Vector& q1 = w.hist_q[1];
+  const Vector& q0 = w.hist_q[0];
+  if (q1.size() != w.state.getNQ() || q0.size() != q1.size()) return;
+  Vector pred = q1 + (q1 - q0) * (d_new / d_last);
+  w.state.updQ() = pred;
+}
+
+void remember(FullWorkspace::Impl& w, double q) {
+  const bool revolute = w.model.scene.joints[w.model.independent].type == models::JointType::Revolute;
+  const double d = revolute ? std::remainder(q - w.hist_x[1], 2 * M_PI) : q - w.hist_x[1];
+  if (w.hist_n > 0 && std::abs(d) < 1e-9) {  // same point again: refresh it
+    w.hist_q[1] = w.state.getQ();
+    w.hist_x[1] = q;
+    return;
+  }
+  w.hist_q[0] = w.hist_q[1];
+  w.hist_x[0] = w.hist_x[1];
+  w.hist_q[1] = w.state.getQ();
+  w.hist_x[1] = q;
+  w.hist_n = std::min(w.hist_n + 1, 2);
+}
+
 // Applies the prescribed laws (already stored in the state) and projects q and u onto the
-// constraint manifold, starting from the previous configuration.
+// constraint manifold, starting from the predicted configuration.
 void project(const FullModel::Impl& m, State& s, double q_for_message) {
   try {
     m.system.realize(s, Stage::Time);
@@ -81,10 +114,12 @@ void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
   ensure_kinetostatic_mode(m, s);
   s.setTime(0.0);
   m.set_law(s, 0, poly_law(q, 0.0, 0.0));
+  predict(ws.impl(), q);
   try {
     m.system.realize(s, Stage::Time);
     m.system.prescribeQ(s);
     m.system.projectQ(s, 1e-12);
+    remember(ws.impl(), q);
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",

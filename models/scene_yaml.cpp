@@ -421,6 +421,19 @@ std::string resolve_scene_path(const std::string& name_or_path) {
 
 Scene parse_scene(const std::string& text, const std::string& file,
                   const std::vector<Override>& overrides) {
+  // Scenes are a few kilobytes; refuse anything huge before the YAML parser sees it.
+  constexpr size_t kMaxSceneBytes = 1 << 20;
+  if (text.size() > kMaxSceneBytes)
+    throw SceneError(file, 0, "", fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
+  // yaml-cpp recurses once per nesting level: bound the depth so no input can exhaust the stack.
+  {
+    int depth = 0, max_depth = 0;
+    for (char c : text) {
+      if (c == '[' || c == '{') max_depth = std::max(max_depth, ++depth);
+      else if ((c == ']' || c == '}') && depth > 0) --depth;
+    }
+    if (max_depth > 64) throw SceneError(file, 0, "", "nested too deeply for a scene (more than 64 levels of [ or {)");
+  }
   if (text.find('\0') != std::string::npos)
     throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
   YAML::Node root;
