@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "engine/full_model_impl.hpp"
 #include "engine/kinetostatic.hpp"
 
@@ -30,8 +32,17 @@ auto FullKinetostaticSource::at(double q, F&& call) {
       approach(q, jump);
       ++calls_;
       return call();
-    } catch (const EngineError&) {
-      if (jump == kMaxJump / 50) throw;
+    } catch (const EngineError& e) {
+      if (jump == kMaxJump / 50) {
+        const auto& sc = model_.scene();
+        const bool rev = sc.find_joint(sc.independent)->type == models::JointType::Revolute;
+        const double k = rev ? 180.0 / M_PI : 1.0;
+        throw EngineError(fmt::format(
+            "{}: the independent coordinate '{}' cannot move from {:.6g} to {:.6g} {}: a dead point of the mechanism "
+            "lies in between (the loops cannot close beyond it). Reduced tables need an independent coordinate that "
+            "covers the whole range without dead points, such as a crank that turns fully. ({})",
+            sc.source_file, sc.independent, q_start * k, q * k, rev ? "degrees" : "m", e.what()));
+      }
       ws_.impl().state.updQ() = q_backup;  // back to the last good configuration
       q_now_ = q_start;
     }

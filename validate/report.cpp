@@ -175,6 +175,14 @@ nlohmann::json summary_json(const ValidationResult& v) {
   j["speedup_at_matched_error"] = v.speedup_at_matched_error ? nlohmann::json(*v.speedup_at_matched_error) : nullptr;
   if (v.matched_full >= 0) j["matched_full"] = run_json(v.runs[v.matched_full]);
   if (v.matched_reduced >= 0) j["matched_reduced"] = run_json(v.runs[v.matched_reduced]);
+  // The settings to use for this scene, chosen from the measurements: the cheapest reduced
+  // run within the target on the speed and on the headline quantity.
+  const RunRecord* rec = nullptr;
+  for (const auto& r : v.runs)
+    if (r.model == "reduced" && r.failure.empty() && err(r, "qdot") <= v.matched_target &&
+        err(r, v.headline_quantity) <= v.matched_target && (!rec || r.per_simulated_s < rec->per_simulated_s))
+      rec = &r;
+  j["recommended_reduced"] = rec ? run_json(*rec) : nlohmann::json(nullptr);
   j["headline"] = headline(v);
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& r : v.runs) runs.push_back(run_json(r));

@@ -150,3 +150,78 @@ TEST_F(Cli, UnwritableOutputFolder) {
 }
 
 }  // namespace
+
+namespace {
+
+// A crank-rocker four-bar whose independent coordinate is the rocker: the rocker swings
+// between two dead points, so a reduced table over a full turn cannot exist.
+const char* kRockerDriven = R"(name: rocker-driven
+ground_points: {A: [0.0, 0.0], D: [0.30, 0.0]}
+bodies:
+  - {name: crank,   mass_kg: 0.50, com_m: [0.04, 0], inertia_kgm2: 2.667e-4, points: {B: [0.08, 0]}}
+  - {name: coupler, mass_kg: 1.20, com_m: [0.14, 0], inertia_kgm2: 7.84e-3,  points: {C: [0.28, 0]}}
+  - {name: rocker,  mass_kg: 0.90, com_m: [0.10, 0], inertia_kgm2: 3.0e-3,   points: {C: [0.20, 0]}}
+joints:
+  - {name: crank,   type: revolute, parent: ground, parent_point: A, child: crank,   guess_deg: 30}
+  - {name: coupler, type: revolute, parent: crank,  parent_point: B, child: coupler, guess_deg: 4.85}
+  - {name: rocker,  type: revolute, parent: ground, parent_point: D, child: rocker,  guess_deg: 90.27}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+independent: rocker
+initial: {q_deg: 90.27, qdot: 0.0}
+)";
+
+TEST_F(Cli, DeadPointInsideTheRangeIsRefused) {
+  const std::string f = write("rocker.yaml", kRockerDriven);
+  const auto out = dir_ / "t.csv";
+  CliRun r = rdyn("extract " + f + " --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("rocker.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("dead point"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  expect_refused("simulate " + f + " --model reduced", "rocker.yaml");
+}
+
+TEST_F(Cli, ValuesAndTopologyErrorsNameTheField) {
+  const std::string base = kRockerDriven;
+  auto variant = [&](const std::string& from, const std::string& to) {
+    std::string t = base;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  struct Case {
+    std::string name, text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"nan_mass.yaml", variant("mass_kg: 0.90", "mass_kg: .nan"), "mass_kg"},
+      {"neg_mass.yaml", variant("mass_kg: 0.90", "mass_kg: -1"), "mass_kg"},
+      {"zero_inertia.yaml", variant("inertia_kgm2: 3.0e-3", "inertia_kgm2: 0"), "inertia"},
+      {"two_dof.yaml", variant("loops:\n  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}\n", ""),
+       "3 degrees of freedom"},
+      {"missing.yaml", variant("independent: rocker\n", ""), "independent"},
+      {"truncated.yaml", base.substr(0, base.find("joints:") + 40), "truncated.yaml"},
+  };
+  for (const auto& c : cases) {
+    const std::string f = write(c.name, c.text);
+    const CliRun r = rdyn("simulate " + f + " --out " + (dir_ / "o").string());
+    EXPECT_EQ(r.status, 2) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find(c.name), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "o"));
+  }
+}
+
+TEST_F(Cli, EveryCommandRefusesBadInputWithoutOutput) {
+  const std::string bad = write("bad.yaml", "name: x\nbodies: [\n");
+  for (const std::string& cmd : std::vector<std::string>{"extract " + bad + " --out " + (dir_ / "t.csv").string(),
+                                "validate " + bad + " --out " + (dir_ / "v").string(),
+                                "calibrate " + bad + " --write-scene " + (dir_ / "c.yaml").string(),
+                                "sweep " + bad + " --vary a=1:2:2 --out " + (dir_ / "s.csv").string()}) {
+    const CliRun r = rdyn(cmd);
+    EXPECT_EQ(r.status, 2) << cmd << ": " << r.output;
+    EXPECT_NE(r.output.find("bad.yaml"), std::string::npos) << r.output;
+  }
+  for (const char* f : {"t.csv", "v", "c.yaml", "s.csv"}) EXPECT_FALSE(fs::exists(dir_ / f)) << f;
+}
+
+}  // namespace
