@@ -31,17 +31,28 @@ std::vector<int> revolute_path(const models::Scene& s, const std::string& body) 
   return path;
 }
 
+// GSL periodic cubic spline through (q, y) over one period (the first point repeated at
+// q[0] + period, as GSL's periodic splines require).
+struct PeriodicSpline {
+  std::vector<double> x, y;
+  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp{nullptr, gsl_spline_free};
+  PeriodicSpline(const std::vector<double>& q, const std::vector<double>& v, double period) : x(q), y(v) {
+    x.push_back(q[0] + period);
+    y.push_back(v[0]);
+    sp.reset(gsl_spline_alloc(gsl_interp_cspline_periodic, x.size()));
+    gsl_spline_init(sp.get(), x.data(), y.data(), x.size());
+  }
+  double eval(double q) const {  // q wrapped into [x.front(), x.back()]
+    const double P = x.back() - x.front();
+    return gsl_spline_eval(sp.get(), q - P * std::floor((q - x.front()) / P), nullptr);
+  }
+};
+
 // ∫ from q[0] to q[i] of a periodic cubic spline through (q, y), for every grid point.
 std::vector<double> periodic_integral(const std::vector<double>& q, const std::vector<double>& y, double period) {
-  const size_t n = q.size();
-  std::vector<double> x(q), v(y);
-  x.push_back(q[0] + period);
-  v.push_back(y[0]);
-  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(gsl_interp_cspline_periodic, n + 1),
-                                                             gsl_spline_free);
-  gsl_spline_init(sp.get(), x.data(), v.data(), n + 1);
-  std::vector<double> out(n);
-  for (size_t i = 0; i < n; ++i) out[i] = gsl_spline_eval_integ(sp.get(), x[0], x[i], nullptr);
+  const PeriodicSpline sp(q, y, period);
+  std::vector<double> out(q.size());
+  for (size_t i = 0; i < q.size(); ++i) out[i] = gsl_spline_eval_integ(sp.sp.get(), sp.x[0], sp.x[i], nullptr);
   return out;
 }
 
@@ -64,12 +75,9 @@ std::vector<double> ratio_roots(KinetostaticSource& src, int j, const std::vecto
                                 const std::vector<double>& r, double period) {
   std::vector<double> roots;
   const size_t n = q.size();
-  std::vector<double> x(q), y(r);
-  x.push_back(q[0] + period);
-  y.push_back(r[0]);
-  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(gsl_interp_cspline_periodic, n + 1),
-                                                             gsl_spline_free);
-  gsl_spline_init(sp.get(), x.data(), y.data(), n + 1);
+  const PeriodicSpline sp(q, r, period);
+  const auto& x = sp.x;
+  const auto& y = sp.y;
   std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
       gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
   RatioRootContext ctx{&src, j};
@@ -97,7 +105,7 @@ std::vector<double> ratio_roots(KinetostaticSource& src, int j, const std::vecto
     double lo = a, hi = b;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
-      ((gsl_spline_eval(sp.get(), mid, nullptr) > 0) == (ra > 0) ? lo : hi) = mid;
+      ((sp.eval(mid) > 0) == (ra > 0) ? lo : hi) = mid;
     }
     const double est = 0.5 * (lo + hi);
     // Tight bracket on the full model, widened until the sign changes (within the interval).
@@ -241,18 +249,9 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     for (long i = 0; i < n; ++i)
       if (!singular[i]) x.push_back(s.q[i]), y.push_back(col[i]);
     if (x.size() < 4 || x.size() == static_cast<size_t>(n)) return;
-    x.push_back(x[0] + 2 * kPi);
-    y.push_back(y[0]);
-    std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(gsl_interp_cspline_periodic, x.size()),
-                                                               gsl_spline_free);
-    gsl_spline_init(sp.get(), x.data(), y.data(), x.size());
+    const PeriodicSpline sp(x, y, 2 * kPi);
     for (long i = 0; i < n; ++i)
-      if (singular[i]) {
-        double q = s.q[i];
-        while (q < x.front()) q += 2 * kPi;
-        while (q > x.back()) q -= 2 * kPi;
-        col[i] = gsl_spline_eval(sp.get(), q, nullptr);
-      }
+      if (singular[i]) col[i] = sp.eval(s.q[i]);
   };
   if (std::count(singular.begin(), singular.end(), 1) > 0) {
     for (long i = 0; i < n; ++i)

@@ -38,6 +38,19 @@ void fill_stats(RunRecord& r, const models::TimeSeries& ts) {
   r.events = ts.stats.events;
 }
 
+double energy_residual_rel(const models::TimeSeries& ts);
+
+// Timing (median of the repeats), stability metrics and errors against the reference.
+void finish_run(RunRecord& r, const std::vector<double>& walls, const models::TimeSeries& ts,
+                const ValidationResult& v) {
+  r.repeats = static_cast<int>(walls.size());
+  r.wall_s = median(walls);
+  r.per_simulated_s = r.wall_s / v.duration_s;
+  fill_stats(r, ts);
+  r.energy_residual_rel = energy_residual_rel(ts);
+  r.errors = compare_series(v.reference, ts, v.window.t_start);
+}
+
 double energy_residual_rel(const models::TimeSeries& ts) {
   double r = 0, e = 0;
   for (size_t i = 0; i < ts.t.size(); ++i) {
@@ -151,12 +164,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       ts = full_run_with(r.integrator, r.tolerance);
       walls.push_back(seconds_since(t0));
     }
-    r.repeats = full_repeats;
-    r.wall_s = median(walls);
-    r.per_simulated_s = r.wall_s / v.duration_s;
-    fill_stats(r, ts);
-    r.energy_residual_rel = energy_residual_rel(ts);
-    r.errors = compare_series(v.reference, ts, v.window.t_start);
+    finish_run(r, walls, ts, v);
     v.runs.push_back(r);
   }
   progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(full_runs.size()),
@@ -228,12 +236,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
           v.runs.push_back(r);
           return;
         }
-        r.repeats = red_repeats;
-        r.wall_s = median(walls);
-        r.per_simulated_s = r.wall_s / v.duration_s;
-        fill_stats(r, ts);
-        r.energy_residual_rel = energy_residual_rel(ts);
-        r.errors = compare_series(v.reference, ts, v.window.t_start);
+        finish_run(r, walls, ts, v);
         v.runs.push_back(r);
         if (grid == 10 && var.interp == "fourier" && !var.ec && integrator == "rk8pd" && tol == red_tols.back()) {
           v.showcase = ts;
