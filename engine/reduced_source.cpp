@@ -12,7 +12,9 @@ namespace rdyn::engine {
 using namespace SimTK;
 
 namespace {
-constexpr double kMaxJump = 5.0 * 3.14159265358979323846 / 180.0;
+// Continuation moves of at most 10° (with the secant predictor; retried in 2° and 0.2° moves
+// when a projection fails).
+constexpr double kMaxJump = 10.0 * 3.14159265358979323846 / 180.0;
 }
 
 FullKinetostaticSource::FullKinetostaticSource(const FullModel& model)

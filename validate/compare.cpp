@@ -42,16 +42,18 @@ SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, 
     mean.push_back(2 * M_PI / (crossings[k] - t0));
     if (k > 0) start.push_back(t0);
   }
-  const double last = mean.back();
+  // Walk back from the last revolution while consecutive means stay within the tolerance.
   size_t first_steady = mean.size() - 1;
-  while (first_steady > 0 && std::abs(mean[first_steady - 1] - last) <= tol * std::abs(last)) --first_steady;
+  while (first_steady > 0 &&
+         std::abs(mean[first_steady] - mean[first_steady - 1]) <= tol * std::abs(mean[first_steady]))
+    --first_steady;
   first_steady = std::max<size_t>(first_steady, 1);  // always skip the first revolution
   w.t_start = start[first_steady];
   w.revolutions = static_cast<int>(mean.size() - first_steady);
   w.how = fmt::format(
-      "revolution-mean speeds: the transient ends at the first revolution after which every revolution's mean "
-      "speed stays within {:.1g} of the last one's (always skipping the first revolution): t ≥ {:.3f} s, {} "
-      "revolutions compared",
+      "revolution-mean speeds: the start-up transient ends at the first revolution from which consecutive "
+      "revolutions' mean speeds differ by less than {:.1g} (always skipping the first revolution): t ≥ {:.3f} s, "
+      "{} revolutions compared",
       tol, w.t_start, w.revolutions);
   return w;
 }
