@@ -66,60 +66,54 @@ double ratio_at(double q, void* p) {
   return c->src->ratio(q, c->joint);
 }
 
-// Zeros of joint j's velocity ratio over one period, located on the full model: each sign
-// change between grid samples is first located on the periodic cubic spline of the samples,
-// then bracketed tightly around that estimate on the full model and refined with Brent's
-// method (GSL). A pair of zeros inside one grid interval is not seen: refine the grid if a
-// gate switches that quickly.
-std::vector<double> ratio_roots(KinetostaticSource& src, int j, const std::vector<double>& q,
-                                const std::vector<double>& r, double period) {
-  std::vector<double> roots;
-  const size_t n = q.size();
-  const PeriodicSpline sp(q, r, period);
-  const auto& x = sp.x;
-  const auto& y = sp.y;
+// The zero of joint j's velocity ratio inside one grid interval [a, b] (ra, rb of opposite
+// signs), located on the full model: a tight bracket around the estimate, widened until the
+// sign changes, then Brent's method (GSL). Called while the sweep stands at that interval, so
+// every evaluation is a short continuation step.
+double refine_root(KinetostaticSource& src, int j, double a, double ra, double b, double rb, double est) {
+  if (ra == 0.0) return a;
+  if (rb == 0.0) return b;
   std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
       gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
   RatioRootContext ctx{&src, j};
   gsl_function fn{ratio_at, &ctx};
-  auto brent = [&](double a, double b) {
-    gsl_root_fsolver_set(solver.get(), &fn, a, b);
-    double root = 0.5 * (a + b);
+  auto brent = [&](double lo, double hi) {
+    gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
+    double root = 0.5 * (lo + hi);
     for (int it = 0; it < 100; ++it) {
       if (gsl_root_fsolver_iterate(solver.get()) != GSL_SUCCESS) break;
       root = gsl_root_fsolver_root(solver.get());
       if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()),
-                                 1e-14, 0.0) == GSL_SUCCESS)
+                                 1e-13, 0.0) == GSL_SUCCESS)
         break;
     }
     return root;
   };
-  for (size_t i = 0; i < n; ++i) {
-    const double a = x[i], b = x[i + 1], ra = y[i], rb = y[i + 1];
-    if (ra == 0.0) {
-      roots.push_back(a);
-      continue;
-    }
-    if ((ra > 0) == (rb > 0) || rb == 0.0) continue;
-    // Estimate on the spline (bisection: no full-model calls).
-    double lo = a, hi = b;
-    for (int it = 0; it < 60; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      ((sp.eval(mid) > 0) == (ra > 0) ? lo : hi) = mid;
-    }
-    const double est = 0.5 * (lo + hi);
-    // Tight bracket on the full model, widened until the sign changes (within the interval).
-    double w = 1e-3 * (b - a), root = NAN;
-    for (int k = 0; k < 12 && std::isnan(root); ++k, w *= 4) {
-      const double l = std::max(a, est - w), h = std::min(b, est + w);
-      const double fl = l == a ? ra : src.ratio(l, j), fh = h == b ? rb : src.ratio(h, j);
-      if (fl == 0.0) root = l;
-      else if (fh == 0.0) root = h;
-      else if ((fl > 0) != (fh > 0)) root = brent(l, h);
-    }
-    roots.push_back(std::isnan(root) ? brent(a, b) : root);
+  est = std::min(b, std::max(a, est));
+  for (double w = 1e-3 * (b - a); w < (b - a); w *= 6) {
+    const double l = std::max(a, est - w), h = std::min(b, est + w);
+    const double fl = l == a ? ra : src.ratio(l, j), fh = h == b ? rb : src.ratio(h, j);
+    if (fl == 0.0) return l;
+    if (fh == 0.0) return h;
+    if ((fl > 0) != (fh > 0)) return brent(l, h);
   }
-  return roots;
+  return brent(a, b);
+}
+
+// Zero of the quadratic through three samples (x0 < x1 < x2) inside [x1, x2], else the chord.
+double quadratic_zero(double x0, double y0, double x1, double y1, double x2, double y2) {
+  const double chord = x1 - y1 * (x2 - x1) / (y2 - y1);
+  const double d01 = (y1 - y0) / (x1 - x0), d12 = (y2 - y1) / (x2 - x1), c = (d12 - d01) / (x2 - x0);
+  const double b = d12 + c * (x2 - x1);  // slope at x2 of p(x) = y2 + b (x − x2) + c (x − x2)²
+  if (std::abs(c) < 1e-300) return chord;
+  const double disc = b * b - 4 * c * y2;
+  if (disc < 0) return chord;
+  for (double sgn : {1.0, -1.0}) {
+    const double dx = (-b + sgn * std::sqrt(disc)) / (2 * c);
+    const double x = x2 + dx;
+    if (x >= x1 && x <= x2) return x;
+  }
+  return chord;
 }
 
 }  // namespace
@@ -143,6 +137,7 @@ std::string method_name(Method m) {
 }
 
 Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, const ExtractOptions& opt) {
+  gsl_set_error_handler_off();  // GSL reports through return codes, never abort()
   const auto& ind = *scene.find_joint(scene.independent);
   if (ind.type != models::JointType::Revolute)
     throw TableError("reduced tables over a range of a prismatic coordinate are not supported yet; "
@@ -210,6 +205,25 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   const bool conservative_loads = scene.gravity.enabled || !scene.springs.empty();
   const bool inertial_here = opt.method == Method::Kinetostatic || opt.method == Method::Integrated;
   std::vector<char> singular(n, 0);
+  // Joints gating loads: their ratio's zeros are the switch angles (refined during the sweep).
+  std::vector<int> gate_joints;
+  for (const auto& t : scene.joint_torques)
+    if (t.active_when) {
+      const int j = scene.joint_index(t.active_when->joint);
+      if (std::find(gate_joints.begin(), gate_joints.end(), j) == gate_joints.end()) gate_joints.push_back(j);
+    }
+  std::vector<std::vector<double>> gate_roots(gate_joints.size());
+  auto bracket = [&](size_t g, long i0, long i1, double x1_offset) {
+    // Sign change of gate joint g between samples i0 and i1 (i1 may wrap to 0 + 2π).
+    const int j = gate_joints[g];
+    const double a = s.q[i0], b = s.q[i1] + x1_offset, ra = r[j][i0], rb = r[j][i1];
+    if (ra == 0.0 || ((ra > 0) != (rb > 0) && rb != 0.0)) {
+      const long im = (i0 + n - 1) % n;
+      const double xm = s.q[im] - (im > i0 ? 2 * kPi : 0.0);
+      const double est = quadratic_zero(xm, r[j][im], a, ra, b, rb);
+      gate_roots[g].push_back(refine_root(src, j, a, ra, b, rb, est));
+    }
+  };
   for (long i = 0; i < n; ++i) {
     GridSample g;
     if (inertial_here) {
@@ -232,7 +246,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
     }
     singular[i] = g.singular;
+    if (i >= 1)
+      for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, i - 1, i, 0.0);
   }
+  for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, n - 1, 0, 2 * kPi);  // the wrap-around interval
   if (opt.method == Method::Integrated) {
     // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).
     std::vector<double> two_m2(n);
@@ -276,14 +293,11 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   for (int j = 0; j < nj; ++j) s.add("r_" + scene.joints[j].name, r[j]);
   for (int k = 0; k < nk; ++k)
     for (int j = 0; j < nj; ++j) s.add("rx_" + forces[k].name + "_" + scene.joints[j].name, rx[k][j]);
-  // Switch angles of rate-gated loads: exact zeros of the gating joint's ratio.
-  gsl_set_error_handler_off();
-  for (const auto& t : scene.joint_torques) {
-    if (!t.active_when) continue;
-    const std::string col = "r_" + t.active_when->joint;
-    if (s.roots_of(col)) continue;
-    const int j = scene.joint_index(t.active_when->joint);
-    s.roots.emplace_back(col, ratio_roots(src, j, s.q, r[j], 2 * kPi));
+  // Switch angles of rate-gated loads: the zeros located during the sweep.
+  for (size_t gj = 0; gj < gate_joints.size(); ++gj) {
+    auto roots = gate_roots[gj];
+    std::sort(roots.begin(), roots.end());
+    s.roots.emplace_back("r_" + scene.joints[gate_joints[gj]].name, roots);
   }
   // Body angular rates for the bodies that carry a resistance.
   for (const auto& res : scene.resistances) {
