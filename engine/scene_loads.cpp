@@ -14,15 +14,6 @@ namespace {
 
 Vec3 v3(models::Vec2 p) { return Vec3(p.x, p.y, 0); }
 
-double resistance_torque(const models::Resistance& r, double omega) {
-  switch (r.law) {
-    case models::ResistanceLaw::Constant: return omega > 0 ? -r.coefficient : omega < 0 ? r.coefficient : 0.0;
-    case models::ResistanceLaw::Viscous: return -r.coefficient * omega;
-    case models::ResistanceLaw::Quadratic: return -r.coefficient * omega * std::abs(omega);
-  }
-  return 0.0;
-}
-
 int load_mode(const FullModel::Impl& m, const State& s) {
   return Value<int>::downcast(m.forces.getDiscreteVariable(s, m.load_mode_index));
 }
@@ -95,7 +86,7 @@ class SceneLoads : public Force::Custom::Implementation {
     }
     for (const auto& r : sc.resistances) {
       const int b = sc.body_index(r.body);
-      const double T = resistance_torque(r, m_.body_rate(s, b));
+      const double T = models::resistance_torque(r.law, r.coefficient, m_.body_rate(s, b));
       if (const auto& f = m_.body_fold[b]) {
         add_joint_force(m_, s, f->driven_joint, T, mobility);
       } else {
@@ -174,7 +165,7 @@ double non_conservative_power(const FullModel::Impl& m, const State& s) {
   }
   for (const auto& r : sc.resistances) {
     const double w = m.body_rate(s, sc.body_index(r.body));
-    P += resistance_torque(r, w) * w;
+    P += models::resistance_torque(r.law, r.coefficient, w) * w;
   }
   return P;
 }

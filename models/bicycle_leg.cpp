@@ -208,11 +208,8 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
   const double omega = p.gear_ratio * 2.0 * kPi * p.resistance_cadence_Hz;  // flywheel [rad/s]
   if (p.resistance_power_W > 0.0) {
     if (!(omega > 0.0)) fail("resistance.cadence_Hz", "must be positive");
-    const int power = p.resistance_law == ResistanceLaw::Constant   ? 1
-                      : p.resistance_law == ResistanceLaw::Viscous ? 2
-                                                                   : 3;
     s.resistances.push_back({"flywheel_resistance", "flywheel", p.resistance_law,
-                             p.resistance_power_W / std::pow(omega, power)});
+                             p.resistance_power_W / std::pow(omega, dissipation_exponent(p.resistance_law))});
   }
   s.independent = "crank";
 }

@@ -174,6 +174,19 @@ void check_scene(const Scene& s) {
   if (!finite(s.gravity.g_m_s2.x) || !finite(s.gravity.g_m_s2.y)) fail("gravity.g_m_s2", "not finite");
 }
 
+double resistance_torque(ResistanceLaw law, double c, double w) {
+  switch (law) {
+    case ResistanceLaw::Constant: return w > 0 ? -c : w < 0 ? c : 0.0;
+    case ResistanceLaw::Viscous: return -c * w;
+    case ResistanceLaw::Quadratic: return -c * w * std::abs(w);
+  }
+  return 0.0;
+}
+
+int dissipation_exponent(ResistanceLaw law) {
+  return law == ResistanceLaw::Constant ? 1 : law == ResistanceLaw::Viscous ? 2 : 3;
+}
+
 std::optional<double> fixed_speed_ratio(const Scene& s, const std::string& body) {
   for (const auto& j : s.joints) {
     if (j.child != body || j.parent != kGround || j.type != JointType::Revolute) continue;

@@ -204,6 +204,11 @@ struct Scene {
 // Throws SceneError naming the scene file and the offending field.
 void check_scene(const Scene& scene);
 
+// Resistance torque at angular rate ω [rad/s]: −c0·sgn ω, −c1·ω or −c2·ω|ω| [N·m].
+double resistance_torque(ResistanceLaw law, double coefficient, double omega);
+// Exponent n of the dissipated power P = c·ωⁿ (1 constant, 2 viscous, 3 quadratic).
+int dissipation_exponent(ResistanceLaw law);
+
 // Rate of `body` per unit rate of the independent coordinate, when that ratio is a
 // constant of the topology: the body is the independent joint's child (ratio 1) or the
 // child of a joint geared to it (ratio r). Empty otherwise.

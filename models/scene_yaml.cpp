@@ -487,8 +487,7 @@ Scene parse_scene(const std::string& text, const std::string& file,
                          "'dissipates' needs a body turning at a fixed ratio to the independent "
                          "coordinate (its child, or geared to it); give a coefficient instead");
       const double omega = std::abs(*ratio) * 2.0 * kPi * p.cadence_Hz;
-      const int power = r.law == ResistanceLaw::Constant ? 1 : r.law == ResistanceLaw::Viscous ? 2 : 3;
-      r.coefficient = p.power_W / std::pow(omega, power);  // P = c·ω^power
+      r.coefficient = p.power_W / std::pow(omega, dissipation_exponent(r.law));  // P = c·ωⁿ
     }
     if (top.has("gravity")) {
       Fields f(top.raw("gravity"), "gravity", file, {"enabled", "g_m_s2"});

@@ -7,19 +7,6 @@
 
 namespace rdyn::reduced {
 
-namespace {
-
-double resistance_torque(models::ResistanceLaw law, double c, double w) {
-  switch (law) {
-    case models::ResistanceLaw::Constant: return w > 0 ? -c : w < 0 ? c : 0.0;
-    case models::ResistanceLaw::Viscous: return -c * w;
-    case models::ResistanceLaw::Quadratic: return -c * w * std::abs(w);
-  }
-  return 0.0;
-}
-
-}  // namespace
-
 ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
                                 bool energy_consistent_m2) {
   ReducedModel m;
@@ -120,7 +107,7 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
     ++r;
   }
   for (const auto& b : m.brakes) {
-    F_nc += resistance_torque(b.law, b.coefficient, *r * qdot) * *r;
+    F_nc += models::resistance_torque(b.law, b.coefficient, *r * qdot) * *r;
     ++r;
   }
   // Eksergian: m1 q̈ + m2 q̇² = Q_cons + F_nc
@@ -184,7 +171,7 @@ void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, d
     for (const auto& mo : m.motors)
       Qx += mo.stall * (1.0 - T.eval(mo.c_r, q) * qdot / mo.no_load_speed) * T.eval(mo.c_rx[k], q);
     for (const auto& b : m.brakes)
-      Qx += resistance_torque(b.law, b.coefficient, T.eval(b.c_w, q) * qdot) * T.eval(b.c_wx[k], q);
+      Qx += models::resistance_torque(b.law, b.coefficient, T.eval(b.c_w, q) * qdot) * T.eval(b.c_wx[k], q);
     // me1 q̈ + me2 q̇² = F_E + Q_x
     forces[k] = T.eval(m.c_me1[k], q) * qddot + T.eval(m.c_me2[k], q) * qdot * qdot - Qx;
   }
@@ -223,7 +210,7 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
       c += 2;
     }
     for (const auto& b : m.brakes) {
-      Qx += resistance_torque(b.law, b.coefficient, c[0] * qdot) * c[1];
+      Qx += models::resistance_torque(b.law, b.coefficient, c[0] * qdot) * c[1];
       c += 2;
     }
     forces[k] = me1 * qddot + me2 * qdot * qdot - Qx;  // me1 q̈ + me2 q̇² = F_E + Q_x

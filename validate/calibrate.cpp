@@ -17,10 +17,6 @@ namespace rdyn::validate {
 
 namespace {
 
-int law_power(models::ResistanceLaw law) {
-  return law == models::ResistanceLaw::Constant ? 1 : law == models::ResistanceLaw::Viscous ? 2 : 3;
-}
-
 // The scene with its one resistance dissipating P at cadence F and every drive torque set
 // to ±T (signs kept).
 models::Scene with_loads(models::Scene s, double T, double coefficient) {
@@ -90,7 +86,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   if (!ratio) fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
   CalibrationResult r;
   const double omega_b = std::abs(*ratio) * 2 * M_PI * opt.cadence_hz;
-  r.resistance_coefficient = opt.power_w / std::pow(omega_b, law_power(res.law));  // P = c·ω^n
+  r.resistance_coefficient = opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
 
   // The table does not depend on load values: extract once.
   progress.note("calibrate: extracting the reduced table");
@@ -111,11 +107,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     }
     const auto& b = m.brakes[0];
     const double w = m.table.eval(b.c_w, q);
-    const double ww = w * qd;
-    const double Tb = b.law == models::ResistanceLaw::Constant ? -b.coefficient * (ww > 0 ? 1 : -1)
-                      : b.law == models::ResistanceLaw::Viscous ? -b.coefficient * ww
-                                                                 : -b.coefficient * ww * std::abs(ww);
-    E_diss += -Tb * w * dq;
+    E_diss += -models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
   }
   if (!(W_unit > 0)) fail("loads", "the drive torques do no net work per revolution at this cadence");
   r.drive_work_per_rev_per_Nm = W_unit;
