@@ -33,6 +33,14 @@ class SceneError : public std::runtime_error {
   std::string field_;
 };
 
+// A computation that failed on valid input (an integrator that cannot meet its tolerance or
+// its step/wall-time budget, an energy balance that does not close, a non-finite table, a
+// calibration that misses its target). The CLI maps it to exit status 1 and writes nothing.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 inline constexpr const char* kGround = "ground";
 
 struct Body {

@@ -146,6 +146,9 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;
+  } catch (const rdyn::models::NumericalError& e) {
+    std::fprintf(stderr, "rdyn: numerical failure: %s\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rdyn: internal error: %s\n", e.what());
     return 1;
