@@ -17,6 +17,14 @@ namespace rdyn::validate {
 
 namespace {
 
+// Acceptance of a calibration (relative cadence error). Reduced: the steady cycle is solved
+// to 1e-12 and the torque to 1e-10 N·m, so 1e-6 is met with a wide margin by any genuine
+// root. Full: the reduced table's own error (≈ 1e-5 of the speed at 10°, docs/theory.md) and
+// the 5 s window's quasi-steady drift keep the full model within 1e-4; 1 % is the user-level
+// target (issue #13: "holds 1 Hz within 1 %").
+constexpr double kReducedCadenceTolerance = 1e-6;
+constexpr double kFullCadenceTolerance = 1e-2;
+
 // The scene with its one resistance dissipating P at cadence F and every drive torque set
 // to ±T (signs kept).
 models::Scene with_loads(models::Scene s, double T, double coefficient) {
@@ -141,11 +149,23 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   r.torque_Nm = T;
   for (auto& t : m.torques) t.value = (t.value < 0 ? -1.0 : 1.0) * T;
   const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals);
+  if (!cy.ok)
+    throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the torque found "
+                                             "({:.6g} N·m)", T));
   r.evaluations = evals;
   r.steady_q = scene.initial.q;
   r.steady_qdot = cy.speed;
   r.mean_cadence_hz_reduced = 1.0 / cy.period;
   r.mean_power_w = T * W_unit / cy.period;
+  // The result must meet its own target (issue #9): the root finder converges to 1e-10 N·m,
+  // so the reduced cadence is off by far less than kReducedCadenceTolerance unless the
+  // bracket held a discontinuity (a stall) instead of a root.
+  const double miss_reduced = std::abs(r.mean_cadence_hz_reduced - opt.cadence_hz) / opt.cadence_hz;
+  if (!(miss_reduced <= kReducedCadenceTolerance))
+    throw models::NumericalError(fmt::format(
+        "calibration missed its target: the reduced model's steady cadence is {:.6g} Hz at {:.6g} N·m, target {:g} Hz "
+        "(off by {:.3g} %, allowed {:g} %)",
+        r.mean_cadence_hz_reduced, T, opt.cadence_hz, 100 * miss_reduced, 100 * kReducedCadenceTolerance));
 
   // The steady cycle sampled finely: fluctuation and peak force.
   reduced::ReducedOptions ro;
@@ -189,6 +209,12 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     r.peak_force_full_N = 0.0;
     for (size_t i = i1; i < ts.t.size(); ++i) r.peak_force_full_N = std::max(r.peak_force_full_N, std::abs(ts.forces[0][i]));
   }
+  const double miss_full = std::abs(r.mean_cadence_hz_full - opt.cadence_hz) / opt.cadence_hz;
+  if (!(miss_full <= kFullCadenceTolerance))
+    throw models::NumericalError(fmt::format(
+        "calibration not confirmed: the full model at {:.6g} N·m holds a mean cadence of {:.6g} Hz, target {:g} Hz "
+        "(off by {:.3g} %, allowed {:g} %)",
+        T, r.mean_cadence_hz_full, opt.cadence_hz, 100 * miss_full, 100 * kFullCadenceTolerance));
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

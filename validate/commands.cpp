@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <cctype>
+#include <map>
+#include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -15,6 +17,7 @@
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/escape.hpp"
 #include "validate/harness.hpp"
 #include "validate/report.hpp"
 #include "validate/sweep.hpp"
@@ -36,34 +39,56 @@ models::Scene load(const std::string& scene, const std::vector<std::string>& set
   return models::load_scene(scene, overrides_of(sets));
 }
 
-// Writes text to path through a temporary file and a rename (no half-written output).
-void write_file_atomically(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path target = fs::absolute(path);
-  std::error_code ec;
-  if (!fs::is_directory(target.parent_path(), ec))
-    throw OutputError(path + ": cannot write: folder '" + target.parent_path().string() + "' does not exist");
-  const std::string tmp = target.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f << text;
-    if (!f) {
-      fs::remove(tmp, ec);
-      throw OutputError(path + ": cannot write");
-    }
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw OutputError(path + ": cannot write: " + ec.message());
-  }
+// Ranges of the command-line numbers (README, "Limits"). Every number is checked before any
+// work starts, so nothing hangs or exhausts memory.
+constexpr double kMaxDuration_s = 1e5;
+constexpr double kMinOutputInterval_s = 1e-6;
+constexpr double kMaxOutputRows = 1e7;       // ~1.5 GB of CSV at most
+constexpr double kMinTolerance = 1e-14, kMaxTolerance = 1e-1;
+constexpr double kMinFixedStep_s = 1e-7, kMaxFixedStep_s = 1.0;
+constexpr double kMaxFixedSteps = 1e8;       // ~20 s of RK4 steps
+constexpr double kMinGrid_deg = 0.01, kMaxGrid_deg = 90.0;  // 36000 grid points at most
+constexpr int kMaxThreads = 256;
+constexpr double kMaxCadence_Hz = 1000.0, kMaxPower_W = 1e7;
+
+void require_in(const std::string& option, double v, double lo, double hi, const char* unit) {
+  if (!(std::isfinite(v) && v >= lo && v <= hi))
+    throw ArgumentError(fmt::format("{}: must be a finite number in [{:g}, {:g}]{} (got {})", option, lo, hi, unit, v));
 }
 
-void write_json(const std::string& path, const nlohmann::json& j) {
-  std::ofstream f(path);
-  f << j.dump(2) << "\n";
-  if (!f) throw OutputError(path + ": cannot write");
+void require_positive_up_to(const std::string& option, double v, double hi, const char* unit) {
+  if (!(std::isfinite(v) && v > 0 && v <= hi))
+    throw ArgumentError(fmt::format("{}: must be a finite number in (0, {:g}]{} (got {})", option, hi, unit, v));
 }
+
+void require_grid(const std::string& option, double g) {
+  require_in(option, g, kMinGrid_deg, kMaxGrid_deg, " deg");
+  const double n = 360.0 / g;
+  if (std::abs(n - std::round(n)) > 1e-9 * n)
+    throw ArgumentError(fmt::format("{}: {:g}° does not divide 360° into whole steps", option, g));
+}
+
+// Duration, output interval and the number of rows they make.
+void require_timing(double duration, double dt_out) {
+  require_positive_up_to("--duration", duration, kMaxDuration_s, " s");
+  require_in("--dt-out", dt_out, kMinOutputInterval_s, duration, " s (and at most --duration)");
+  if (duration / dt_out > kMaxOutputRows)
+    throw ArgumentError(fmt::format("--dt-out: {:g} s over {:g} s makes {:.3g} rows; at most {:g}", dt_out, duration,
+                                    duration / dt_out, kMaxOutputRows));
+}
+
+// Recognisers of rdyn's own single-file outputs, so a re-run may replace them.
+bool is_rdyn_table(const std::string& head) { return head.rfind("# rdyn-table", 0) == 0; }
+bool is_rdyn_calibrated_scene(const std::string& head) { return head.rfind("# Calibrated by `rdyn calibrate`", 0) == 0; }
+bool is_rdyn_sweep(const std::string& head) {
+  // Shard 0 starts with the header; other shards with a case row "<index>,...,ok|error,".
+  if (head.rfind("case,", 0) == 0) return true;
+  const std::string first = head.substr(0, head.find('\n'));
+  return !first.empty() && std::isdigit(static_cast<unsigned char>(first[0])) &&
+         (first.find(",ok,") != std::string::npos || first.find(",error,") != std::string::npos);
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
 
 }  // namespace
 
@@ -72,9 +97,20 @@ int run_simulate(const SimulateArgs& a) {
   const double duration = std::isnan(a.duration) ? scene.simulation.duration_s : a.duration;
   const double dt_out = std::isnan(a.dt_out) ? scene.simulation.output_interval_s : a.dt_out;
   const double tolerance = std::isnan(a.tolerance) ? scene.simulation.tolerance : a.tolerance;
-  if (!(duration > 0) || !(dt_out > 0) || !(tolerance > 0 && tolerance < 1))
-    throw models::SceneError(a.scene, 0, "--duration/--dt-out/--tolerance", "must be positive (tolerance < 1)");
-  OutputDir out(a.out);  // fails early on an unwritable folder
+  require_timing(duration, dt_out);
+  if (a.model == "full") {
+    require_in("--tolerance", tolerance, kMinTolerance, kMaxTolerance, "");
+  } else {
+    require_in("--reduced-tolerance", a.reduced_tolerance, kMinTolerance, kMaxTolerance, "");
+    if (a.table.empty()) require_grid("--grid-deg", a.grid_deg);
+    if (a.reduced_integrator == "rk4-fixed") {
+      require_in("--fixed-step", a.fixed_step, kMinFixedStep_s, kMaxFixedStep_s, " s");
+      if (duration / a.fixed_step > kMaxFixedSteps)
+        throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}",
+                                        a.fixed_step, duration, duration / a.fixed_step, kMaxFixedSteps));
+    }
+  }
+  OutputDir out(a.out, a.force);  // fails early on an unusable folder
 
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
                         {"duration_s", duration},  {"output_interval_s", dt_out}};
@@ -134,27 +170,13 @@ int run_simulate(const SimulateArgs& a) {
 }
 
 int run_extract(const ExtractArgs& a) {
+  require_grid("--grid-deg", a.grid_deg);
   const models::Scene scene = load(a.scene, a.sets);
   const auto method = reduced::parse_method(a.method);
-  // Write beside the target and rename, so a failure leaves no half-written table.
-  namespace fs = std::filesystem;
-  const fs::path target = fs::absolute(a.out);
-  std::error_code ec;
-  if (!fs::is_directory(target.parent_path(), ec))
-    throw OutputError(a.out + ": cannot write: folder '" + target.parent_path().string() + "' does not exist");
+  OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
   const auto e = extract_from_full(scene, a.grid_deg, method);
-  const std::string tmp = target.string() + ".tmp";
-  try {
-    reduced::write_samples_csv(tmp, e.samples);
-  } catch (const reduced::TableError& err) {
-    fs::remove(tmp, ec);
-    throw OutputError(err.what());
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw OutputError(a.out + ": cannot write: " + ec.message());
-  }
+  reduced::write_samples_csv(out.write_path(), e.samples);
+  out.commit();
   std::fprintf(stderr, "%s\n",
                fmt::format("rdyn: extracted {} ({}, {}° grid, {} points) in {:.3g} ms with {} kinetostatic calls; "
                            "wrote {}",
@@ -165,13 +187,12 @@ int run_extract(const ExtractArgs& a) {
 
 int run_calibrate(const CalibrateArgs& a) {
   const auto base = overrides_of(a.sets);
+  require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
+  require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
+  require_grid("--grid-deg", a.grid_deg);
   const models::Scene scene = models::load_scene(a.scene, base);
-  if (!a.write_scene.empty()) {  // fail early on an unwritable destination
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (!fs::is_directory(fs::absolute(a.write_scene).parent_path(), ec))
-      throw OutputError(a.write_scene + ": cannot write: its folder does not exist");
-  }
+  std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
+  if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
   CalibrationOptions opt;
   opt.cadence_hz = a.cadence_hz;
   opt.power_w = a.power_w;
@@ -200,8 +221,9 @@ int run_calibrate(const CalibrateArgs& a) {
       {"steady_cycles_computed", r.evaluations},
       {"wall_time_s", r.wall_time_s},
   };
-  if (!a.write_scene.empty()) {
-    write_file_atomically(a.write_scene, calibrated_scene_yaml(a.scene, base, scene, opt, r));
+  if (out) {
+    write_text_file(out->write_path(), calibrated_scene_yaml(a.scene, base, scene, opt, r));
+    out->commit();
     j["written_scene"] = a.write_scene;
   }
   std::printf("%s\n", j.dump(2).c_str());
@@ -243,89 +265,138 @@ int run_sweep_command(const SweepArgs& a) {
   o.power_w = a.power_w;
   o.threads = a.threads;
   o.grid_deg = a.grid_deg;
-  if (std::sscanf(a.shard.c_str(), "%d/%d", &o.shard, &o.shards) != 2)
-    throw models::SceneError("", 0, "--shard", "expected i/N, got '" + a.shard + "'");
-  if (a.vary.empty()) throw models::SceneError("", 0, "--vary", "give at least one key=a:b:n");
-  for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
-  {  // fail early on an unwritable destination
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (!fs::is_directory(fs::absolute(a.out).parent_path(), ec))
-      throw OutputError(a.out + ": cannot write: its folder does not exist");
+  require_grid("--grid-deg", a.grid_deg);
+  if (a.threads != 0) require_in("--threads", a.threads, 1, kMaxThreads, "");
+  if (a.cadence_hz != 0) require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
+  if (a.power_w != 0) require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
+  {
+    int used = 0;
+    if (std::sscanf(a.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 ||
+        used != static_cast<int>(a.shard.size()) || o.shards < 1 || o.shards > 1000000 || o.shard < 0 ||
+        o.shard >= o.shards)
+      throw ArgumentError("--shard: expected i/N with whole numbers 0 ≤ i < N ≤ 1000000, got '" + a.shard + "'");
   }
-  const std::string csv = run_sweep(o, Progress().enabled());
-  write_file_atomically(a.out, csv);
-  std::fprintf(stderr, "rdyn: sweep shard %s wrote %s\n", a.shard.c_str(), a.out.c_str());
+  if (a.vary.empty()) throw ArgumentError("--vary: give at least one key=a:b:n");
+  for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
+  OutputFile out(a.out, a.force, is_rdyn_sweep);  // fails early on an unusable destination
+  const SweepResult r = run_sweep(o, Progress().enabled());
+  write_text_file(out.write_path(), r.csv);
+  out.commit();
+  if (r.failed > 0) {
+    std::fprintf(stderr, "rdyn: sweep shard %s: %ld of %ld cases failed (rows with status 'error' in %s)\n",
+                 a.shard.c_str(), r.failed, r.cases, a.out.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "rdyn: sweep shard %s: %ld cases; wrote %s\n", a.shard.c_str(), r.cases, a.out.c_str());
   return 0;
 }
 
-int run_validate(const ValidateArgs& a) {
+namespace {
+
+// A suite scene's file stem names its report folder: it must be a plain name (no '/', no
+// leading dot, no characters that need quoting in HTML or a shell) and unique in the suite.
+constexpr size_t kMaxSuiteScenes = 1000;
+
+bool plain_name(const std::string& s) {
+  if (s.empty() || s.size() > 64) return false;
+  if (!(std::isalnum(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return true;
+}
+
+std::vector<std::string> suite_files(const std::string& suite) {
   namespace fs = std::filesystem;
-  Progress progress;
-  ValidationOptions opt;
-  if (!a.suite.empty() && !a.scene.empty()) throw models::SceneError(a.scene, 0, "", "give a scene or --suite, not both");
-  if (a.suite.empty() && a.scene.empty()) throw models::SceneError("", 0, "", "give a scene or --suite FOLDER");
-  if (a.scene.empty()) {
-    std::error_code ec;
-    if (!fs::is_directory(a.suite, ec)) throw models::SceneError(a.suite, 0, "", "not a folder of scenes");
-    std::vector<std::string> files;
-    for (const auto& e : fs::directory_iterator(a.suite))
-      if (e.path().extension() == ".yaml" || e.path().extension() == ".yml") files.push_back(e.path().string());
-    std::sort(files.begin(), files.end());
-    if (files.empty()) throw models::SceneError(a.suite, 0, "", "the folder has no .yaml scenes");
-    OutputDir out(a.out);
-    opt.quick = !a.thorough;
-    nlohmann::json scenes = nlohmann::json::array();
-    bool all_pass = true;
-    std::string rows;
-    for (size_t i = 0; i < files.size(); ++i) {
-      const std::string stem = fs::path(files[i]).stem().string();
-      progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
-      nlohmann::json entry;
-      try {
-        const auto scene = models::load_scene(files[i], overrides_of(a.sets));
-        fs::create_directory(out.file(stem));
-        bool pass = false;
-        entry = validate_one(scene, opt, out.file(stem), progress, pass);
-        all_pass &= pass;
-      } catch (const std::exception& e) {  // a failing scene does not stop the others
-        entry = {{"name", stem}, {"file", files[i]}, {"status", "error"}, {"error", e.what()}};
-        all_pass = false;
-      }
-      entry["report"] = stem + "/report.html";
-      const std::string status = entry["status"];
-      rows += fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td></tr>",
-                          stem, status, entry.contains("error") ? std::string(entry["error"]) : std::string(entry.value("note", "")));
-      scenes.push_back(entry);
-    }
-    nlohmann::json summary = {{"suite", a.suite}, {"status", all_pass ? "pass" : "fail"}, {"scenes", scenes}};
-    {
-      std::ofstream f(out.file("summary.json"));
-      f << summary.dump(2) << "\n";
-    }
-    {
-      std::ofstream f(out.file("index.html"));
-      f << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:sans-serif;"
-           "max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{border-collapse:collapse}"
-           ".pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn validation suite: "
-        << a.suite << "</h1><table><tr><th>scene</th><th>status</th><th>what it tests / error</th></tr>" << rows
-        << "</table></body></html>\n";
-    }
-    out.commit();
-    std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(), all_pass ? "all scenes pass" : "FAILURES",
-                 a.out.c_str());
-    return all_pass ? 0 : 1;
+  std::error_code ec;
+  if (!fs::is_directory(suite, ec)) throw models::SceneError(suite, 0, "--suite", "not a folder of scenes");
+  std::vector<std::string> files;
+  for (auto it = fs::directory_iterator(suite, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const auto ext = it->path().extension();
+    if ((ext == ".yaml" || ext == ".yml") && it->is_regular_file(ec)) files.push_back(it->path().string());
+    if (files.size() > kMaxSuiteScenes)
+      throw models::SceneError(suite, 0, "--suite", fmt::format("more than {} scenes", kMaxSuiteScenes));
   }
+  if (ec) throw models::SceneError(suite, 0, "--suite", "cannot list the folder: " + ec.message());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw models::SceneError(suite, 0, "--suite", "the folder has no .yaml scenes");
+  std::map<std::string, std::string> seen;
+  for (const auto& f : files) {
+    const std::string stem = fs::path(f).stem().string();
+    if (!plain_name(stem))
+      throw models::SceneError(f, 0, "--suite",
+                               "the file name must be a plain name (letters, digits, '_', '-', '.'; not starting with "
+                               "'.' or '-'; at most 64 characters): it names the scene's report folder");
+    if (seen.count(stem))
+      throw models::SceneError(f, 0, "--suite", "has the same name as " + seen[stem] + " (both would write " + stem + "/)");
+    seen[stem] = f;
+  }
+  return files;
+}
+
+int run_suite(const ValidateArgs& a, Progress& progress) {
+  namespace fs = std::filesystem;
+  const auto files = suite_files(a.suite);
+  OutputDir out(a.out, a.force);
+  ValidationOptions opt;
+  opt.quick = !a.thorough;
+  nlohmann::json scenes = nlohmann::json::array();
+  bool all_pass = true;
+  std::string rows;
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string stem = fs::path(files[i]).stem().string();
+    progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
+    nlohmann::json entry;
+    try {
+      const auto scene = models::load_scene(files[i], overrides_of(a.sets));
+      out.make_subfolder(stem);
+      bool pass = false;
+      entry = validate_one(scene, opt, out.file(stem), progress, pass);
+      all_pass &= pass;
+    } catch (const OutputError&) {
+      throw;  // the output itself failed: nothing is written
+    } catch (const std::exception& e) {  // a failing scene does not stop the others
+      entry = {{"name", stem}, {"file", files[i]}, {"status", "error"}, {"error", e.what()}};
+      all_pass = false;
+    }
+    entry["report"] = stem + "/report.html";
+    const std::string status = entry["status"];
+    const std::string what = entry.contains("error") ? std::string(entry["error"]) : std::string(entry.value("note", ""));
+    rows += fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td></tr>",
+                        html_escape(stem), html_escape(status), html_escape(what));
+    scenes.push_back(entry);
+  }
+  write_json(out.file("summary.json"),
+             {{"suite", a.suite}, {"status", all_pass ? "pass" : "fail"}, {"scenes", scenes}});
+  write_text_file(out.file("index.html"),
+                  "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:"
+                  "sans-serif;max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{"
+                  "border-collapse:collapse}.pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn "
+                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th><th>what "
+                  "it tests / error</th></tr>" + rows + "</table></body></html>\n");
+  out.commit();
+  std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(),
+               all_pass ? "all scenes pass" : "FAILURES", a.out.c_str());
+  return all_pass ? 0 : 1;
+}
+
+}  // namespace
+
+int run_validate(const ValidateArgs& a) {
+  if (!a.suite.empty() && !a.scene.empty()) throw ArgumentError("give a scene or --suite, not both");
+  if (a.suite.empty() && a.scene.empty()) throw ArgumentError("give a scene or --suite FOLDER");
+  if (a.quick && a.thorough) throw ArgumentError("--quick and --thorough: give one of them");
+  Progress progress;
+  if (!a.suite.empty()) return run_suite(a, progress);
   const auto scene = load(a.scene, a.sets);
-  OutputDir out(a.out);
+  OutputDir out(a.out, a.force);
+  ValidationOptions opt;
   opt.quick = a.quick;
-  bool pass = false;
   const ValidationResult v = run_validation(scene, opt, progress);
   write_validation_report(v, out.file(""));
-  pass = v.pass;
   out.commit();
   std::printf("%s\n\nReport: %s/report.html\n", headline(v).c_str(), a.out.c_str());
-  return pass ? 0 : 1;
+  if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
+  return v.pass ? 0 : 1;
 }
 
 }  // namespace rdyn::validate

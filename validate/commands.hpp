@@ -3,10 +3,17 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace rdyn::validate {
+
+// A command-line value out of its documented range (exit status 2).
+class ArgumentError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 struct SimulateArgs {
   std::string scene;
@@ -18,6 +25,7 @@ struct SimulateArgs {
   std::string route = "actuator";
   std::vector<std::string> sets;
   std::string out;
+  bool force = false;  // write into a folder that holds files rdyn did not write
   // reduced model
   std::string table;  // CSV from `rdyn extract`; empty: extract now
   double grid_deg = 10.0;
@@ -36,6 +44,7 @@ struct ExtractArgs {
   std::string method = "kinetostatic";
   std::vector<std::string> sets;
   std::string out;  // FILE.csv
+  bool force = false;  // replace a file rdyn did not write
 };
 int run_extract(const ExtractArgs& args);
 
@@ -45,6 +54,7 @@ struct CalibrateArgs {
   double power_w = 125.0;
   std::vector<std::string> sets;
   std::string write_scene;  // optional output YAML
+  bool force = false;
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
 };
@@ -57,6 +67,7 @@ struct ValidateArgs {
   std::vector<std::string> sets;
   bool quick = false;     // short ladders (default for --suite)
   bool thorough = false;  // full ladders even for --suite
+  bool force = false;
 };
 int run_validate(const ValidateArgs& args);
 
@@ -69,6 +80,7 @@ struct SweepArgs {
   int threads = 0;
   double cadence_hz = 0.0, power_w = 0.0;
   double grid_deg = 10.0;
+  bool force = false;
 };
 int run_sweep_command(const SweepArgs& args);
 

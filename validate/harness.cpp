@@ -19,6 +19,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Fewest output samples over which an error maximum is claimed (a 20-point maximum of a
+// smooth signal sampled at 1/20 of its cycle still resolves its peak to ~1 %).
+constexpr long kMinComparedSamples = 20;
+
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 double median(std::vector<double> v) {
@@ -130,6 +134,11 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   progress.count(scene.name + ": reference (full model)", 2, 2);
   v.window = detect_steady_window(v.reference, rotating);
   v.reference_change = compare_series(v.reference, half, v.window.t_start);
+  // Errors and speedups are claimed only over enough samples (issue #9).
+  if (v.reference_change.samples < kMinComparedSamples)
+    v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
+                       "lengthen validation.duration_s or shorten simulation.output_interval_s",
+                       v.reference_change.samples, v.window.how, kMinComparedSamples));
 
   // 2. Full-model tolerance ladder.
   // Simbody's Runge–Kutta–Merson over the whole ladder; RK3 and CPodes at loose tolerances,
@@ -295,7 +304,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       if (v.matched_reduced < 0 || r.per_simulated_s < v.runs[v.matched_reduced].per_simulated_s)
         v.matched_reduced = static_cast<int>(i);
     }
-    if (v.matched_reduced >= 0)
+    if (v.matched_reduced >= 0 && v.reference_change.samples >= kMinComparedSamples)
       v.speedup_at_matched_error = v.runs[v.matched_full].per_simulated_s / v.runs[v.matched_reduced].per_simulated_s;
   }
 
@@ -333,10 +342,18 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       tr.run = fmt::format("reduced {:g}° {} rk8pd tol {:.0e}", th.grid_deg, interp, red_tols.back());
     }
     tr.pass = tr.error <= th.max_error;
-    v.pass &= tr.pass;
+    if (!tr.pass)
+      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr.error,
+                         th.max_error, tr.run));
     v.thresholds.push_back(tr);
   }
   return v;
+}
+
+std::string ValidationResult::failure_summary() const {
+  std::string s;
+  for (const auto& f : failures) s += (s.empty() ? "" : "; ") + f;
+  return s;
 }
 
 }  // namespace rdyn::validate

@@ -82,6 +82,14 @@ struct ValidationResult {
   CalibrationOptions calibration_options;
   std::vector<ThresholdResult> thresholds;
   bool pass = true;
+  std::vector<std::string> failures;  // why pass is false, in plain words
+
+  // Marks the validation failed for `why`.
+  void fail(std::string why) {
+    pass = false;
+    failures.push_back(std::move(why));
+  }
+  std::string failure_summary() const;
 };
 
 // Runs everything (engine + reduced) for one scene. Throws on scene/engine errors.

@@ -1,5 +1,7 @@
-// rdyn command-line interface. Exit status: 0 success, 2 bad input (scene, arguments,
-// table, output folder, a mechanism that cannot assemble), 1 an internal failure.
+// rdyn command-line interface. Exit status (README, "Exit status"): 0 success; 1 a numerical
+// failure (an integrator that cannot go on, an energy balance that does not close, a
+// calibration or validation that misses its target); 2 bad input (scene, arguments, table,
+// output destination, a mechanism that cannot assemble), with the file, line and field.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
@@ -11,6 +13,11 @@
 
 namespace {
 constexpr int kExitBadInput = 2;
+constexpr int kExitNumerical = 1;
+constexpr const char* kForceHelpDir =
+    "Write into an existing folder that holds files rdyn did not write (same-named files are replaced, nothing else "
+    "is touched). Without it such a folder is refused; an earlier rdyn output is replaced atomically.";
+constexpr const char* kForceHelpFile = "Replace an existing file that rdyn did not write";
 }
 
 int main(int argc, char** argv) {
@@ -34,6 +41,7 @@ int main(int argc, char** argv) {
   simulate->add_option("--dt-out", sim.dt_out, "Output interval [s] (default: the scene's)");
   simulate->add_option("--set", sim.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   simulate->add_option("--out", sim.out, "Output folder (written atomically)")->required();
+  simulate->add_flag("--force", sim.force, kForceHelpDir);
   auto* full = simulate->add_option_group("full model");
   full->add_option("--tolerance", sim.tolerance, "Integrator accuracy (default: the scene's)");
   full->add_option("--integrator", sim.integrator, "rkmerson, rk3 or cpodes")
@@ -67,6 +75,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"kinetostatic", "paper-sweep", "integrated", "direct"}));
   extract->add_option("--set", ext.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   extract->add_option("--out", ext.out, "Output CSV file")->required();
+  extract->add_flag("--force", ext.force, kForceHelpFile);
 
   CalibrateArgs cal;
   auto* calibrate = app.add_subcommand(
@@ -79,6 +88,7 @@ int main(int argc, char** argv) {
   calibrate->add_option("--cadence-hz", cal.cadence_hz, "Target cadence [Hz] (default 1)");
   calibrate->add_option("--power-w", cal.power_w, "Power the resistance dissipates at that cadence [W] (default 125)");
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
+  calibrate->add_flag("--force", cal.force, kForceHelpFile);
   calibrate->add_option("--set", cal.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   calibrate->add_option("--grid-deg", cal.grid_deg, "Reduced table grid [deg] (default 10)");
   calibrate->add_option("--interp", cal.interpolation, "Reduced table interpolation (default fourier)")
@@ -95,6 +105,7 @@ int main(int argc, char** argv) {
   validate->add_option("scene", val.scene, "Scene name or YAML file");
   validate->add_option("--suite", val.suite, "Folder of scenes to validate (each may declare thresholds)");
   validate->add_option("--out", val.out, "Output folder (written atomically)")->required();
+  validate->add_flag("--force", val.force, kForceHelpDir);
   validate->add_option("--set", val.sets, "Override a scalar of the scene(s): key.path=value (repeatable)");
   validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
   validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
@@ -111,6 +122,7 @@ int main(int argc, char** argv) {
       ->required();
   sweep->add_option("--set", sw.sets, "Fixed override key.path=value (repeatable)");
   sweep->add_option("--out", sw.out, "Output CSV file")->required();
+  sweep->add_flag("--force", sw.force, kForceHelpFile);
   sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
   sweep->add_option("--threads", sw.threads, "Worker threads (default: hardware threads)");
   sweep->add_option("--cadence-hz", sw.cadence_hz, "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
@@ -146,12 +158,18 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;
+  } catch (const ArgumentError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
   } catch (const rdyn::models::NumericalError& e) {
     std::fprintf(stderr, "rdyn: numerical failure: %s\n", e.what());
-    return 1;
+    return kExitNumerical;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "rdyn: numerical failure: out of memory\n");
+    return kExitNumerical;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rdyn: internal error: %s\n", e.what());
-    return 1;
+    return kExitNumerical;
   }
   return 0;
 }

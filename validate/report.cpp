@@ -8,6 +8,10 @@
 
 #include <fmt/format.h>
 
+#include "validate/escape.hpp"
+#include "validate/output_dir.hpp"
+#include "validate/run_program.hpp"
+
 namespace rdyn::validate {
 
 namespace {
@@ -24,11 +28,10 @@ std::string secs(double s) {
   return fmt::format("{:.3g} µs", s * 1e6);
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  if (!f) throw OutputError(path + ": cannot write");
-}
+void write_text(const std::string& path, const std::string& text) { write_text_file(path, text); }
+
+// Scene-given text in HTML.
+std::string H(const std::string& s) { return html_escape(s); }
 
 std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -210,6 +213,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
                   {"run", t.run}});
   j["thresholds"] = th;
   j["status"] = v.pass ? "pass" : "fail";
+  j["failures"] = v.failures;
   return j;
 }
 
@@ -226,7 +230,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
     for (const auto& sig : v.reference_change.signals) s += ",max_rel_" + sig.name + ",rms_rel_" + sig.name;
     s += "\n";
     for (const auto& r : v.runs) {
-      s += fmt::format("{},\"{}\",{},{},{},{},{:g},{:g},{:.6g},{},{:.3g},{},{}", r.model, r.label(), r.grid_deg,
+      s += fmt::format("{},{},{},{},{},{},{:g},{:g},{:.6g},{},{:.3g},{},{}", r.model, csv_field(r.label()), r.grid_deg,
                        r.interpolation, r.energy_consistent ? 1 : 0, r.integrator, r.tolerance, r.fixed_step_s,
                        r.per_simulated_s, r.steps, r.energy_residual_rel, r.pareto ? 1 : 0, r.errors.excluded);
       for (const auto& sig : r.errors.signals) s += fmt::format(",{:.6g},{:.6g}", sig.max_rel, sig.rms_rel);
@@ -271,10 +275,10 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
     for (size_t c = 1; c < v.dense_names.size(); ++c) {
       const std::string unit = c <= 2 ? units[c - 1] : "kg·m";
       gp += fmt::format(
-          "set title '{} [{}]' noenhanced\nplot 'params_dense.csv' skip 1 using 1:{} with lines lw 2 lc rgb '#1f77b4' "
+          "set title {} noenhanced\nplot 'params_dense.csv' skip 1 using 1:{} with lines lw 2 lc rgb '#1f77b4' "
           "title 'interpolant', 'params.csv' skip 1 using 1:{} with points pt 7 ps 0.6 lc rgb '#d62728' title "
           "'samples'\n",
-          v.dense_names[c], unit, c + 1, c + 1);
+          gnuplot_quoted(v.dense_names[c] + " [" + unit + "]"), c + 1, c + 1);
     }
     gp += "unset multiplot\n";
     write_text(dir + "/params.gp", gp);
@@ -306,10 +310,10 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
         "set title 'reduced − full [rad/s]'\nplot 'compare.csv' skip 1 using 1:4 with lines lc rgb '#1f77b4' notitle\n";
     if (has_f)
       gp += fmt::format(
-          "set title '{0} force [N]' noenhanced\nplot 'compare.csv' skip 1 using 1:5 with lines lw 3 lc rgb '#aaaaaa' "
+          "set title {0} noenhanced\nplot 'compare.csv' skip 1 using 1:5 with lines lw 3 lc rgb '#aaaaaa' "
           "title 'full', '' skip 1 using 1:6 with lines lw 1 lc rgb '#d62728' title 'reduced'\n"
           "set title 'reduced − full [N]'\nplot 'compare.csv' skip 1 using 1:7 with lines lc rgb '#1f77b4' notitle\n",
-          f.force_names[0]);
+          gnuplot_quoted(f.force_names[0] + " force [N]"));
     gp += "unset multiplot\n";
     write_text(dir + "/timeseries.gp", gp);
   }
@@ -321,12 +325,12 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
     for (const auto& r : v.runs) {
       if (!r.failure.empty()) continue;  // stopped runs have no error to plot
       const double e = std::max(err(r, Q), 1e-12);
-      const std::string line = fmt::format("{:.6g},{:.6g},\"{}\"\n", r.per_simulated_s, e, r.label());
+      const std::string line = fmt::format("{:.6g},{:.6g},{}\n", r.per_simulated_s, e, csv_field(r.label()));
       (r.model == "full" ? full : red) += line;
       if (r.model == "reduced" && r.pareto) fr.push_back(&r);
     }
     std::sort(fr.begin(), fr.end(), [](auto a, auto b) { return a->per_simulated_s < b->per_simulated_s; });
-    for (const auto* r : fr) front += fmt::format("{:.6g},{:.6g},\"{}\"\n", r->per_simulated_s, std::max(err(*r, Q), 1e-12), r->label());
+    for (const auto* r : fr) front += fmt::format("{:.6g},{:.6g},{}\n", r->per_simulated_s, std::max(err(*r, Q), 1e-12), csv_field(r->label()));
     write_text(dir + "/pareto_reduced.csv", red);
     write_text(dir + "/pareto_front.csv", front);
     write_text(dir + "/pareto_full.csv", full);
@@ -336,7 +340,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
                            "set terminal svg size 960,560 dynamic enhanced font 'sans,11' background rgb 'white'\n"
                            "set output 'pareto.svg'\nset datafile separator ','\nset grid\nset logscale xy\n"
                            "set format x '10^{{%L}}'\nset format y '10^{{%L}}'\n"
-                           "set xlabel 'computing time per simulated second [s]'\nset ylabel '{0} error / peak' noenhanced\n"
+                           "set xlabel 'computing time per simulated second [s]'\nset ylabel {2} noenhanced\n"
                            "set title 'Accuracy against cost: every reduced run, its Pareto front, and the full-model "
                            "tolerance ladder'\nset key outside right\n"
                            "plot 'pareto_reduced.csv' skip 1 using 1:2 with points pt 6 ps 0.6 lc rgb '#999999' title "
@@ -344,7 +348,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
                            "title 'reduced Pareto front', 'pareto_full.csv' skip 1 using 1:2 with linespoints pt 5 lw 2 lc "
                            "rgb '#1f77b4' title 'full model (tolerance ladder)', {1:g} with lines dt 2 lc rgb '#555555' title "
                            "'matched-error target'\n",
-                           Q, v.matched_target));
+                           Q, v.matched_target, gnuplot_quoted(Q + " error / peak")));
   }
 
   // Figure 4: error vs grid step with the observed order.
@@ -370,7 +374,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
         "# Error against grid step (rk8pd at the tightest tolerance). Data: convergence.csv.\n"
         "set terminal svg size 960,560 dynamic enhanced font 'sans,11' background rgb 'white'\n"
         "set output 'convergence.svg'\nset datafile separator ','\nset grid\nset logscale xy\nset format y '10^{%L}'\n"
-        "set xlabel 'grid step [deg]'\nset ylabel '" + Q + " error / peak' noenhanced\nset key outside right\n"
+        "set xlabel 'grid step [deg]'\nset ylabel " + gnuplot_quoted(Q + " error / peak") + " noenhanced\nset key outside right\n"
         "set title 'Convergence with the grid (slopes: observed order, fitted above 10× the reference floor)'\n"
         "plot ";
     const char* colors[] = {"#1f77b4", "#2ca02c", "#9467bd", "#d62728"};
@@ -388,9 +392,10 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
   // Render the figures.
   std::string figures_note;
   bool gnuplot_ok = true;
+  // No shell: gnuplot gets an argument vector and runs in the report's folder (60 s each).
   for (const char* name : {"params", "timeseries", "pareto", "convergence"}) {
-    const std::string cmd = fmt::format("cd '{}' && gnuplot {}.gp >> gnuplot.log 2>&1", dir, name);
-    if (std::system(cmd.c_str()) != 0) gnuplot_ok = false;
+    const auto run = run_program({"gnuplot", std::string(name) + ".gp"}, dir, dir + "/gnuplot.log", 60.0);
+    if (!run.ok()) gnuplot_ok = false;
   }
   auto svg = [&](const std::string& name) {
     std::string text = read_text(dir + "/" + name + ".svg");
@@ -402,20 +407,25 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
 
   // report.html
   std::string h;
-  h += "<!DOCTYPE html><html lang=en><head><meta charset='utf-8'><title>rdyn validation: " + v.scene + "</title>";
+  h += "<!DOCTYPE html><html lang=en><head><meta charset='utf-8'><title>rdyn validation: " + H(v.scene) + "</title>";
   h += "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 1em;line-height:1.45;color:#222}"
        "h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ccc}"
        "table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
        "th{background:#f3f3f3}td.l{text-align:left}.lead{font-size:1.08em;background:#f6f9ff;padding:.8em;border-left:"
        "4px solid #1f77b4}.warn{color:#a00}.pass{color:#070;font-weight:bold}.fail{color:#a00;font-weight:bold}"
        "svg{max-width:100%;height:auto}code{background:#f3f3f3;padding:0 3px}</style></head><body>";
-  h += "<h1>rdyn validation: " + v.scene + "</h1>";
-  h += "<p class=lead>" + headline(v) + "</p>";
-  if (!v.note.empty()) h += "<p><b>What this scene tests:</b> " + v.note + "</p>";
+  h += "<h1>rdyn validation: " + H(v.scene) + "</h1>";
+  h += "<p class=lead>" + H(headline(v)) + "</p>";
+  if (!v.failures.empty()) {
+    h += "<p class=fail>Validation FAILED:</p><ul>";
+    for (const auto& f : v.failures) h += "<li class=warn>" + H(f) + "</li>";
+    h += "</ul>";
+  }
+  if (!v.note.empty()) h += "<p><b>What this scene tests:</b> " + H(v.note) + "</p>";
   h += fmt::format("<p>Scene file: <code>{}</code>. Simulated {:g} s, output every {:g} s. Steady cycles: {}. "
                    "Samples lying between the two models' instants of a load switch (where the force jumps) are "
                    "excluded from the error maxima and counted in <code>runs.csv</code>.</p>",
-                   v.scene_file, v.duration_s, v.output_interval_s, v.window.how);
+                   H(v.scene_file), v.duration_s, v.output_interval_s, H(v.window.how));
   h += figures_note;
   h += "<h2>1. Reduced parameters</h2><p>m1, m2 of Eksergian's equation <code>m1 q̈ + m2 q̇² = F*</code> and me1, me2 of "
        "each constraint line <code>me1 q̈ + me2 q̇² = F_E + Q_x</code>, from kinetostatic calls of the full model at 10° "
@@ -459,22 +469,22 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
     h += "<h2>Acceptance thresholds</h2><table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</th><th>run</th><th></th></tr>";
     for (const auto& t : v.thresholds)
       h += fmt::format("<tr><td class=l>{}</td><td>{:g}°</td><td>{}</td><td>{}</td><td class=l>{}</td><td class={}>{}</td></tr>",
-                       t.threshold.quantity, t.threshold.grid_deg, pct(t.threshold.max_error), pct(t.error), t.run,
+                       H(t.threshold.quantity), t.threshold.grid_deg, pct(t.threshold.max_error), pct(t.error), H(t.run),
                        t.pass ? "pass" : "fail", t.pass ? "pass" : "FAIL");
     h += "</table>";
   }
   h += "<h2>All runs</h2><p>Median wall time of repeated runs per simulated second; errors are maxima over the steady "
        "cycles relative to the reference's peak (RMS in <code>runs.csv</code>). ★: on the Pareto front of its model.</p>"
        "<table><tr><th>run</th><th>time / sim. s</th><th>steps</th><th>energy residual</th>";
-  for (const auto& sig : v.reference_change.signals) h += "<th>" + sig.name + "</th>";
+  for (const auto& sig : v.reference_change.signals) h += "<th>" + H(sig.name) + "</th>";
   h += "</tr>";
   for (const auto& r : v.runs) {
     if (!r.failure.empty()) {
-      h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>", r.label(),
-                       3 + v.reference_change.signals.size(), r.failure);
+      h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>", H(r.label()),
+                       3 + v.reference_change.signals.size(), H(r.failure));
       continue;
     }
-    h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{:.1e}</td>", r.pareto ? "★ " : "", r.label(),
+    h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{:.1e}</td>", r.pareto ? "★ " : "", H(r.label()),
                      secs(r.per_simulated_s), r.steps, r.energy_residual_rel);
     for (const auto& sig : r.errors.signals) h += fmt::format("<td>{:.2e}</td>", sig.max_rel);
     h += "</tr>";
@@ -487,7 +497,7 @@ void write_validation_report(const ValidationResult& v, const std::string& dir) 
                    v.duration_s, secs(v.extraction_ms * 1e-3 / v.duration_s));
   h += "<h2>Files</h2><p><code>summary.json</code> (every number above), <code>runs.csv</code>, and for each figure its "
        "data (<code>*.csv</code>) and gnuplot script (<code>*.gp</code>): edit a script and run <code>gnuplot NAME.gp</code> "
-       "in this folder to restyle it.</p><p>Machine: " + v.machine + ".</p></body></html>\n";
+       "in this folder to restyle it.</p><p>Machine: " + H(v.machine) + ".</p></body></html>\n";
   write_text(dir + "/report.html", h);
 }
 

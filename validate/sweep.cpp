@@ -1,5 +1,6 @@
 #include "validate/sweep.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <mutex>
@@ -9,6 +10,7 @@
 
 #include "models/scene_yaml.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/escape.hpp"
 #include "validate/progress.hpp"
 
 namespace rdyn::validate {
@@ -31,7 +33,7 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   return a;
 }
 
-std::string run_sweep(const SweepOptions& opt, bool show_progress) {
+SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
     throw models::SceneError("", 0, "--shard", "expected i/N with 0 ≤ i < N");
   std::vector<models::Override> fixed;
@@ -46,15 +48,28 @@ std::string run_sweep(const SweepOptions& opt, bool show_progress) {
   if (!(copt.cadence_hz > 0) || !(copt.power_w > 0))
     throw models::SceneError(base.source_file, 0, "--cadence-hz/--power-w",
                              "give them, or a validation.calibrate block in the scene");
+  // Every axis at both ends of its range on the base scene: unknown keys and values out of
+  // range fail here, before any thread starts.
+  for (const auto& a : opt.axes)
+    for (double v : {a.values.front(), a.values.back()}) {
+      std::vector<models::Override> o = fixed;
+      o.push_back({a.key, fmt::format("{:.17g}", v)});
+      models::load_scene(opt.scene, o);
+    }
 
+  constexpr long kMaxCases = 1000000;
   long total = 1;
-  for (const auto& a : opt.axes) total *= static_cast<long>(a.values.size());
+  for (const auto& a : opt.axes) {
+    total *= static_cast<long>(a.values.size());
+    if (total > kMaxCases)
+      throw models::SceneError("", 0, "--vary", fmt::format("more than {} cases in all", kMaxCases));
+  }
   const long per = (total + opt.shards - 1) / opt.shards;
   const long first = std::min(total, per * opt.shard), last = std::min(total, first + per);
   const long n = last - first;
 
   std::vector<std::string> rows(n);
-  std::atomic<long> next{0}, done{0};
+  std::atomic<long> next{0}, done{0}, failed{0};
   std::mutex progress_mutex;
   Progress progress(show_progress);
   const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
@@ -79,10 +94,8 @@ std::string run_sweep(const SweepOptions& opt, bool show_progress) {
                           r.mean_cadence_hz_reduced, r.mean_power_w, force.empty() ? NAN : r.peak_force_N,
                           r.speed_fluctuation);
       } catch (const std::exception& e) {
-        std::string msg = e.what();
-        for (char& c : msg)
-          if (c == '"' || c == '\n' || c == ',') c = ' ';
-        row = fmt::format("{}{},error,,,,,,\"{}\"", index, params, msg);
+        row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
+        ++failed;
       }
       rows[k] = row;
       const long d = ++done;
@@ -90,7 +103,8 @@ std::string run_sweep(const SweepOptions& opt, bool show_progress) {
       progress.count("sweep", d, n);
     }
   };
-  const int threads = std::max(1, opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = static_cast<int>(std::clamp<long>(
+      opt.threads > 0 ? opt.threads : static_cast<long>(std::thread::hardware_concurrency()), 1, std::max(1L, n)));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();
@@ -98,12 +112,12 @@ std::string run_sweep(const SweepOptions& opt, bool show_progress) {
   std::string csv;
   if (opt.shard == 0) {
     csv = "case";
-    for (const auto& a : opt.axes) csv += "," + a.key;
+    for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
     csv += fmt::format(",status,hip_torque_Nm,mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n",
                        force.empty() ? "constraint" : force);
   }
   for (const auto& r : rows) csv += r + "\n";
-  return csv;
+  return {csv, n, failed.load()};
 }
 
 }  // namespace rdyn::validate

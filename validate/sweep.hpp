@@ -28,8 +28,16 @@ struct SweepOptions {
   double grid_deg = 10.0;
 };
 
-// Runs the cases of this shard and returns the CSV text (header only on shard 0). A failing
-// case gives a row with status "error" and its message, and does not stop the others.
-std::string run_sweep(const SweepOptions& opt, bool show_progress);
+struct SweepResult {
+  std::string csv;  // header only on shard 0
+  long cases = 0;   // in this shard
+  long failed = 0;  // rows with status "error"
+};
+
+// Runs the cases of this shard. Every axis key is first applied at both ends of its range to
+// the base scene, so an unknown key or an out-of-range value is a SceneError before any work.
+// A failing case gives a row with status "error" and its message (RFC 4180-quoted), and
+// does not stop the others.
+SweepResult run_sweep(const SweepOptions& opt, bool show_progress);
 
 }  // namespace rdyn::validate

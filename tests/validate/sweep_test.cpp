@@ -25,14 +25,51 @@ TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   o.scene = "bicycle";
   o.axes = {parse_sweep_axis("bicycle_leg.hip_torque_Nm=60:60:1"), parse_sweep_axis("bicycle_leg.crank_length_m=0.16:0.18:3")};
   o.threads = 2;
-  const std::string whole = run_sweep(o, false);
+  const SweepResult r = run_sweep(o, false);
+  const std::string& whole = r.csv;
+  EXPECT_EQ(r.cases, 3);
+  EXPECT_EQ(r.failed, 0);
   std::string parts;
   o.shards = 2;
-  for (o.shard = 0; o.shard < 2; ++o.shard) parts += run_sweep(o, false);
+  for (o.shard = 0; o.shard < 2; ++o.shard) parts += run_sweep(o, false).csv;
   EXPECT_EQ(parts, whole);
   // header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
   EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 4);
   EXPECT_EQ(whole.find("error"), whole.find("error\n"));  // only the header's column name
+}
+
+}  // namespace
+}  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// Keys are checked on the base scene at both ends of each axis before any case runs.
+TEST(Sweep, UnknownKeysAndOutOfRangeEndsFailBeforeWork) {
+  SweepOptions o;
+  o.scene = "fourbar";
+  o.cadence_hz = 1.0;
+  o.power_w = 1.0;
+  o.axes = {parse_sweep_axis("no_such.key=1:2:3")};
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  o.axes = {parse_sweep_axis("bodies.crank.mass_kg=1:-1:3")};  // the far end is not a mass
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+}
+
+// A failing case is a row with status "error" and its message, and it is counted: the
+// four-bar has no drive torque, so no case can be calibrated.
+TEST(Sweep, FailingCasesAreCountedAndReported) {
+  SweepOptions o;
+  o.scene = "fourbar";
+  o.cadence_hz = 1.0;
+  o.power_w = 1.0;
+  o.axes = {parse_sweep_axis("bodies.crank.mass_kg=0.4:0.6:3")};
+  o.threads = 2;
+  const SweepResult r = run_sweep(o, false);
+  EXPECT_EQ(r.cases, 3);
+  EXPECT_EQ(r.failed, 3) << r.csv;
+  EXPECT_NE(r.csv.find(",error,,,,,,"), std::string::npos) << r.csv;
+  EXPECT_NE(r.csv.find("joint torque"), std::string::npos) << r.csv;
 }
 
 }  // namespace
