@@ -94,9 +94,9 @@ void write_json(const std::string& path, const nlohmann::json& j) { write_text_f
 
 int run_simulate(const SimulateArgs& a) {
   const models::Scene scene = load(a.scene, a.sets);
-  const double duration = std::isnan(a.duration) ? scene.simulation.duration_s : a.duration;
-  const double dt_out = std::isnan(a.dt_out) ? scene.simulation.output_interval_s : a.dt_out;
-  const double tolerance = std::isnan(a.tolerance) ? scene.simulation.tolerance : a.tolerance;
+  const double duration = a.duration.value_or(scene.simulation.duration_s);
+  const double dt_out = a.dt_out.value_or(scene.simulation.output_interval_s);
+  const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
   require_timing(duration, dt_out);
   if (a.model == "full") {
     require_in("--tolerance", tolerance, kMinTolerance, kMaxTolerance, "");

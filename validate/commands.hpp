@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,9 +19,9 @@ class ArgumentError : public std::runtime_error {
 struct SimulateArgs {
   std::string scene;
   std::string model = "full";  // full | reduced
-  double duration = NAN;       // NAN: the scene's
-  double dt_out = NAN;
-  double tolerance = NAN;      // full-model integrator accuracy
+  std::optional<double> duration;   // empty: the scene's
+  std::optional<double> dt_out;
+  std::optional<double> tolerance;  // full-model integrator accuracy
   std::string integrator = "rkmerson";
   std::string route = "actuator";
   std::vector<std::string> sets;

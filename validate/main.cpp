@@ -37,13 +37,14 @@ int main(int argc, char** argv) {
   simulate->add_option("scene", sim.scene, "Scene name or YAML file")->required();
   simulate->add_option("--model", sim.model, "full (Simbody) or reduced (tables + Eksergian's equation)")
       ->check(CLI::IsMember({"full", "reduced"}));
-  simulate->add_option("--duration", sim.duration, "Simulated time [s] (default: the scene's)");
-  simulate->add_option("--dt-out", sim.dt_out, "Output interval [s] (default: the scene's)");
+  double duration = 0, dt_out = 0, tolerance = 0;  // copied into `sim` when given
+  auto* duration_opt = simulate->add_option("--duration", duration, "Simulated time [s] (default: the scene's)");
+  auto* dt_out_opt = simulate->add_option("--dt-out", dt_out, "Output interval [s] (default: the scene's)");
   simulate->add_option("--set", sim.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   simulate->add_option("--out", sim.out, "Output folder (written atomically)")->required();
   simulate->add_flag("--force", sim.force, kForceHelpDir);
   auto* full = simulate->add_option_group("full model");
-  full->add_option("--tolerance", sim.tolerance, "Integrator accuracy (default: the scene's)");
+  auto* tolerance_opt = full->add_option("--tolerance", tolerance, "Integrator accuracy (default: the scene's)");
   full->add_option("--integrator", sim.integrator, "rkmerson, rk3 or cpodes")
       ->check(CLI::IsMember({"rkmerson", "rk3", "cpodes"}));
   full->add_option("--constraint-force-route", sim.route,
@@ -140,6 +141,9 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
 
+  if (duration_opt->count()) sim.duration = duration;
+  if (dt_out_opt->count()) sim.dt_out = dt_out;
+  if (tolerance_opt->count()) sim.tolerance = tolerance;
   try {
     if (*simulate) return run_simulate(sim);
     if (*extract) return run_extract(ext);
