@@ -22,6 +22,9 @@ using Clock = std::chrono::steady_clock;
 // Fewest output samples over which an error maximum is claimed (a 20-point maximum of a
 // smooth signal sampled at 1/20 of its cycle still resolves its peak to ~1 %).
 constexpr long kMinComparedSamples = 20;
+// Fewest steady revolutions over which a cycling run's errors are claimed: one revolution
+// cannot show that the cycle repeats (detect_steady_window compares consecutive means).
+constexpr int kMinSteadyRevolutions = 2;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -139,6 +142,10 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
                        "lengthen validation.duration_s or shorten simulation.output_interval_s",
                        v.reference_change.samples, v.window.how, kMinComparedSamples));
+  if (v.window.revolutions > 0 && v.window.revolutions < kMinSteadyRevolutions)
+    v.fail(fmt::format("the run never settles into a steady cycle: only {} revolution(s) after the start-up transient "
+                       "({}); lengthen validation.duration_s",
+                       v.window.revolutions, v.window.how));
 
   // 2. Full-model tolerance ladder.
   // Simbody's Runge–Kutta–Merson over the whole ladder; RK3 and CPodes at loose tolerances,
@@ -304,7 +311,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       if (v.matched_reduced < 0 || r.per_simulated_s < v.runs[v.matched_reduced].per_simulated_s)
         v.matched_reduced = static_cast<int>(i);
     }
-    if (v.matched_reduced >= 0 && v.reference_change.samples >= kMinComparedSamples)
+    if (v.matched_reduced >= 0 && v.failures.empty())
       v.speedup_at_matched_error = v.runs[v.matched_full].per_simulated_s / v.runs[v.matched_reduced].per_simulated_s;
   }
 
