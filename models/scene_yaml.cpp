@@ -62,7 +62,8 @@ constexpr size_t kMaxOverrideKeyLength = 1024;
 void check_yaml_tree(const YAML::Node& node, const std::string& file, const std::string& path, int depth,
                      size_t& visits) {
   auto fail = [&](const YAML::Node& at, const std::string& field, const std::string& msg) {
-    throw SceneError(file, line_of(at), field, msg);
+    // A path through a cycle is as long as the depth limit allows: keep the message readable.
+    throw SceneError(file, line_of(at), field.size() > 100 ? field.substr(0, 100) + "…" : field, msg);
   };
   if (++visits > kMaxTreeNodes)
     fail(node, path, fmt::format("the YAML tree has more than {} nodes (aliases expanded); a scene needs far fewer",
@@ -582,7 +583,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
              {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops",
               "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation",
               "validation"});
-  s.name = top.str("name");
+  s.name = top.name("name");
   s.description = top.str_or("description", "");
 
   // Initial conditions first: the generator places the mechanism at q0.
