@@ -391,7 +391,8 @@ std::optional<double> fixed_speed_ratio(const Scene& s, const std::string& body)
     if (j.name == s.independent) return 1.0;
     for (const auto& g : s.gears) {
       const Joint* driver = s.find_joint(g.driver);
-      if (g.driven == j.name && g.driver == s.independent && driver->parent == kGround)
+      // Called before check_scene (to turn `dissipates` into a coefficient): names may be unknown.
+      if (driver && g.driven == j.name && g.driver == s.independent && driver->parent == kGround)
         return g.ratio;
     }
   }

@@ -156,6 +156,17 @@ TEST(CheckScene, ValidationSettingsHaveRanges) {
             "validation.calibrate.power_W");
 }
 
+TEST(FixedSpeedRatio, GearsAndUnknownJointsBeforeTheChecks) {
+  Scene s = geared_pair();
+  EXPECT_EQ(fixed_speed_ratio(s, "wheel"), 1.0);
+  EXPECT_EQ(fixed_speed_ratio(s, "pinion"), -2.0);
+  // The reader asks before check_scene has run: a gear whose driver names no joint (and an
+  // independent coordinate naming the same) dereferenced a null joint.
+  s.independent = "nosuch";
+  s.gears[0].driver = "nosuch";
+  EXPECT_EQ(fixed_speed_ratio(s, "pinion"), std::nullopt);
+}
+
 TEST(CheckScene, ListsAreBounded) {
   EXPECT_EQ(refused_field([](Scene& s) {
               for (int i = 0; i < 1000; ++i) s.bodies.push_back({"b" + std::to_string(i), 1.0, {}, 1.0, {}});

@@ -297,6 +297,22 @@ independent: wheel
   EXPECT_EQ(refusal(with(ok, "ratio: 2", "ratio: 2.0e3")).field(), "gears.mesh.ratio");
 }
 
+TEST(SceneYaml, DissipatesThroughAGearFromAnUnknownJointIsRefused) {
+  // Crashed (null joint) before check_scene could refuse the unknown names.
+  const std::string y = R"(name: g
+bodies:
+  - {name: wheel, mass_kg: 2, inertia_kgm2: 0.04}
+joints:
+  - {name: wheel, type: revolute, parent: ground, child: wheel}
+gears:
+  - {name: mesh, driver: nosuch, driven: wheel, ratio: 2}
+independent: nosuch
+loads:
+  - {type: resistance, name: brake, body: wheel, law: viscous, dissipates: {power_W: 10, cadence_Hz: 1}}
+)";
+  EXPECT_EQ(refusal(y).field(), "loads.brake.dissipates");
+}
+
 TEST(SceneYaml, AMotorRunningAwayIsRefused) {
   const std::string y = with(read_scene_text("slider-crank"), "no_load_speed_rad_s: 60.0", "no_load_speed_rad_s: -60.0");
   const SceneError e = refusal(y);
