@@ -330,8 +330,8 @@ void check_scene(const Scene& s) {
   c.abs_at_most("initial.qdot", s.initial.qdot, limits::kMaxRate, "rad/s or m/s");
 
   const auto& sim = s.simulation;
-  c.in_range("simulation.duration_s", sim.duration_s, 0.0, limits::kMaxDuration_s, "s");
-  if (sim.duration_s <= 0.0) fail("simulation.duration_s", "must be positive");
+  if (!(sim.duration_s > 0.0 && sim.duration_s <= limits::kMaxDuration_s))
+    fail("simulation.duration_s", fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
   c.in_range("simulation.output_interval_s", sim.output_interval_s, limits::kMinOutputInterval_s, sim.duration_s, "s");
   const double longest = std::max(sim.duration_s, s.validation.duration_s);
   if (longest / sim.output_interval_s > limits::kMaxOutputRows)
