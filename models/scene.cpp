@@ -1,10 +1,10 @@
 #include "models/scene.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
-
-#include <fmt/format.h>
 
 namespace rdyn::models {
 
@@ -72,9 +72,10 @@ std::string printable(const std::string& n) {
 }  // namespace
 
 std::string invalid_name_message(const std::string& n) {
-  return fmt::format("'{}' is not a valid name: 1 to {} characters from A-Z a-z 0-9 _ -, starting with a "
-                     "letter or '_'",
-                     printable(n), limits::kMaxNameLength);
+  return fmt::format(
+      "'{}' is not a valid name: 1 to {} characters from A-Z a-z 0-9 _ -, starting with a "
+      "letter or '_'",
+      printable(n), limits::kMaxNameLength);
 }
 
 namespace {
@@ -87,11 +88,13 @@ struct Checker {
   }
   void in_range(const std::string& field, double v, double lo, double hi, const char* unit) const {
     if (!std::isfinite(v) || v < lo || v > hi)
-      fail(field, fmt::format("must be in [{:g}, {:g}]{}{} (got {:g})", lo, hi, *unit ? " " : "", unit, v));
+      fail(field, fmt::format("must be in [{:g}, {:g}]{}{} (got {:g})", lo, hi, *unit ? " " : "",
+                              unit, v));
   }
   void abs_at_most(const std::string& field, double v, double hi, const char* unit) const {
     if (!std::isfinite(v) || std::abs(v) > hi)
-      fail(field, fmt::format("must be finite with |value| ≤ {:g}{}{} (got {:g})", hi, *unit ? " " : "", unit, v));
+      fail(field, fmt::format("must be finite with |value| ≤ {:g}{}{} (got {:g})", hi,
+                              *unit ? " " : "", unit, v));
   }
   void point(const std::string& field, Vec2 p) const {
     abs_at_most(field + "[0]", p.x, limits::kMaxCoordinate_m, "m");
@@ -102,13 +105,15 @@ struct Checker {
     if (std::hypot(d.x, d.y) < 1e-12) fail(field, "must be a non-zero vector");
   }
   // Names of one kind: valid and unique. `path` is the list ("bodies"), `i` the item.
-  void name(const std::string& path, size_t i, const std::string& n, std::set<std::string>& seen) const {
+  void name(const std::string& path, size_t i, const std::string& n,
+            std::set<std::string>& seen) const {
     name(fmt::format("{}[{}].name", path, i), n, seen, path);
   }
   void name(const std::string& f, const std::string& n, std::set<std::string>& seen,
             const std::string& path = "") const {
     if (!is_valid_name(n)) fail(f, invalid_name_message(n));
-    if (!seen.insert(n).second) fail(f, fmt::format("duplicate name '{}' in {}", n, path.empty() ? f : path));
+    if (!seen.insert(n).second)
+      fail(f, fmt::format("duplicate name '{}' in {}", n, path.empty() ? f : path));
   }
   void count(const std::string& field, size_t n) const {
     if (n > limits::kMaxItems)
@@ -117,15 +122,16 @@ struct Checker {
   void points(const std::string& field, const std::map<std::string, Vec2>& pts) const {
     count(field, pts.size());
     for (const auto& [n, p] : pts) {
-      if (!is_valid_name(n))
-        fail(field, "point " + invalid_name_message(n));
+      if (!is_valid_name(n)) fail(field, "point " + invalid_name_message(n));
       point(field + "." + n, p);
     }
   }
   // A joint coordinate: an angle for a revolute joint, a length for a prismatic one.
   void coordinate(const std::string& field, const Joint* j, double v) const {
-    if (j && j->type == JointType::Prismatic) abs_at_most(field, v, limits::kMaxCoordinate_m, "m");
-    else abs_at_most(field, v, limits::kMaxAngle_rad, "rad");
+    if (j && j->type == JointType::Prismatic)
+      abs_at_most(field, v, limits::kMaxCoordinate_m, "m");
+    else
+      abs_at_most(field, v, limits::kMaxAngle_rad, "rad");
   }
 };
 
@@ -145,7 +151,8 @@ void check_scene(const Scene& s) {
   c.count("joints", s.joints.size());
   c.count("loops", s.loops.size());
   c.count("gears", s.gears.size());
-  c.count("loads", s.joint_torques.size() + s.resistances.size() + s.springs.size() + s.motors.size());
+  c.count("loads",
+          s.joint_torques.size() + s.resistances.size() + s.springs.size() + s.motors.size());
   c.count("outputs.constraint_forces", s.outputs.constraint_forces.size());
   c.count("outputs.bodies", s.outputs.bodies.size());
   c.count("validation.thresholds", s.validation.thresholds.size());
@@ -154,7 +161,8 @@ void check_scene(const Scene& s) {
   // Names first, so that the fields below can name items by name.
   std::set<std::string> names;
   for (size_t i = 0; i < s.bodies.size(); ++i) {
-    if (s.bodies[i].name == kGround) fail(fmt::format("bodies[{}].name", i), "'ground' is reserved");
+    if (s.bodies[i].name == kGround)
+      fail(fmt::format("bodies[{}].name", i), "'ground' is reserved");
     c.name("bodies", i, s.bodies[i].name, names);
   }
   names.clear();
@@ -179,8 +187,8 @@ void check_scene(const Scene& s) {
   for (const auto& b : s.bodies) {
     const std::string f = "bodies." + b.name;
     c.in_range(f + ".mass_kg", b.mass_kg, limits::kMinMass_kg, limits::kMaxMass_kg, "kg");
-    c.in_range(f + ".inertia_kgm2", b.inertia_kgm2, limits::kMinInertia_kgm2, limits::kMaxInertia_kgm2,
-               "kg·m²");
+    c.in_range(f + ".inertia_kgm2", b.inertia_kgm2, limits::kMinInertia_kgm2,
+               limits::kMaxInertia_kgm2, "kg·m²");
     c.point(f + ".com_m", b.com_m);
     c.points(f + ".points", b.points);
   }
@@ -190,11 +198,13 @@ void check_scene(const Scene& s) {
   std::map<std::string, std::string> parent_of;
   for (const auto& j : s.joints) {
     const std::string f = "joints." + j.name;
-    if (!is_body_or_ground(j.parent)) fail(f + ".parent", "unknown body '" + printable(j.parent) + "'");
+    if (!is_body_or_ground(j.parent))
+      fail(f + ".parent", "unknown body '" + printable(j.parent) + "'");
     if (!s.find_body(j.child)) fail(f + ".child", "unknown body '" + printable(j.child) + "'");
     if (j.parent == j.child) fail(f + ".child", "a joint cannot join a body to itself");
     if (parent_of.count(j.child))
-      fail(f + ".child", "body '" + j.child + "' is already the child of another joint; "
+      fail(f + ".child", "body '" + j.child +
+                             "' is already the child of another joint; "
                              "close loops with 'loops', not with a second joint");
     parent_of[j.child] = j.parent;
     c.point(f + ".parent_point", j.parent_point);
@@ -219,8 +229,10 @@ void check_scene(const Scene& s) {
 
   for (const auto& l : s.loops) {
     const std::string f = "loops." + l.name;
-    if (!is_body_or_ground(l.body_a)) fail(f + ".body_a", "unknown body '" + printable(l.body_a) + "'");
-    if (!is_body_or_ground(l.body_b)) fail(f + ".body_b", "unknown body '" + printable(l.body_b) + "'");
+    if (!is_body_or_ground(l.body_a))
+      fail(f + ".body_a", "unknown body '" + printable(l.body_a) + "'");
+    if (!is_body_or_ground(l.body_b))
+      fail(f + ".body_b", "unknown body '" + printable(l.body_b) + "'");
     if (l.body_a == l.body_b) fail(f, "a loop must join two different bodies");
     c.point(f + ".point_a", l.point_a);
     c.point(f + ".point_b", l.point_b);
@@ -233,8 +245,9 @@ void check_scene(const Scene& s) {
     if (!b) fail(f + ".driven", "unknown joint '" + printable(g.driven) + "'");
     // A joint geared to itself is no constraint at all (rate = r·rate is 0 = 0 for r = 1, or
     // freezes the joint otherwise), yet it would be counted as one in the mobility below.
-    if (a == b) fail(f + ".driven", "a gear must couple two different joints (driver and driven are both '" +
-                                        g.driver + "')");
+    if (a == b)
+      fail(f + ".driven", "a gear must couple two different joints (driver and driven are both '" +
+                              g.driver + "')");
     if (a->type != JointType::Revolute || b->type != JointType::Revolute)
       fail(f, "gears couple two revolute joints");
     if (!std::isfinite(g.ratio) || std::abs(g.ratio) < limits::kMinGearRatio ||
@@ -262,7 +275,8 @@ void check_scene(const Scene& s) {
     const std::string f = "loads." + t.name;
     check_joint_ref(f + ".joint", t.joint);
     const bool prismatic = s.find_joint(t.joint)->type == JointType::Prismatic;
-    c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce, prismatic ? "N" : "N·m");
+    c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce,
+                  prismatic ? "N" : "N·m");
     if (t.active_when) check_joint_ref(f + ".active_when.joint", t.active_when->joint);
   }
   for (const auto& r : s.resistances) {
@@ -272,17 +286,21 @@ void check_scene(const Scene& s) {
     const double max_c = b->inertia_kgm2 / limits::kMinResistanceTimeConstant_s;
     if (!std::isfinite(r.coefficient) || r.coefficient < 0.0 || r.coefficient > max_c)
       fail(f + ".coefficient",
-           fmt::format("must be in [0, {:g}] = inertia of '{}' / {:g} s, so that the resistance alone "
-                       "cannot change its speed faster than that time constant (got {:g})",
-                       max_c, b->name, limits::kMinResistanceTimeConstant_s, r.coefficient));
+           fmt::format(
+               "must be in [0, {:g}] = inertia of '{}' / {:g} s, so that the resistance alone "
+               "cannot change its speed faster than that time constant (got {:g})",
+               max_c, b->name, limits::kMinResistanceTimeConstant_s, r.coefficient));
   }
   for (const auto& sp : s.springs) {
     const std::string f = "loads." + sp.name;
-    if (!is_body_or_ground(sp.body_a)) fail(f + ".body_a", "unknown body '" + printable(sp.body_a) + "'");
-    if (!is_body_or_ground(sp.body_b)) fail(f + ".body_b", "unknown body '" + printable(sp.body_b) + "'");
+    if (!is_body_or_ground(sp.body_a))
+      fail(f + ".body_a", "unknown body '" + printable(sp.body_a) + "'");
+    if (!is_body_or_ground(sp.body_b))
+      fail(f + ".body_b", "unknown body '" + printable(sp.body_b) + "'");
     c.point(f + ".point_a", sp.point_a);
     c.point(f + ".point_b", sp.point_b);
-    c.in_range(f + ".stiffness_N_per_m", sp.stiffness_N_per_m, 0.0, limits::kMaxStiffness_N_per_m, "N/m");
+    c.in_range(f + ".stiffness_N_per_m", sp.stiffness_N_per_m, 0.0, limits::kMaxStiffness_N_per_m,
+               "N/m");
     c.in_range(f + ".rest_length_m", sp.rest_length_m, 0.0, limits::kMaxCoordinate_m, "m");
   }
   for (const auto& m : s.motors) {
@@ -290,19 +308,21 @@ void check_scene(const Scene& s) {
     check_joint_ref(f + ".joint", m.joint);
     const bool prismatic = s.find_joint(m.joint)->type == JointType::Prismatic;
     const std::string speed = f + (prismatic ? ".no_load_speed_m_s" : ".no_load_speed_rad_s");
-    c.abs_at_most(f + (prismatic ? ".stall_force_N" : ".stall_torque_Nm"), m.stall_torque, limits::kMaxForce,
-                  prismatic ? "N" : "N·m");
+    c.abs_at_most(f + (prismatic ? ".stall_force_N" : ".stall_torque_Nm"), m.stall_torque,
+                  limits::kMaxForce, prismatic ? "N" : "N·m");
     if (!std::isfinite(m.no_load_speed) || std::abs(m.no_load_speed) < limits::kMinMotorSpeed ||
         std::abs(m.no_load_speed) > limits::kMaxRate)
-      fail(speed, fmt::format("must be finite with |value| in [{:g}, {:g}] (got {:g})", limits::kMinMotorSpeed,
-                              limits::kMaxRate, m.no_load_speed));
+      fail(speed, fmt::format("must be finite with |value| in [{:g}, {:g}] (got {:g})",
+                              limits::kMinMotorSpeed, limits::kMaxRate, m.no_load_speed));
     // τ = stall·(1 − rate/no_load_speed) drives the rate toward no_load_speed only when both have
     // the same sign; with opposite signs the torque grows with the speed it produces (a runaway).
     if (m.stall_torque * m.no_load_speed < 0.0)
-      fail(speed, fmt::format("has the opposite sign of the stall torque ({:g} vs {:g}): such a motor pushes "
-                              "harder the faster it turns and runs away; give both the sign of the "
-                              "direction it drives",
-                              m.no_load_speed, m.stall_torque));
+      fail(speed,
+           fmt::format(
+               "has the opposite sign of the stall torque ({:g} vs {:g}): such a motor pushes "
+               "harder the faster it turns and runs away; give both the sign of the "
+               "direction it drives",
+               m.no_load_speed, m.stall_torque));
   }
   for (size_t i = 0; i < s.outputs.constraint_forces.size(); ++i) {
     const auto& cf = s.outputs.constraint_forces[i];
@@ -331,17 +351,22 @@ void check_scene(const Scene& s) {
 
   const auto& sim = s.simulation;
   if (!(sim.duration_s > 0.0 && sim.duration_s <= limits::kMaxDuration_s))
-    fail("simulation.duration_s", fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
-  c.in_range("simulation.output_interval_s", sim.output_interval_s, limits::kMinOutputInterval_s, sim.duration_s, "s");
+    fail("simulation.duration_s",
+         fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
+  c.in_range("simulation.output_interval_s", sim.output_interval_s, limits::kMinOutputInterval_s,
+             sim.duration_s, "s");
   const double longest = std::max(sim.duration_s, s.validation.duration_s);
   if (longest / sim.output_interval_s > limits::kMaxOutputRows)
     fail("simulation.output_interval_s",
-         fmt::format("{:g} s over {:g} s gives {:g} output rows; at most {:g}", sim.output_interval_s, longest,
-                     longest / sim.output_interval_s, limits::kMaxOutputRows));
-  c.in_range("simulation.tolerance", sim.tolerance, limits::kMinTolerance, limits::kMaxTolerance, "");
+         fmt::format("{:g} s over {:g} s gives {:g} output rows; at most {:g}",
+                     sim.output_interval_s, longest, longest / sim.output_interval_s,
+                     limits::kMaxOutputRows));
+  c.in_range("simulation.tolerance", sim.tolerance, limits::kMinTolerance, limits::kMaxTolerance,
+             "");
 
   const auto& v = s.validation;
-  c.in_range("validation.duration_s", v.duration_s, 0.0, limits::kMaxDuration_s, "s (0: simulation.duration_s)");
+  c.in_range("validation.duration_s", v.duration_s, 0.0, limits::kMaxDuration_s,
+             "s (0: simulation.duration_s)");
   c.in_range("validation.reference_tolerance", v.reference_tolerance, limits::kMinTolerance,
              limits::kMaxReferenceTolerance, "");
   for (size_t i = 0; i < v.thresholds.size(); ++i) {
@@ -350,33 +375,41 @@ void check_scene(const Scene& s) {
     bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
     for (const auto& cf : s.outputs.constraint_forces) known |= cf.name == th.quantity;
     if (!known)
-      fail(f + ".quantity", fmt::format("'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
-                                        printable(th.quantity)));
+      fail(f + ".quantity",
+           fmt::format(
+               "'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
+               printable(th.quantity)));
     if (!th.interpolation.empty() && !is_valid_name(th.interpolation))
-      fail(f + ".interpolation", fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
+      fail(f + ".interpolation",
+           fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
     if (!(th.max_error > 0.0 && th.max_error <= 1.0))
       fail(f + ".max_error", fmt::format("must be in (0, 1] (a fraction; got {:g})", th.max_error));
     c.in_range(f + ".grid_deg", th.grid_deg, limits::kMinGrid_deg, limits::kMaxGrid_deg, "degrees");
     // The table is periodic over one turn: the grid must divide 360° into whole steps.
     const double steps = 360.0 / th.grid_deg;
     if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
-      fail(f + ".grid_deg", fmt::format("{:g}° does not divide 360° into whole steps", th.grid_deg));
+      fail(f + ".grid_deg",
+           fmt::format("{:g}° does not divide 360° into whole steps", th.grid_deg));
   }
   if (v.calibrate_cadence_Hz != 0.0 || v.calibrate_power_W != 0.0) {
     if (!(v.calibrate_cadence_Hz > 0.0 && v.calibrate_cadence_Hz <= limits::kMaxCadence_Hz))
       fail("validation.calibrate.cadence_Hz",
-           fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz, v.calibrate_cadence_Hz));
+           fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz,
+                       v.calibrate_cadence_Hz));
     if (!(v.calibrate_power_W > 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
-      fail("validation.calibrate.power_W",
-           fmt::format("must be in (0, {:g}] W (got {:g})", limits::kMaxPower_W, v.calibrate_power_W));
+      fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
+                                                       limits::kMaxPower_W, v.calibrate_power_W));
   }
 }
 
 double resistance_torque(ResistanceLaw law, double c, double w) {
   switch (law) {
-    case ResistanceLaw::Constant: return w > 0 ? -c : w < 0 ? c : 0.0;
-    case ResistanceLaw::Viscous: return -c * w;
-    case ResistanceLaw::Quadratic: return -c * w * std::abs(w);
+    case ResistanceLaw::Constant:
+      return w > 0 ? -c : w < 0 ? c : 0.0;
+    case ResistanceLaw::Viscous:
+      return -c * w;
+    case ResistanceLaw::Quadratic:
+      return -c * w * std::abs(w);
   }
   return 0.0;
 }

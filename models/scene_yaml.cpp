@@ -1,6 +1,8 @@
 #include "models/scene_yaml.hpp"
 
+#include <fmt/format.h>
 #include <sys/stat.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +10,6 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-
-#include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include "models/bicycle_leg.hpp"
 
@@ -59,38 +58,49 @@ constexpr size_t kMaxOverrideKeyLength = 1024;
 // Walks the tree once: keys are unique scalars, every mapping and list has at most
 // limits::kMaxItems entries, every scalar at most limits::kMaxTextLength characters, the
 // nesting at most kMaxDepth and the walk (aliases expanded) at most kMaxTreeNodes visits.
-void check_yaml_tree(const YAML::Node& node, const std::string& file, const std::string& path, int depth,
-                     size_t& visits) {
+void check_yaml_tree(const YAML::Node& node, const std::string& file, const std::string& path,
+                     int depth, size_t& visits) {
   auto fail = [&](const YAML::Node& at, const std::string& field, const std::string& msg) {
     // A path through a cycle is as long as the depth limit allows: keep the message readable.
-    throw SceneError(file, line_of(at), field.size() > 100 ? field.substr(0, 100) + "…" : field, msg);
+    throw SceneError(file, line_of(at), field.size() > 100 ? field.substr(0, 100) + "…" : field,
+                     msg);
   };
   if (++visits > kMaxTreeNodes)
-    fail(node, path, fmt::format("the YAML tree has more than {} nodes (aliases expanded); a scene needs far fewer",
-                                 kMaxTreeNodes));
+    fail(node, path,
+         fmt::format(
+             "the YAML tree has more than {} nodes (aliases expanded); a scene needs far fewer",
+             kMaxTreeNodes));
   if (depth > kMaxDepth)
-    fail(node, path, fmt::format("nested more than {} levels deep (or an alias refers to its own ancestor)", kMaxDepth));
+    fail(node, path,
+         fmt::format("nested more than {} levels deep (or an alias refers to its own ancestor)",
+                     kMaxDepth));
   auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
   if (node.IsScalar()) {
     if (node.Scalar().size() > limits::kMaxTextLength)
-      fail(node, path, fmt::format("a value of {} characters; at most {}", node.Scalar().size(), limits::kMaxTextLength));
+      fail(node, path,
+           fmt::format("a value of {} characters; at most {}", node.Scalar().size(),
+                       limits::kMaxTextLength));
   } else if (node.IsSequence()) {
     if (node.size() > limits::kMaxItems)
-      fail(node, path, fmt::format("a list of {} items; at most {}", node.size(), limits::kMaxItems));
+      fail(node, path,
+           fmt::format("a list of {} items; at most {}", node.size(), limits::kMaxItems));
     for (size_t i = 0; i < node.size(); ++i)
       check_yaml_tree(node[i], file, path + fmt::format("[{}]", i), depth + 1, visits);
   } else if (node.IsMap()) {
     if (node.size() > limits::kMaxItems)
-      fail(node, path, fmt::format("a mapping of {} keys; at most {}", node.size(), limits::kMaxItems));
+      fail(node, path,
+           fmt::format("a mapping of {} keys; at most {}", node.size(), limits::kMaxItems));
     std::map<std::string, int> first_line;  // key → line of its first occurrence
     for (const auto& kv : node) {
-      if (!kv.first.IsScalar()) fail(kv.first, path, "a key must be plain text, not a list or mapping");
+      if (!kv.first.IsScalar())
+        fail(kv.first, path, "a key must be plain text, not a list or mapping");
       const std::string& key = kv.first.Scalar();
       const std::string shown = key.size() > 64 ? key.substr(0, 64) + "…" : key;
       // yaml-cpp keeps both entries of a repeated key and reads the first: refuse instead.
       const auto [it, inserted] = first_line.emplace(key, line_of(kv.first));
       if (!inserted)
-        fail(kv.first, child(shown), fmt::format("duplicate key '{}' (first given at line {})", shown, it->second));
+        fail(kv.first, child(shown),
+             fmt::format("duplicate key '{}' (first given at line {})", shown, it->second));
       check_yaml_tree(kv.second, file, child(shown), depth + 1, visits);
     }
   }
@@ -106,15 +116,21 @@ void check_yaml_tree(const YAML::Node& root, const std::string& file) {
 YAML::Node load_checked_yaml(const std::string& text, const std::string& file) {
   // Refuse anything huge before the YAML parser sees it.
   if (text.size() > kMaxSceneBytes)
-    throw SceneError(file, 0, "", fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
+    throw SceneError(
+        file, 0, "",
+        fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
   {  // flow nesting, counted conservatively (brackets inside quotes count too)
     int depth = 0, max_depth = 0;
     for (char c : text) {
-      if (c == '[' || c == '{') max_depth = std::max(max_depth, ++depth);
-      else if ((c == ']' || c == '}') && depth > 0) --depth;
+      if (c == '[' || c == '{')
+        max_depth = std::max(max_depth, ++depth);
+      else if ((c == ']' || c == '}') && depth > 0)
+        --depth;
     }
     if (max_depth > kMaxDepth)
-      throw SceneError(file, 0, "", fmt::format("nested too deeply for a scene (more than {} levels of [ or {{)", kMaxDepth));
+      throw SceneError(
+          file, 0, "",
+          fmt::format("nested too deeply for a scene (more than {} levels of [ or {{)", kMaxDepth));
   }
   if (text.find('\0') != std::string::npos)
     throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
@@ -125,7 +141,8 @@ YAML::Node load_checked_yaml(const std::string& text, const std::string& file) {
     throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
   }
   if (!root || root.IsNull()) throw SceneError(file, 0, "", "the scene file is empty");
-  if (!root.IsMap()) throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
+  if (!root.IsMap())
+    throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
   check_yaml_tree(root, file);
   return root;
 }
@@ -157,7 +174,8 @@ YAML::Node locate_field(const YAML::Node& root, const std::string& field) {
         ok = true;
       }
       for (size_t k = 0; k < cur.size() && !ok; ++k)
-        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() && cur[k]["name"].Scalar() == key) {
+        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
+            cur[k]["name"].Scalar() == key) {
           next.reset(cur[k]);
           ok = true;
         }
@@ -180,8 +198,10 @@ struct Context {
       if (n.IsDefined() && node.is(n)) return &path;
     return nullptr;
   }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& field, const std::string& msg) const {
-    if (const std::string* o = override_of(n)) throw SceneError(file, 0, "--set " + *o, field + ": " + msg);
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& field,
+                         const std::string& msg) const {
+    if (const std::string* o = override_of(n))
+      throw SceneError(file, 0, "--set " + *o, field + ": " + msg);
     throw SceneError(file, line_of(n), field, msg);
   }
 };
@@ -190,7 +210,8 @@ struct Context {
 // SceneError with file, line and dotted field path.
 class Fields {
  public:
-  Fields(const YAML::Node& node, std::string path, const Context& ctx, std::vector<std::string> allowed)
+  Fields(const YAML::Node& node, std::string path, const Context& ctx,
+         std::vector<std::string> allowed)
       : node_(node), path_(std::move(path)), ctx_(ctx), allowed_(std::move(allowed)) {
     if (!node_.IsMap()) fail_at(node_, path_, "expected a mapping of keys to values");
     for (const auto& kv : node_) {
@@ -231,12 +252,14 @@ class Fields {
   // so the message quotes what the user typed.
   double num_abs_max(const std::string& k, double def, double max, const char* unit) const {
     const double v = num_or(k, def);
-    if (std::abs(v) > max) fail(k, fmt::format("must be finite with |value| ≤ {:g} {} (got {:g})", max, unit, v));
+    if (std::abs(v) > max)
+      fail(k, fmt::format("must be finite with |value| ≤ {:g} {} (got {:g})", max, unit, v));
     return v;
   }
   double num_in(const std::string& k, double lo, double hi, const char* unit) const {
     const double v = num(k);
-    if (v < lo || v > hi) fail(k, fmt::format("must be in [{:g}, {:g}] {} (got {:g})", lo, hi, unit, v));
+    if (v < lo || v > hi)
+      fail(k, fmt::format("must be in [{:g}, {:g}] {} (got {:g})", lo, hi, unit, v));
     return v;
   }
   std::string str(const std::string& k) const {
@@ -269,7 +292,8 @@ class Fields {
     const std::string text = n.Scalar();
     if (!YAML::convert<double>::decode(n, v) || text.empty())
       fail_at(n, field, fmt::format("expected a number, got '{}'", text.substr(0, 40)));
-    if (!std::isfinite(v)) fail_at(n, field, fmt::format("must be finite, got '{}'", text.substr(0, 40)));
+    if (!std::isfinite(v))
+      fail_at(n, field, fmt::format("must be finite, got '{}'", text.substr(0, 40)));
     return v;
   }
   Vec2 to_vec2(const YAML::Node& n, const std::string& field) const {
@@ -316,15 +340,18 @@ Vec2 read_point(const Fields& f, const std::string& key, const std::string& body
 std::vector<std::string> split_key_path(const std::string& path) {
   std::vector<std::string> parts(1);
   for (char c : path) {
-    if (c == '.') parts.emplace_back();
-    else parts.back() += c;
+    if (c == '.')
+      parts.emplace_back();
+    else
+      parts.back() += c;
   }
   return parts;
 }
 
 // A list index: digits only, below `size`.
 bool parse_index(const std::string& text, size_t size, size_t& index) {
-  if (text.empty() || text.size() > 9 || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+  if (text.empty() || text.size() > 9 ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
     return false;
   index = std::stoul(text);
   return index < size;
@@ -335,9 +362,7 @@ bool parse_index(const std::string& text, size_t size, size_t& index) {
 void apply_override(YAML::Node root, const Override& o, const std::string& file,
                     std::vector<std::pair<YAML::Node, std::string>>* touched = nullptr) {
   const std::vector<std::string> parts = split_key_path(o.path);
-  auto fail = [&](const std::string& msg) {
-    throw SceneError(file, 0, "--set " + o.path, msg);
-  };
+  auto fail = [&](const std::string& msg) { throw SceneError(file, 0, "--set " + o.path, msg); };
   if (std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
     fail("malformed key path (empty part)");
   YAML::Node cur;
@@ -353,13 +378,15 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
         found = true;
       } else {
         for (size_t k = 0; k < cur.size() && !found; ++k)
-          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() && cur[k]["name"].Scalar() == key) {
+          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
+              cur[k]["name"].Scalar() == key) {
             next.reset(cur[k]);
             found = true;
           }
       }
       if (!found)
-        fail(fmt::format("no list item '{}' (an index below {} or an item's name)", key, cur.size()));
+        fail(fmt::format("no list item '{}' (an index below {} or an item's name)", key,
+                         cur.size()));
     } else if (cur.IsMap()) {
       if (!cur[key]) {
         cur[key] = YAML::Node(YAML::NodeType::Map);  // allows setting a generator default
@@ -448,7 +475,8 @@ void read_mechanism(const Fields& top, Scene& s) {
     b.mass_kg = f.num("mass_kg");  // ranges: check_scene
     b.com_m = f.has("com_m") ? f.vec2("com_m") : Vec2{};
     b.inertia_kgm2 = f.num("inertia_kgm2");
-    if (s.find_body(b.name) || b.name == kGround) f.fail("name", "duplicate body name '" + b.name + "'");
+    if (s.find_body(b.name) || b.name == kGround)
+      f.fail("name", "duplicate body name '" + b.name + "'");
     if (f.has("points")) {
       const YAML::Node pts = f.raw("points");
       if (!pts.IsMap()) f.fail("points", "expected a mapping name: [x, y]");
@@ -465,12 +493,16 @@ void read_mechanism(const Fields& top, Scene& s) {
     Joint j;
     j.name = f.name("name");
     const std::string type = f.str("type");
-    if (type == "revolute") j.type = JointType::Revolute;
-    else if (type == "prismatic") j.type = JointType::Prismatic;
-    else f.fail("type", "expected revolute or prismatic");
+    if (type == "revolute")
+      j.type = JointType::Revolute;
+    else if (type == "prismatic")
+      j.type = JointType::Prismatic;
+    else
+      f.fail("type", "expected revolute or prismatic");
     j.parent = f.str("parent");
     j.child = f.str("child");
-    if (j.parent != kGround && !s.find_body(j.parent)) f.fail("parent", "unknown body '" + j.parent + "'");
+    if (j.parent != kGround && !s.find_body(j.parent))
+      f.fail("parent", "unknown body '" + j.parent + "'");
     if (!s.find_body(j.child)) f.fail("child", "unknown body '" + j.child + "'");
     j.parent_point = f.has("parent_point") ? read_point(f, "parent_point", j.parent, s) : Vec2{};
     j.child_point = f.has("child_point") ? read_point(f, "child_point", j.child, s) : Vec2{};
@@ -479,10 +511,12 @@ void read_mechanism(const Fields& top, Scene& s) {
       const double len = std::hypot(j.axis.x, j.axis.y);
       if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
       j.axis = {j.axis.x / len, j.axis.y / len};
-      if (f.has("offset_deg") || f.has("guess_deg")) f.fail("type", "prismatic joints take guess_m, not degrees");
+      if (f.has("offset_deg") || f.has("guess_deg"))
+        f.fail("type", "prismatic joints take guess_m, not degrees");
       j.guess = f.num_or("guess_m", 0.0);
     } else {
-      if (f.has("axis") || f.has("guess_m")) f.fail("type", "revolute joints take guess_deg and no axis");
+      if (f.has("axis") || f.has("guess_m"))
+        f.fail("type", "revolute joints take guess_deg and no axis");
       const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
       j.offset_rad = f.num_abs_max("offset_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
       j.guess = f.num_abs_max("guess_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
@@ -515,22 +549,29 @@ struct PendingDissipation {
 void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pending) {
   std::set<std::string> names;
   for_each_item(top, "loads", [&](const YAML::Node& n, const std::string& path) {
-    if (!n.IsMap() || !n["type"]) throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
+    if (!n.IsMap() || !n["type"])
+      throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
     const std::string type = n["type"].as<std::string>();
     if (n["name"] && (!n["name"].IsScalar() || !is_valid_name(n["name"].Scalar())))
-      top.ctx().fail(n["name"], path + ".name", invalid_name_message(n["name"].IsScalar() ? n["name"].Scalar() : "(not text)"));
+      top.ctx().fail(
+          n["name"], path + ".name",
+          invalid_name_message(n["name"].IsScalar() ? n["name"].Scalar() : "(not text)"));
     const std::string name = n["name"] ? n["name"].Scalar() : fmt::format("load{}", names.size());
     if (!names.insert(name).second)
-      throw SceneError(top.file(), line_of(n), path + ".name", "duplicate load name '" + name + "'");
+      throw SceneError(top.file(), line_of(n), path + ".name",
+                       "duplicate load name '" + name + "'");
     if (type == "joint_torque") {
-      Fields f(n, path, top.ctx(), {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
+      Fields f(n, path, top.ctx(),
+               {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
       JointTorque t{name, f.str("joint"), 0.0, std::nullopt};
-      if (f.has("torque_Nm") == f.has("force_N")) f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
+      if (f.has("torque_Nm") == f.has("force_N"))
+        f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
       t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num("force_N");
       if (f.has("active_when")) {
         Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
         const std::string rate = g.str("rate");
-        if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+        if (rate != "positive" && rate != "negative")
+          g.fail("rate", "expected positive or negative");
         t.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
       }
       s.joint_torques.push_back(t);
@@ -546,13 +587,15 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
         const double power_W = d.num_in("power_W", 0.0, limits::kMaxPower_W, "W");
         const double cadence_Hz = d.num("cadence_Hz");
         if (!(cadence_Hz > 0.0 && cadence_Hz <= limits::kMaxCadence_Hz))
-          d.fail("cadence_Hz", fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz, cadence_Hz));
+          d.fail("cadence_Hz", fmt::format("must be in (0, {:g}] Hz (got {:g})",
+                                           limits::kMaxCadence_Hz, cadence_Hz));
         pending.push_back({s.resistances.size(), power_W, cadence_Hz, d.line()});
       }
       s.resistances.push_back(r);
     } else if (type == "spring") {
       Fields f(n, path, top.ctx(),
-               {"type", "name", "body_a", "point_a", "body_b", "point_b", "stiffness_N_per_m", "rest_length_m"});
+               {"type", "name", "body_a", "point_a", "body_b", "point_b", "stiffness_N_per_m",
+                "rest_length_m"});
       Spring sp;
       sp.name = name;
       sp.body_a = f.str("body_a");
@@ -568,21 +611,23 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
                 "no_load_speed_m_s"});
       Motor m{name, f.str("joint"), 0.0, 0.0};
       m.stall_torque = f.has("stall_force_N") ? f.num("stall_force_N") : f.num("stall_torque_Nm");
-      m.no_load_speed = f.has("no_load_speed_m_s") ? f.num("no_load_speed_m_s") : f.num("no_load_speed_rad_s");
+      m.no_load_speed =
+          f.has("no_load_speed_m_s") ? f.num("no_load_speed_m_s") : f.num("no_load_speed_rad_s");
       s.motors.push_back(m);
     } else {
-      throw SceneError(top.file(), line_of(n["type"]), path + ".type",
-                       "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
+      throw SceneError(
+          top.file(), line_of(n["type"]), path + ".type",
+          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
     }
   });
 }
 
 // Reads the YAML tree into `s` (names and shapes checked here, values by check_scene).
 void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
-  Fields top(root, "", ctx,
-             {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops",
-              "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation",
-              "validation"});
+  Fields top(
+      root, "", ctx,
+      {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
+       "independent", "loads", "gravity", "outputs", "initial", "simulation", "validation"});
   s.name = top.name("name");
   s.description = top.str_or("description", "");
 
@@ -593,19 +638,23 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
     // Ranges in SI are check_scene's; the converted units are checked here, where the
     // message can quote them (the generator places the mechanism at q before that).
-    s.initial.q = f.has("q_deg") ? f.num_abs_max("q_deg", 0.0, limits::kMaxAngle_rad * 180.0 / kPi, "degrees") * kPi / 180.0
+    s.initial.q = f.has("q_deg") ? f.num_abs_max("q_deg", 0.0, limits::kMaxAngle_rad * 180.0 / kPi,
+                                                 "degrees") *
+                                       kPi / 180.0
                                  : f.num_abs_max("q", 0.0, limits::kMaxAngle_rad, "rad or m");
-    s.initial.qdot = f.has("cadence_Hz")
-                         ? f.num_abs_max("cadence_Hz", 0.0, limits::kMaxRate / (2.0 * kPi), "Hz") * 2.0 * kPi
-                         : f.num_or("qdot", 0.0);
+    s.initial.qdot =
+        f.has("cadence_Hz")
+            ? f.num_abs_max("cadence_Hz", 0.0, limits::kMaxRate / (2.0 * kPi), "Hz") * 2.0 * kPi
+            : f.num_or("qdot", 0.0);
   }
   if (top.has("bicycle_leg")) {
     for (const char* k : {"bodies", "joints", "loops", "gears", "independent", "ground_points"})
-      if (top.has(k)) top.fail(k, "a bicycle_leg scene generates its own mechanism; remove this key");
+      if (top.has(k))
+        top.fail(k, "a bicycle_leg scene generates its own mechanism; remove this key");
     Fields f(top.raw("bicycle_leg"), "bicycle_leg", ctx,
              {"subject", "legs", "crank_length_m", "crank_mass_kg", "seat_tube_angle_deg",
-              "knee_flexion_at_extension_deg", "ankle_angle_deg", "pedal_stack_m",
-              "hip_torque_Nm", "flywheel", "resistance"});
+              "knee_flexion_at_extension_deg", "ankle_angle_deg", "pedal_stack_m", "hip_torque_Nm",
+              "flywheel", "resistance"});
     read_bicycle_leg(f, s);
   } else {
     read_mechanism(top, s);
@@ -615,7 +664,8 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   for (const auto& p : pending) {
     Resistance& r = s.resistances[p.index];
     if (!s.find_body(r.body))
-      throw SceneError(ctx.file, p.line, "loads." + r.name + ".body", "unknown body '" + r.body + "'");
+      throw SceneError(ctx.file, p.line, "loads." + r.name + ".body",
+                       "unknown body '" + r.body + "'");
     const auto ratio = fixed_speed_ratio(s, r.body);
     if (!ratio)
       throw SceneError(ctx.file, p.line, "loads." + r.name + ".dissipates",
@@ -657,14 +707,16 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     }
   }
   if (top.has("simulation")) {
-    Fields f(top.raw("simulation"), "simulation", ctx, {"duration_s", "output_interval_s", "tolerance"});
+    Fields f(top.raw("simulation"), "simulation", ctx,
+             {"duration_s", "output_interval_s", "tolerance"});
     s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
     s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
     s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
   }
   if (top.has("validation")) {
     Fields f(top.raw("validation"), "validation", ctx,
-             {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance", "reference_integrator"});
+             {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
+              "reference_integrator"});
     s.validation.duration_s = f.num_or("duration_s", 0.0);
     s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
     s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
@@ -700,9 +752,11 @@ Override parse_override(const std::string& text) {
   if (eq == 0) throw SceneError("", 0, "--set " + shown, "expected key.path=value (empty key)");
   Override o{text.substr(0, eq), text.substr(eq + 1)};
   if (o.path.size() > kMaxOverrideKeyLength)
-    throw SceneError("", 0, "--set " + shown, fmt::format("key path longer than {} characters", kMaxOverrideKeyLength));
+    throw SceneError("", 0, "--set " + shown,
+                     fmt::format("key path longer than {} characters", kMaxOverrideKeyLength));
   if (o.value.size() > limits::kMaxTextLength)
-    throw SceneError("", 0, "--set " + shown, fmt::format("value longer than {} characters", limits::kMaxTextLength));
+    throw SceneError("", 0, "--set " + shown,
+                     fmt::format("value longer than {} characters", limits::kMaxTextLength));
   const auto parts = split_key_path(o.path);
   if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); }))
     throw SceneError("", 0, "--set " + shown, "malformed key path (an empty part between dots)");
@@ -754,7 +808,6 @@ Scene parse_scene(const std::string& text, const std::string& file,
   return s;
 }
 
-
 std::string read_scene_text(const std::string& name_or_path) {
   const std::string path = resolve_scene_path(name_or_path);
   std::ifstream in(path, std::ios::binary);
@@ -785,7 +838,8 @@ bool find_path(YAML::Node root, const std::string& path, YAML::Node& parent, std
       found = true;
     } else if (cur.IsSequence()) {
       for (size_t k = 0; k < cur.size() && !found; ++k)
-        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == parts[i]) next.reset(cur[k]), found = true;
+        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == parts[i])
+          next.reset(cur[k]), found = true;
     }
     if (!found) return false;
     cur.reset(next);
@@ -808,7 +862,8 @@ bool scene_yaml_has(const std::string& text, const std::string& path) {
   }
 }
 
-std::string rewrite_scene_yaml(const std::string& text, const std::string& file, const std::vector<Override>& overrides,
+std::string rewrite_scene_yaml(const std::string& text, const std::string& file,
+                               const std::vector<Override>& overrides,
                                const std::vector<std::string>& remove) {
   YAML::Node root = load_checked_yaml(text, file);
   for (const auto& path : remove) {

@@ -9,7 +9,8 @@
 //   cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DRDYN_FUZZ=ON -DRDYN_SANITIZE=ON \
 //         -DCMAKE_CXX_FLAGS=-fsanitize=fuzzer-no-link
 //   cmake --build build-fuzz --target rdyn_fuzz_scene
-//   ./build-fuzz/rdyn_fuzz_scene -max_total_time=600 -max_len=4096 build-fuzz/corpus tests/fuzz/corpus
+//   ./build-fuzz/rdyn_fuzz_scene -max_total_time=600 -max_len=4096 build-fuzz/corpus
+//   tests/fuzz/corpus
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -27,9 +28,10 @@ const std::map<std::string, std::string>& shipped_scenes() {
     std::map<std::string, std::string> t;
     for (const char* name : {"bicycle", "fourbar", "slider-crank"})
       t[name] = rdyn::models::read_scene_text(std::string(RDYN_SCENES_DIR) + "/" + name + ".yaml");
-    for (const char* name : {"coarse-grid", "high-cadence", "high-saddle", "light-flywheel", "motor-startup",
-                             "parallelogram", "stall", "thousand-cycles"})
-      t[name] = rdyn::models::read_scene_text(std::string(RDYN_SCENES_DIR) + "/hard/" + name + ".yaml");
+    for (const char* name : {"coarse-grid", "high-cadence", "high-saddle", "light-flywheel",
+                             "motor-startup", "parallelogram", "stall", "thousand-cycles"})
+      t[name] =
+          rdyn::models::read_scene_text(std::string(RDYN_SCENES_DIR) + "/hard/" + name + ".yaml");
     return t;
   }();
   return texts;
@@ -57,8 +59,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   static const std::string kSetMode = "--set\n";
   try {
-    if (text.compare(0, kSetMode.size(), kSetMode) == 0) fuzz_overrides(text.substr(kSetMode.size()));
-    else rdyn::models::parse_scene(text, "fuzz.yaml");
+    if (text.compare(0, kSetMode.size(), kSetMode) == 0)
+      fuzz_overrides(text.substr(kSetMode.size()));
+    else
+      rdyn::models::parse_scene(text, "fuzz.yaml");
   } catch (const rdyn::models::SceneError&) {
     // Refused with a message: the expected outcome for bad input.
   }

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -104,8 +103,9 @@ TEST(SceneYaml, UnknownKeySuggestsNearestAndNamesLine) {
 }
 
 TEST(SceneYaml, OverridesReachScalarsByPathAndName) {
-  const Scene s = parse_scene(kFourbar, "t.yaml", {parse_override("loads.bearing.coefficient=0.25"),
-                                                   parse_override("bodies.1.mass_kg=2.5")});
+  const Scene s = parse_scene(
+      kFourbar, "t.yaml",
+      {parse_override("loads.bearing.coefficient=0.25"), parse_override("bodies.1.mass_kg=2.5")});
   EXPECT_DOUBLE_EQ(s.resistances[0].coefficient, 0.25);
   EXPECT_DOUBLE_EQ(s.bodies[1].mass_kg, 2.5);
   const Scene b = load_scene("bicycle", {parse_override("bicycle_leg.hip_torque_Nm=50")});
@@ -119,7 +119,8 @@ TEST(SceneYaml, BadValuesAreRefusedWithTheirField) {
   std::string y = kFourbar;
   y.replace(y.find("mass_kg: 0.9"), 12, "mass_kg: 0.0");
   // check_scene names the item by name; the reader finds its line (the rocker is on line 7).
-  EXPECT_NE(error_of(y).find("test.yaml:7: field 'bodies.rocker.mass_kg'"), std::string::npos) << error_of(y);
+  EXPECT_NE(error_of(y).find("test.yaml:7: field 'bodies.rocker.mass_kg'"), std::string::npos)
+      << error_of(y);
   y = kFourbar;
   y.replace(y.find("mass_kg: 0.9"), 12, "mass_kg: .nan");
   EXPECT_NE(error_of(y).find("finite"), std::string::npos) << error_of(y);
@@ -171,14 +172,18 @@ TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
   struct Case {
     std::string yaml, field, second;  // scene, key path, text on the line of the repeated key
   };
-  const std::string bike = "name: b\nbicycle_leg:\n  legs: 2\n  flywheel: {gear_ratio: 3, gear_ratio: 2}\n";
+  const std::string bike =
+      "name: b\nbicycle_leg:\n  legs: 2\n  flywheel: {gear_ratio: 3, gear_ratio: 2}\n";
   const Case cases[] = {
       {fb + "name: again\n", "name", "name: again"},
       {with(fb, "mass_kg: 0.9,", "mass_kg: 0.9, mass_kg: 2,"), "bodies[2].mass_kg", "mass_kg: 2"},
-      {with(fb, "points: {C: [0.2, 0]}", "points: {C: [0.2, 0], C: [0.3, 0]}"), "bodies[2].points.C", "C: [0.3"},
+      {with(fb, "points: {C: [0.2, 0]}", "points: {C: [0.2, 0], C: [0.3, 0]}"),
+       "bodies[2].points.C", "C: [0.3"},
       {with(fb, "D: [0.3, 0]}", "D: [0.3, 0], A: [1, 1]}"), "ground_points.A", "A: [1, 1]"},
-      {with(fb, "coefficient: 1.0e-3}", "coefficient: 1.0e-3, law: quadratic}"), "loads[0].law", "law: quadratic"},
-      {fb + "validation:\n  duration_s: 1\n  note: x\n  duration_s: 2\n", "validation.duration_s", "duration_s: 2"},
+      {with(fb, "coefficient: 1.0e-3}", "coefficient: 1.0e-3, law: quadratic}"), "loads[0].law",
+       "law: quadratic"},
+      {fb + "validation:\n  duration_s: 1\n  note: x\n  duration_s: 2\n", "validation.duration_s",
+       "duration_s: 2"},
       {bike, "bicycle_leg.flywheel.gear_ratio", "gear_ratio: 2"},
   };
   for (const auto& c : cases) {
@@ -190,10 +195,12 @@ TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
 }
 
 TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
-  const std::string fb = std::string(kFourbar) +
-                         "outputs:\n  constraint_forces:\n    - {name: axial, joint: rocker, direction: C}\n";
+  const std::string fb =
+      std::string(kFourbar) +
+      "outputs:\n  constraint_forces:\n    - {name: axial, joint: rocker, direction: C}\n";
   // YAML spellings of a space, comma, quote, apostrophe, newline, slash, angle bracket, dot.
-  for (const std::string bad : {"'a b'", "'a,b'", "'a\"b'", "\"a'b\"", "\"a\\nb\"", "a/b", "'<b>'", "a.b", "1a"}) {
+  for (const std::string bad :
+       {"'a b'", "'a,b'", "'a\"b'", "\"a'b\"", "\"a\\nb\"", "a/b", "'<b>'", "a.b", "1a"}) {
     struct Case {
       std::string from, to, field;
     };
@@ -221,7 +228,9 @@ TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
 
 TEST(SceneYaml, DuplicateNamesWithinAKindAreRefused) {
   const std::string fb = kFourbar;
-  std::string y = with(fb, "independent:", "  - {name: C, body_a: coupler, point_a: C, body_b: crank, point_b: B}\nindependent:");
+  std::string y =
+      with(fb, "independent:",
+           "  - {name: C, body_a: coupler, point_a: C, body_b: crank, point_b: B}\nindependent:");
   EXPECT_EQ(refusal(y).field(), "loops[1].name");
   EXPECT_EQ(refusal(y).line(), line_in(y, "body_b: crank"));
   y = with(fb, "{name: coupler, type", "{name: crank, type");
@@ -244,27 +253,33 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
       {"guess_deg: 90", "guess_deg: 1.0e300", "joints[2].guess_deg"},
       {"coefficient: 1.0e-3", "coefficient: 1.0e9", "loads.bearing.coefficient"},
       {"coefficient: 1.0e-3", "coefficient: -1", "loads.bearing.coefficient"},
-      {"coefficient: 1.0e-3", "dissipates: {power_W: -5, cadence_Hz: 1}", "loads[0].dissipates.power_W"},
-      {"coefficient: 1.0e-3", "dissipates: {power_W: 5, cadence_Hz: 0}", "loads[0].dissipates.cadence_Hz"},
+      {"coefficient: 1.0e-3", "dissipates: {power_W: -5, cadence_Hz: 1}",
+       "loads[0].dissipates.power_W"},
+      {"coefficient: 1.0e-3", "dissipates: {power_W: 5, cadence_Hz: 0}",
+       "loads[0].dissipates.cadence_Hz"},
       {"gravity: {enabled: true}", "gravity: {g_m_s2: [0, -1.0e308]}", "gravity.g_m_s2[1]"},
       {"gravity: {enabled: true}", "initial: {q_deg: 1.0e300}", "initial.q_deg"},
       {"gravity: {enabled: true}", "initial: {cadence_Hz: -1.0e4}", "initial.cadence_Hz"},
       {"gravity: {enabled: true}", "initial: {qdot: 1.0e5}", "initial.qdot"},
       {"gravity: {enabled: true}", "simulation: {duration_s: 0}", "simulation.duration_s"},
       {"gravity: {enabled: true}", "simulation: {duration_s: 1.0e6}", "simulation.duration_s"},
-      {"gravity: {enabled: true}", "simulation: {output_interval_s: 1.0e-9}", "simulation.output_interval_s"},
+      {"gravity: {enabled: true}", "simulation: {output_interval_s: 1.0e-9}",
+       "simulation.output_interval_s"},
       {"gravity: {enabled: true}", "simulation: {duration_s: 1.0e4, output_interval_s: 1.0e-4}",
        "simulation.output_interval_s"},  // 1e8 rows
       {"gravity: {enabled: true}", "simulation: {tolerance: 1}", "simulation.tolerance"},
-      {"gravity: {enabled: true}", "validation: {thresholds: [{quantity: qdot, grid_deg: 7, max_error: 0.01}]}",
+      {"gravity: {enabled: true}",
+       "validation: {thresholds: [{quantity: qdot, grid_deg: 7, max_error: 0.01}]}",
        "validation.thresholds[0].grid_deg"},
-      {"gravity: {enabled: true}", "validation: {thresholds: [{quantity: qdot, grid_deg: 10, max_error: 2}]}",
+      {"gravity: {enabled: true}",
+       "validation: {thresholds: [{quantity: qdot, grid_deg: 10, max_error: 2}]}",
        "validation.thresholds[0].max_error"},
       {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 50, power_W: 10}}",
        "validation.calibrate.cadence_Hz"},
       {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 1.0e6}}",
        "validation.calibrate.power_W"},
-      {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}", "validation.reference_tolerance"},
+      {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}",
+       "validation.reference_tolerance"},
   };
   for (const auto& c : cases) {
     const std::string y = with(fb, c.from, c.to);
@@ -314,7 +329,8 @@ loads:
 }
 
 TEST(SceneYaml, AMotorRunningAwayIsRefused) {
-  const std::string y = with(read_scene_text("slider-crank"), "no_load_speed_rad_s: 60.0", "no_load_speed_rad_s: -60.0");
+  const std::string y = with(read_scene_text("slider-crank"), "no_load_speed_rad_s: 60.0",
+                             "no_load_speed_rad_s: -60.0");
   const SceneError e = refusal(y);
   EXPECT_EQ(e.field(), "loads.motor.no_load_speed_rad_s");
   EXPECT_EQ(e.line(), line_in(y, "no_load_speed_rad_s: -60.0"));
@@ -337,12 +353,13 @@ TEST(SceneYaml, MalformedOverridesAreRefusedNamingThem) {
     std::string override_text, field, says;
   };
   const Case cases[] = {
-      {"bodies.0.mas_kg=3", "--set bodies.0.mas_kg", "did you mean 'mass_kg'"},     // unknown key
-      {"nosuch=3", "--set nosuch", "unknown key"},                                  // unknown top-level key
-      {"bodies.1.mass_kg=heavy", "--set bodies.1.mass_kg", "expected a number"},    // not a number
-      {"bodies.7.mass_kg=1", "--set bodies.7.mass_kg", "no list item '7'"},         // index out of range
+      {"bodies.0.mas_kg=3", "--set bodies.0.mas_kg", "did you mean 'mass_kg'"},  // unknown key
+      {"nosuch=3", "--set nosuch", "unknown key"},  // unknown top-level key
+      {"bodies.1.mass_kg=heavy", "--set bodies.1.mass_kg", "expected a number"},  // not a number
+      {"bodies.7.mass_kg=1", "--set bodies.7.mass_kg", "no list item '7'"},  // index out of range
       {"bodies.rocker.points.C.2=1", "--set bodies.rocker.points.C.2", "no scalar list item"},
-      {"bodies.rocker.mass_kg=-1", "--set bodies.rocker.mass_kg", "must be in [1e-06"},  // out of range
+      {"bodies.rocker.mass_kg=-1", "--set bodies.rocker.mass_kg",
+       "must be in [1e-06"},  // out of range
       {"loads.bearing.coefficient=.nan", "--set loads.bearing.coefficient", "finite"},
       {"name=a b", "--set name", "not a valid name"},
       {"bodies=3", "--set bodies", "only scalar values"},
@@ -356,14 +373,16 @@ TEST(SceneYaml, MalformedOverridesAreRefusedNamingThem) {
 }
 
 TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
-  std::string laughs = "name: x\na0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";  // 10^30 nodes when expanded
+  std::string laughs =
+      "name: x\na0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";  // 10^30 nodes when expanded
   for (int i = 1; i < 30; ++i) {
     laughs += fmt::format("a{}: &a{} [", i, i);
     for (int k = 0; k < 10; ++k) laughs += fmt::format("{}*a{}", k ? ", " : "", i - 1);
     laughs += "]\n";
   }
   std::string many = "name: many\nbodies:\n";
-  for (int i = 0; i < 1001; ++i) many += fmt::format("  - {{name: b{}, mass_kg: 1, inertia_kgm2: 1}}\n", i);
+  for (int i = 0; i < 1001; ++i)
+    many += fmt::format("  - {{name: b{}, mass_kg: 1, inertia_kgm2: 1}}\n", i);
   std::string block_nest = "name: x\nbodies: ";
   for (int i = 0; i < 5000; ++i) block_nest += "- ";
   block_nest += "x\n";
@@ -376,14 +395,16 @@ TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
       {"1001 bodies", many, "at most 1000"},
       {"long string", "name: x\ndescription: " + std::string(5000, 'x') + "\n", "at most 4096"},
       {"long name", "name: " + std::string(65, 'x') + "\n", "not a valid name"},
-      {"deep flow", "name: x\nbodies: " + std::string(100, '[') + std::string(100, ']') + "\n", "nested too deeply"},
+      {"deep flow", "name: x\nbodies: " + std::string(100, '[') + std::string(100, ']') + "\n",
+       "nested too deeply"},
       {"deep block", block_nest, "test.yaml"},
       {"complex key", "name: x\n? [a, b]\n: 1\n", "plain text"},
   };
   for (const auto& c : cases) {
     const auto start = std::chrono::steady_clock::now();
     const SceneError e = refusal(c.yaml);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << c.what << ": " << e.what();
     EXPECT_LT(seconds, 2.0) << c.what;  // a walk over 10^30 nodes would never return
   }
