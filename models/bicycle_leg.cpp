@@ -1,8 +1,8 @@
 #include "models/bicycle_leg.hpp"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "models/anthropometry.hpp"
 
@@ -42,8 +42,8 @@ ShankFoot make_shank_foot(const BicycleLegParams& p, const LowerLimbFractions& f
   const Vec2 ball = add(sole_below_ankle, mul((kBallAlongSole - kAnkleAlongSole) * L_f, sole));
   const Vec2 pedal = add(ball, mul(p.pedal_stack_m, down));
   // Foot centre of mass at de Leva's fraction of heel→toe, half the ankle height up.
-  const Vec2 foot_com = add(add(ankle, mul(0.5 * h_a, down)),
-                            mul((f.foot.com - kAnkleAlongSole) * L_f, sole));
+  const Vec2 foot_com =
+      add(add(ankle, mul(0.5 * h_a, down)), mul((f.foot.com - kAnkleAlongSole) * L_f, sole));
   const Vec2 shank_com{f.shank.com * L_s, 0.0};
   const double m_s = f.shank.mass * p.mass_kg, m_f = f.foot.mass * p.mass_kg;
   const double I_s = m_s * std::pow(f.shank.gyration * L_s, 2);
@@ -118,14 +118,52 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw SceneError(s.source_file, 0, "bicycle_leg." + field, msg);
   };
-  if (!(p.height_m > 0.5 && p.height_m < 2.6)) fail("subject.height_m", "must be in (0.5, 2.6) m");
-  if (!(p.mass_kg > 10.0 && p.mass_kg < 400.0)) fail("subject.mass_kg", "must be in (10, 400) kg");
+  // Every input in a range a human on a bicycle can have; nothing is silently replaced.
+  struct Range {
+    const char* field;
+    double value, lo, hi;
+    bool lo_open;  // (lo, hi] instead of [lo, hi]: zero would mean "no such part"
+    const char* unit;
+  };
+  const Range ranges[] = {
+      // de Leva's (1996) fractions are adult proportions; this spans adult statures and masses.
+      {"subject.height_m", p.height_m, 0.5, 2.6, false, "m"},
+      {"subject.mass_kg", p.mass_kg, 10.0, 400.0, false, "kg"},
+      {"crank_length_m", p.crank_length_m, 0.05, 0.4, false, "m"},
+      {"crank_mass_kg", p.crank_mass_kg, 0.0, 20.0, true, "kg"},
+      // Seat-tube angles of road, time-trial and upright stationary bikes lie within 65–80°;
+      // the hip stays behind (or above) the bottom bracket for the closed-form leg pose.
+      {"seat_tube_angle_deg", p.seat_tube_angle_deg, 45.0, 90.0, false, "degrees"},
+      {"knee_flexion_at_extension_deg", p.knee_flexion_at_extension_deg, 0.0, 90.0, true,
+       "degrees"},
+      // Shank–sole angle: 90° neutral; the ankle's normal range is about 20° dorsiflexion to
+      // 50° plantar flexion (AAOS, Greene & Heckman 1994), i.e. 70–140°.
+      {"ankle_angle_deg", p.ankle_angle_deg, 70.0, 140.0, false, "degrees"},
+      {"pedal_stack_m", p.pedal_stack_m, 0.0, 0.1, false, "m"},
+      // 0: no drive (a coasting or stalling rider); peak isometric hip-extension torques of
+      // strong adults are a few hundred N·m.
+      {"hip_torque_Nm", p.hip_torque_Nm, 0.0, 1000.0, false, "N·m"},
+      {"flywheel.gear_ratio", p.gear_ratio, 0.1, 20.0, false, ""},
+      {"flywheel.inertia_kgm2", p.flywheel_inertia_kgm2.value_or(1.0), 0.0, 1000.0, true, "kg·m²"},
+      {"flywheel.mass_kg", p.flywheel_mass_kg, 0.0, 1000.0, true, "kg"},
+      {"flywheel.bike_mass_kg", p.bike_mass_kg, 0.0, 100.0, true, "kg"},
+      {"flywheel.wheel_radius_m", p.wheel_radius_m, 0.1, 0.5, false, "m"},
+      {"flywheel.wheel_inertia_kgm2", p.wheel_inertia_kgm2, 0.0, 1.0, true, "kg·m²"},
+      {"resistance.power_W", p.resistance_power_W, 0.0, limits::kMaxPower_W, false,
+       "W (0: no resistance)"},
+      {"resistance.cadence_Hz", p.resistance_cadence_Hz, 0.0, limits::kMaxCadence_Hz, true, "Hz"},
+  };
+  for (const Range& r : ranges) {
+    const bool ok =
+        std::isfinite(r.value) && (r.lo_open ? r.value > r.lo : r.value >= r.lo) && r.value <= r.hi;
+    if (!ok)
+      fail(r.field, fmt::format("must be in {}{:g}, {:g}]{}{} (got {:g})", r.lo_open ? "(" : "[",
+                                r.lo, r.hi, *r.unit ? " " : "", r.unit, r.value));
+  }
   if (p.legs != 1 && p.legs != 2) fail("legs", "must be 1 or 2");
-  if (!(p.crank_length_m > 0.05 && p.crank_length_m < 0.4))
-    fail("crank_length_m", "must be in (0.05, 0.4) m");
-  if (!(p.gear_ratio > 0.0) || !std::isfinite(p.gear_ratio)) fail("flywheel.gear_ratio", "must be positive");
-  if (!(p.knee_flexion_at_extension_deg > 0.0 && p.knee_flexion_at_extension_deg < 90.0))
-    fail("knee_flexion_at_extension_deg", "must be in (0, 90) degrees");
+  if (!std::isfinite(s.initial.q) || std::abs(s.initial.q) > limits::kMaxAngle_rad)
+    throw SceneError(s.source_file, 0, "initial.q",
+                     fmt::format("must be finite with |q| ≤ {:g} rad", limits::kMaxAngle_rad));
   Fit fit;
   try {
     fit = make_fit(p);
@@ -152,7 +190,8 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
     (flexion_at(mid) > target ? lo : hi) = mid;
   }
   const double D = 0.5 * (lo + hi) - p.crank_length_m;
-  if (D <= p.crank_length_m) fail("knee_flexion_at_extension_deg", "the hip would sit inside the crank circle");
+  if (D <= p.crank_length_m)
+    fail("knee_flexion_at_extension_deg", "the hip would sit inside the crank circle");
   const Vec2 hip = mul(D, seat_dir);
 
   s.ground_points["bottom_bracket"] = {0.0, 0.0};
@@ -160,19 +199,34 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
   s.ground_points["flywheel_axle"] = {0.40, 0.0};
 
   // Crank (arms + chainring): assumed uniform arms, inertia m L²/3 about the spindle.
-  Body crank{"crank", p.crank_mass_kg, {0, 0}, p.crank_mass_kg * std::pow(p.crank_length_m, 2) / 3.0, {}};
+  Body crank{
+      "crank", p.crank_mass_kg, {0, 0}, p.crank_mass_kg * std::pow(p.crank_length_m, 2) / 3.0, {}};
   crank.points["pedal_r"] = {p.crank_length_m, 0.0};
   crank.points["pedal_l"] = {-p.crank_length_m, 0.0};
   s.bodies.push_back(crank);
-  s.joints.push_back({"crank", JointType::Revolute, kGround, "crank", {0, 0}, {0, 0}, {1, 0},
-                      kPi / 2.0, s.initial.q});
+  s.joints.push_back({"crank",
+                      JointType::Revolute,
+                      kGround,
+                      "crank",
+                      {0, 0},
+                      {0, 0},
+                      {1, 0},
+                      kPi / 2.0,
+                      s.initial.q});
 
   const double I_road = (p.mass_kg + p.bike_mass_kg) * p.wheel_radius_m * p.wheel_radius_m +
                         2.0 * p.wheel_inertia_kgm2;
-  const double I_fly = p.flywheel_inertia_kgm2 > 0.0 ? p.flywheel_inertia_kgm2 : I_road;
+  const double I_fly = p.flywheel_inertia_kgm2.value_or(I_road);
   s.bodies.push_back({"flywheel", p.flywheel_mass_kg, {0, 0}, I_fly, {}});
-  s.joints.push_back({"flywheel", JointType::Revolute, kGround, "flywheel", s.ground_points["flywheel_axle"],
-                      {0, 0}, {1, 0}, 0.0, p.gear_ratio * s.initial.q});
+  s.joints.push_back({"flywheel",
+                      JointType::Revolute,
+                      kGround,
+                      "flywheel",
+                      s.ground_points["flywheel_axle"],
+                      {0, 0},
+                      {1, 0},
+                      0.0,
+                      p.gear_ratio * s.initial.q});
   s.gears.push_back({"chain", "crank", "flywheel", p.gear_ratio});
 
   const double m_t = fit.f.thigh.mass * p.mass_kg;
@@ -182,8 +236,11 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
     LegPose pose{};
     if (!leg_pose(hip, pedal_position(p, q_leg), fit.L_t, fit.L_kp, fit.delta, pose))
       fail("legs", "the leg cannot reach the pedal at the initial crank angle");
-    Body thigh{"thigh_" + side, m_t, {fit.f.thigh.com * fit.L_t, 0},
-               m_t * std::pow(fit.f.thigh.gyration * fit.L_t, 2), {}};
+    Body thigh{"thigh_" + side,
+               m_t,
+               {fit.f.thigh.com * fit.L_t, 0},
+               m_t * std::pow(fit.f.thigh.gyration * fit.L_t, 2),
+               {}};
     thigh.points["hip"] = {0, 0};
     thigh.points["knee"] = {fit.L_t, 0};
     Body shank{"shank_" + side, fit.sf.mass_kg, fit.sf.com, fit.sf.inertia_kgm2, {}};
@@ -192,24 +249,40 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
     shank.points["pedal"] = fit.sf.pedal;
     s.bodies.push_back(thigh);
     s.bodies.push_back(shank);
-    s.joints.push_back({"hip_" + side, JointType::Revolute, kGround, thigh.name, hip, {0, 0}, {1, 0},
-                        0.0, pose.thigh_angle});
-    s.joints.push_back({"knee_" + side, JointType::Revolute, thigh.name, shank.name, {fit.L_t, 0},
-                        {0, 0}, {1, 0}, 0.0, wrap(pose.shank_angle - pose.thigh_angle)});
-    s.loops.push_back({"pedal_" + side, shank.name, fit.sf.pedal, "crank", crank.points["pedal_" + side]});
+    s.joints.push_back({"hip_" + side,
+                        JointType::Revolute,
+                        kGround,
+                        thigh.name,
+                        hip,
+                        {0, 0},
+                        {1, 0},
+                        0.0,
+                        pose.thigh_angle});
+    s.joints.push_back({"knee_" + side,
+                        JointType::Revolute,
+                        thigh.name,
+                        shank.name,
+                        {fit.L_t, 0},
+                        {0, 0},
+                        {1, 0},
+                        0.0,
+                        wrap(pose.shank_angle - pose.thigh_angle)});
+    s.loops.push_back(
+        {"pedal_" + side, shank.name, fit.sf.pedal, "crank", crank.points["pedal_" + side]});
     // Hip torque pushes the thigh down (counter-clockwise: the knee is in front, at −x),
     // and acts only while the thigh descends, i.e. while its angle increases.
     if (p.hip_torque_Nm != 0.0)
-      s.joint_torques.push_back({"hip_torque_" + side, "hip_" + side, p.hip_torque_Nm,
-                                 RateGate{"hip_" + side, +1}});
+      s.joint_torques.push_back(
+          {"hip_torque_" + side, "hip_" + side, p.hip_torque_Nm, RateGate{"hip_" + side, +1}});
   }
 
   // Resistance on the flywheel dissipating P at the cadence f of the crank.
   const double omega = p.gear_ratio * 2.0 * kPi * p.resistance_cadence_Hz;  // flywheel [rad/s]
   if (p.resistance_power_W > 0.0) {
     if (!(omega > 0.0)) fail("resistance.cadence_Hz", "must be positive");
-    s.resistances.push_back({"flywheel_resistance", "flywheel", p.resistance_law,
-                             p.resistance_power_W / std::pow(omega, dissipation_exponent(p.resistance_law))});
+    s.resistances.push_back(
+        {"flywheel_resistance", "flywheel", p.resistance_law,
+         p.resistance_power_W / std::pow(omega, dissipation_exponent(p.resistance_law))});
   }
   s.independent = "crank";
 }

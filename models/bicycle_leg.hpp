@@ -8,6 +8,7 @@
 // knee; the shank+foot frame has x from knee to ankle (the anatomical shank axis).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "models/scene.hpp"
@@ -30,11 +31,11 @@ struct BicycleLegParams {
   double ankle_angle_deg = 100.0;  // locked angle between shank (up) and sole (forward)
   double pedal_stack_m = 0.02;     // pedal spindle below the sole
 
-  // Flywheel: turns at gear_ratio × crank. inertia_kgm2 <= 0 means "road equivalent":
+  // Flywheel: turns at gear_ratio × crank. Without inertia_kgm2, the "road equivalent":
   // the kinetic energy of rider + bicycle moving on the road plus the two wheels
   // spinning, I = (m_rider + m_bike)·r_wheel² + 2·I_wheel (as the original authors did).
   double gear_ratio = 3.0;  // chainring/sprocket, e.g. 48/16
-  double flywheel_inertia_kgm2 = 0.0;
+  std::optional<double> flywheel_inertia_kgm2;
   double flywheel_mass_kg = 10.0;
   double bike_mass_kg = 9.0;
   double wheel_radius_m = 0.335;
@@ -50,7 +51,9 @@ struct BicycleLegParams {
 // Builds bodies, joints, loops, gear, independent coordinate and loads into `scene`
 // (which must not already have any). Names: thigh_r/l, shank_r/l, crank, flywheel;
 // joints hip_r/l, knee_r/l, crank, flywheel; loops pedal_r/l; shank points knee,
-// ankle, pedal. Throws SceneError on an impossible fit.
+// ankle, pedal. Every parameter is checked first (ranges in models/README.md); throws
+// SceneError naming the field ("bicycle_leg.flywheel.gear_ratio") and its range, or an
+// impossible fit.
 void make_bicycle_leg(const BicycleLegParams& p, Scene& scene);
 
 // Knee flexion [rad] of the right leg at crank angle q (closed-form leg pose); exposed

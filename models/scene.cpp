@@ -1,9 +1,10 @@
 #include "models/scene.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <set>
-
-#include <fmt/format.h>
 
 namespace rdyn::models {
 
@@ -21,7 +22,8 @@ SceneError::SceneError(std::string file, int line, std::string field, const std:
     : std::runtime_error(format_error(file, line, field, message)),
       file_(std::move(file)),
       line_(line),
-      field_(std::move(field)) {}
+      field_(std::move(field)),
+      message_(message) {}
 
 const Body* Scene::find_body(const std::string& n) const {
   for (const auto& b : bodies)
@@ -47,44 +49,173 @@ int Scene::body_index(const std::string& n) const {
   return -1;
 }
 
-void check_scene(const Scene& s) {
-  auto fail = [&](const std::string& field, const std::string& msg) {
+bool is_valid_name(const std::string& n) {
+  auto head = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
+  auto tail = [&](char c) { return head(c) || (c >= '0' && c <= '9') || c == '-'; };
+  if (n.empty() || n.size() > limits::kMaxNameLength || !head(n[0])) return false;
+  return std::all_of(n.begin() + 1, n.end(), tail);
+}
+
+namespace {
+
+// Shows a name in a message without letting it break the message (newlines, quotes).
+std::string printable(const std::string& n) {
+  std::string out;
+  for (char c : n.substr(0, 80)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u < 0x20 || u == 0x7f || c == '\'') ? fmt::format("\\x{:02x}", u) : std::string(1, c);
+  }
+  return n.size() > 80 ? out + "…" : out;
+}
+
+// Check helpers: each throws SceneError(file, 0, field, message) on the first violation.
+}  // namespace
+
+std::string invalid_name_message(const std::string& n) {
+  return fmt::format(
+      "'{}' is not a valid name: 1 to {} characters from A-Z a-z 0-9 _ -, starting with a "
+      "letter or '_'",
+      printable(n), limits::kMaxNameLength);
+}
+
+namespace {
+
+struct Checker {
+  const Scene& s;
+
+  [[noreturn]] void fail(const std::string& field, const std::string& msg) const {
     throw SceneError(s.source_file, 0, field, msg);
-  };
-  auto finite = [](double v) { return std::isfinite(v); };
+  }
+  void in_range(const std::string& field, double v, double lo, double hi, const char* unit) const {
+    if (!std::isfinite(v) || v < lo || v > hi)
+      fail(field, fmt::format("must be in [{:g}, {:g}]{}{} (got {:g})", lo, hi, *unit ? " " : "",
+                              unit, v));
+  }
+  void abs_at_most(const std::string& field, double v, double hi, const char* unit) const {
+    if (!std::isfinite(v) || std::abs(v) > hi)
+      fail(field, fmt::format("must be finite with |value| ≤ {:g}{}{} (got {:g})", hi,
+                              *unit ? " " : "", unit, v));
+  }
+  void point(const std::string& field, Vec2 p) const {
+    abs_at_most(field + "[0]", p.x, limits::kMaxCoordinate_m, "m");
+    abs_at_most(field + "[1]", p.y, limits::kMaxCoordinate_m, "m");
+  }
+  void direction(const std::string& field, Vec2 d) const {
+    point(field, d);
+    if (std::hypot(d.x, d.y) < 1e-12) fail(field, "must be a non-zero vector");
+  }
+  // Names of one kind: valid and unique. `path` is the list ("bodies"), `i` the item.
+  void name(const std::string& path, size_t i, const std::string& n,
+            std::set<std::string>& seen) const {
+    name(fmt::format("{}[{}].name", path, i), n, seen, path);
+  }
+  void name(const std::string& f, const std::string& n, std::set<std::string>& seen,
+            const std::string& path = "") const {
+    if (!is_valid_name(n)) fail(f, invalid_name_message(n));
+    if (!seen.insert(n).second)
+      fail(f, fmt::format("duplicate name '{}' in {}", n, path.empty() ? f : path));
+  }
+  void count(const std::string& field, size_t n) const {
+    if (n > limits::kMaxItems)
+      fail(field, fmt::format("{} items; a scene may have at most {}", n, limits::kMaxItems));
+  }
+  void points(const std::string& field, const std::map<std::string, Vec2>& pts) const {
+    count(field, pts.size());
+    for (const auto& [n, p] : pts) {
+      if (!is_valid_name(n)) fail(field, "point " + invalid_name_message(n));
+      point(field + "." + n, p);
+    }
+  }
+  // A joint coordinate: an angle for a revolute joint, a length for a prismatic one.
+  void coordinate(const std::string& field, const Joint* j, double v) const {
+    if (j && j->type == JointType::Prismatic)
+      abs_at_most(field, v, limits::kMaxCoordinate_m, "m");
+    else
+      abs_at_most(field, v, limits::kMaxAngle_rad, "rad");
+  }
+};
+
+}  // namespace
+
+void check_scene(const Scene& s) {
+  const Checker c{s};
+  auto fail = [&](const std::string& field, const std::string& msg) { c.fail(field, msg); };
   auto is_body_or_ground = [&](const std::string& n) { return n == kGround || s.find_body(n); };
 
+  if (!is_valid_name(s.name)) fail("name", invalid_name_message(s.name));
+  if (s.description.size() > limits::kMaxTextLength)
+    fail("description", fmt::format("longer than {} characters", limits::kMaxTextLength));
+  if (s.validation.note.size() > limits::kMaxTextLength)
+    fail("validation.note", fmt::format("longer than {} characters", limits::kMaxTextLength));
+  c.count("bodies", s.bodies.size());
+  c.count("joints", s.joints.size());
+  c.count("loops", s.loops.size());
+  c.count("gears", s.gears.size());
+  c.count("loads",
+          s.joint_torques.size() + s.resistances.size() + s.springs.size() + s.motors.size());
+  c.count("outputs.constraint_forces", s.outputs.constraint_forces.size());
+  c.count("outputs.bodies", s.outputs.bodies.size());
+  c.count("validation.thresholds", s.validation.thresholds.size());
+  c.points("ground_points", s.ground_points);
+
+  // Names first, so that the fields below can name items by name.
   std::set<std::string> names;
+  for (size_t i = 0; i < s.bodies.size(); ++i) {
+    if (s.bodies[i].name == kGround)
+      fail(fmt::format("bodies[{}].name", i), "'ground' is reserved");
+    c.name("bodies", i, s.bodies[i].name, names);
+  }
+  names.clear();
+  for (size_t i = 0; i < s.joints.size(); ++i) c.name("joints", i, s.joints[i].name, names);
+  names.clear();
+  for (size_t i = 0; i < s.loops.size(); ++i) c.name("loops", i, s.loops[i].name, names);
+  names.clear();
+  for (size_t i = 0; i < s.gears.size(); ++i) c.name("gears", i, s.gears[i].name, names);
+  names.clear();
+  {  // loads: one kind in one list, kept here by type, so no list index in the field
+    std::vector<std::string> load_names;
+    for (const auto& t : s.joint_torques) load_names.push_back(t.name);
+    for (const auto& r : s.resistances) load_names.push_back(r.name);
+    for (const auto& sp : s.springs) load_names.push_back(sp.name);
+    for (const auto& m : s.motors) load_names.push_back(m.name);
+    for (const auto& n : load_names) c.name("loads", n, names);
+  }
+  names.clear();
+  for (size_t i = 0; i < s.outputs.constraint_forces.size(); ++i)
+    c.name("outputs.constraint_forces", i, s.outputs.constraint_forces[i].name, names);
+
   for (const auto& b : s.bodies) {
     const std::string f = "bodies." + b.name;
-    if (b.name.empty() || b.name == kGround) fail("bodies", "a body needs a name other than 'ground'");
-    if (!names.insert(b.name).second) fail(f, "duplicate body name");
-    if (!finite(b.mass_kg) || b.mass_kg <= 0.0)
-      fail(f + ".mass_kg", fmt::format("mass must be positive and finite (got {})", b.mass_kg));
-    if (!finite(b.inertia_kgm2) || b.inertia_kgm2 <= 0.0)
-      fail(f + ".inertia_kgm2",
-           fmt::format("centroidal inertia must be positive and finite (got {})", b.inertia_kgm2));
-    if (!finite(b.com_m.x) || !finite(b.com_m.y)) fail(f + ".com_m", "not finite");
+    c.in_range(f + ".mass_kg", b.mass_kg, limits::kMinMass_kg, limits::kMaxMass_kg, "kg");
+    c.in_range(f + ".inertia_kgm2", b.inertia_kgm2, limits::kMinInertia_kgm2,
+               limits::kMaxInertia_kgm2, "kg·m²");
+    c.point(f + ".com_m", b.com_m);
+    c.points(f + ".points", b.points);
   }
   if (s.bodies.empty()) fail("bodies", "the scene has no bodies");
 
   // Tree: every body is the child of exactly one joint, and walking parents reaches ground.
   std::map<std::string, std::string> parent_of;
-  std::set<std::string> joint_names;
   for (const auto& j : s.joints) {
     const std::string f = "joints." + j.name;
-    if (!joint_names.insert(j.name).second) fail(f, "duplicate joint name");
-    if (!is_body_or_ground(j.parent)) fail(f + ".parent", "unknown body '" + j.parent + "'");
-    if (!s.find_body(j.child)) fail(f + ".child", "unknown body '" + j.child + "'");
+    if (!is_body_or_ground(j.parent))
+      fail(f + ".parent", "unknown body '" + printable(j.parent) + "'");
+    if (!s.find_body(j.child)) fail(f + ".child", "unknown body '" + printable(j.child) + "'");
+    if (j.parent == j.child) fail(f + ".child", "a joint cannot join a body to itself");
     if (parent_of.count(j.child))
-      fail(f + ".child", "body '" + j.child + "' is already the child of another joint; "
+      fail(f + ".child", "body '" + j.child +
+                             "' is already the child of another joint; "
                              "close loops with 'loops', not with a second joint");
     parent_of[j.child] = j.parent;
+    c.point(f + ".parent_point", j.parent_point);
+    c.point(f + ".child_point", j.child_point);
     if (j.type == JointType::Prismatic) {
-      const double n = std::hypot(j.axis.x, j.axis.y);
-      if (!finite(n) || n < 1e-12) fail(f + ".axis", "prismatic axis must be a non-zero vector");
+      c.direction(f + ".axis", j.axis);
+      c.coordinate(f + ".guess_m", &j, j.guess);
+    } else {
+      c.coordinate(f + ".offset", &j, j.offset_rad);  // offset_deg/guess_deg: checked by the reader
+      c.coordinate(f + ".guess", &j, j.guess);
     }
-    if (!finite(j.guess) || !finite(j.offset_rad)) fail(f, "guess/offset not finite");
   }
   for (const auto& b : s.bodies) {
     if (!parent_of.count(b.name))
@@ -97,18 +228,32 @@ void check_scene(const Scene& s) {
   }
 
   for (const auto& l : s.loops) {
-    if (!is_body_or_ground(l.body_a)) fail("loops." + l.name + ".body_a", "unknown body");
-    if (!is_body_or_ground(l.body_b)) fail("loops." + l.name + ".body_b", "unknown body");
-    if (l.body_a == l.body_b) fail("loops." + l.name, "a loop must join two different bodies");
+    const std::string f = "loops." + l.name;
+    if (!is_body_or_ground(l.body_a))
+      fail(f + ".body_a", "unknown body '" + printable(l.body_a) + "'");
+    if (!is_body_or_ground(l.body_b))
+      fail(f + ".body_b", "unknown body '" + printable(l.body_b) + "'");
+    if (l.body_a == l.body_b) fail(f, "a loop must join two different bodies");
+    c.point(f + ".point_a", l.point_a);
+    c.point(f + ".point_b", l.point_b);
   }
   for (const auto& g : s.gears) {
+    const std::string f = "gears." + g.name;
     const Joint* a = s.find_joint(g.driver);
     const Joint* b = s.find_joint(g.driven);
-    if (!a) fail("gears." + g.name + ".driver", "unknown joint '" + g.driver + "'");
-    if (!b) fail("gears." + g.name + ".driven", "unknown joint '" + g.driven + "'");
+    if (!a) fail(f + ".driver", "unknown joint '" + printable(g.driver) + "'");
+    if (!b) fail(f + ".driven", "unknown joint '" + printable(g.driven) + "'");
+    // A joint geared to itself is no constraint at all (rate = r·rate is 0 = 0 for r = 1, or
+    // freezes the joint otherwise), yet it would be counted as one in the mobility below.
+    if (a == b)
+      fail(f + ".driven", "a gear must couple two different joints (driver and driven are both '" +
+                              g.driver + "')");
     if (a->type != JointType::Revolute || b->type != JointType::Revolute)
-      fail("gears." + g.name, "gears couple two revolute joints");
-    if (!finite(g.ratio) || g.ratio == 0.0) fail("gears." + g.name + ".ratio", "must be non-zero");
+      fail(f, "gears couple two revolute joints");
+    if (!std::isfinite(g.ratio) || std::abs(g.ratio) < limits::kMinGearRatio ||
+        std::abs(g.ratio) > limits::kMaxGearRatio)
+      fail(f + ".ratio", fmt::format("must be finite with |ratio| in [{:g}, {:g}] (got {:g})",
+                                     limits::kMinGearRatio, limits::kMaxGearRatio, g.ratio));
   }
 
   // Mobility (Grübler for planar joints): each joint adds one coordinate, each loop
@@ -120,65 +265,151 @@ void check_scene(const Scene& s) {
                                "{} gears); rdyn needs exactly 1",
                                dof, s.joints.size(), s.loops.size(), s.gears.size()));
 
-  if (!s.find_joint(s.independent))
-    fail("independent", "unknown joint '" + s.independent + "'");
+  const Joint* independent = s.find_joint(s.independent);
+  if (!independent) fail("independent", "unknown joint '" + printable(s.independent) + "'");
 
   auto check_joint_ref = [&](const std::string& field, const std::string& j) {
-    if (!s.find_joint(j)) fail(field, "unknown joint '" + j + "'");
+    if (!s.find_joint(j)) fail(field, "unknown joint '" + printable(j) + "'");
   };
   for (const auto& t : s.joint_torques) {
-    check_joint_ref("loads." + t.name + ".joint", t.joint);
-    if (!finite(t.value)) fail("loads." + t.name + ".value", "not finite");
-    if (t.active_when) check_joint_ref("loads." + t.name + ".active_when.joint", t.active_when->joint);
+    const std::string f = "loads." + t.name;
+    check_joint_ref(f + ".joint", t.joint);
+    const bool prismatic = s.find_joint(t.joint)->type == JointType::Prismatic;
+    c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce,
+                  prismatic ? "N" : "N·m");
+    if (t.active_when) check_joint_ref(f + ".active_when.joint", t.active_when->joint);
   }
   for (const auto& r : s.resistances) {
-    if (!s.find_body(r.body)) fail("loads." + r.name + ".body", "unknown body '" + r.body + "'");
-    if (!finite(r.coefficient) || r.coefficient < 0.0)
-      fail("loads." + r.name + ".coefficient", "must be finite and non-negative");
+    const std::string f = "loads." + r.name;
+    const Body* b = s.find_body(r.body);
+    if (!b) fail(f + ".body", "unknown body '" + printable(r.body) + "'");
+    const double max_c = b->inertia_kgm2 / limits::kMinResistanceTimeConstant_s;
+    if (!std::isfinite(r.coefficient) || r.coefficient < 0.0 || r.coefficient > max_c)
+      fail(f + ".coefficient",
+           fmt::format(
+               "must be in [0, {:g}] = inertia of '{}' / {:g} s, so that the resistance alone "
+               "cannot change its speed faster than that time constant (got {:g})",
+               max_c, b->name, limits::kMinResistanceTimeConstant_s, r.coefficient));
   }
   for (const auto& sp : s.springs) {
-    if (!is_body_or_ground(sp.body_a) || !is_body_or_ground(sp.body_b))
-      fail("loads." + sp.name, "unknown body");
-    if (!finite(sp.stiffness_N_per_m) || sp.stiffness_N_per_m < 0.0 ||
-        !finite(sp.rest_length_m) || sp.rest_length_m < 0.0)
-      fail("loads." + sp.name, "stiffness and rest length must be finite and non-negative");
+    const std::string f = "loads." + sp.name;
+    if (!is_body_or_ground(sp.body_a))
+      fail(f + ".body_a", "unknown body '" + printable(sp.body_a) + "'");
+    if (!is_body_or_ground(sp.body_b))
+      fail(f + ".body_b", "unknown body '" + printable(sp.body_b) + "'");
+    c.point(f + ".point_a", sp.point_a);
+    c.point(f + ".point_b", sp.point_b);
+    c.in_range(f + ".stiffness_N_per_m", sp.stiffness_N_per_m, 0.0, limits::kMaxStiffness_N_per_m,
+               "N/m");
+    c.in_range(f + ".rest_length_m", sp.rest_length_m, 0.0, limits::kMaxCoordinate_m, "m");
   }
   for (const auto& m : s.motors) {
-    check_joint_ref("loads." + m.name + ".joint", m.joint);
-    if (!finite(m.stall_torque) || !finite(m.no_load_speed) || m.no_load_speed == 0.0)
-      fail("loads." + m.name, "stall torque must be finite and no-load speed non-zero");
+    const std::string f = "loads." + m.name;
+    check_joint_ref(f + ".joint", m.joint);
+    const bool prismatic = s.find_joint(m.joint)->type == JointType::Prismatic;
+    const std::string speed = f + (prismatic ? ".no_load_speed_m_s" : ".no_load_speed_rad_s");
+    c.abs_at_most(f + (prismatic ? ".stall_force_N" : ".stall_torque_Nm"), m.stall_torque,
+                  limits::kMaxForce, prismatic ? "N" : "N·m");
+    if (!std::isfinite(m.no_load_speed) || std::abs(m.no_load_speed) < limits::kMinMotorSpeed ||
+        std::abs(m.no_load_speed) > limits::kMaxRate)
+      fail(speed, fmt::format("must be finite with |value| in [{:g}, {:g}] (got {:g})",
+                              limits::kMinMotorSpeed, limits::kMaxRate, m.no_load_speed));
+    // τ = stall·(1 − rate/no_load_speed) drives the rate toward no_load_speed only when both have
+    // the same sign; with opposite signs the torque grows with the speed it produces (a runaway).
+    if (m.stall_torque * m.no_load_speed < 0.0)
+      fail(speed,
+           fmt::format(
+               "has the opposite sign of the stall torque ({:g} vs {:g}): such a motor pushes "
+               "harder the faster it turns and runs away; give both the sign of the "
+               "direction it drives",
+               m.no_load_speed, m.stall_torque));
   }
-  for (const auto& c : s.outputs.constraint_forces) {
-    const Joint* j = s.find_joint(c.joint);
-    if (!j) fail("outputs.constraint_forces." + c.name + ".joint", "unknown joint '" + c.joint + "'");
-    if (j->type != JointType::Revolute)
-      fail("outputs.constraint_forces." + c.name, "constraint forces are offered on revolute joints");
-    if (c.joint == s.independent)
-      fail("outputs.constraint_forces." + c.name, "the independent coordinate's joint has no "
-                                                  "constraint actuator; pick another joint");
-    const double n = std::hypot(c.direction.x, c.direction.y);
-    if (!finite(n) || n < 1e-12)
-      fail("outputs.constraint_forces." + c.name + ".direction", "must be a non-zero vector");
+  for (size_t i = 0; i < s.outputs.constraint_forces.size(); ++i) {
+    const auto& cf = s.outputs.constraint_forces[i];
+    const std::string f = "outputs.constraint_forces." + cf.name;
+    const Joint* j = s.find_joint(cf.joint);
+    if (!j) fail(f + ".joint", "unknown joint '" + printable(cf.joint) + "'");
+    if (j->type != JointType::Revolute) fail(f, "constraint forces are offered on revolute joints");
+    if (cf.joint == s.independent)
+      fail(f, "the independent coordinate's joint has no constraint actuator; pick another joint");
+    c.direction(f + ".direction", cf.direction);
   }
-  for (const auto& b : s.outputs.bodies)
-    if (!s.find_body(b)) fail("outputs.bodies", "unknown body '" + b + "'");
+  {
+    std::set<std::string> seen;
+    for (size_t i = 0; i < s.outputs.bodies.size(); ++i) {
+      const std::string& b = s.outputs.bodies[i];
+      const std::string f = fmt::format("outputs.bodies[{}]", i);
+      if (!s.find_body(b)) fail(f, "unknown body '" + printable(b) + "'");
+      if (!seen.insert(b).second) fail(f, "body '" + b + "' listed twice");
+    }
+  }
+
+  c.abs_at_most("gravity.g_m_s2[0]", s.gravity.g_m_s2.x, limits::kMaxGravity_m_s2, "m/s²");
+  c.abs_at_most("gravity.g_m_s2[1]", s.gravity.g_m_s2.y, limits::kMaxGravity_m_s2, "m/s²");
+  c.coordinate("initial.q", independent, s.initial.q);
+  c.abs_at_most("initial.qdot", s.initial.qdot, limits::kMaxRate, "rad/s or m/s");
 
   const auto& sim = s.simulation;
-  if (!finite(sim.duration_s) || sim.duration_s <= 0.0)
-    fail("simulation.duration_s", "must be positive");
-  if (!finite(sim.output_interval_s) || sim.output_interval_s <= 0.0)
-    fail("simulation.output_interval_s", "must be positive");
-  if (!finite(sim.tolerance) || sim.tolerance <= 0.0 || sim.tolerance >= 1.0)
-    fail("simulation.tolerance", "must be in (0, 1)");
-  if (!finite(s.initial.q) || !finite(s.initial.qdot)) fail("initial", "not finite");
-  if (!finite(s.gravity.g_m_s2.x) || !finite(s.gravity.g_m_s2.y)) fail("gravity.g_m_s2", "not finite");
+  if (!(sim.duration_s > 0.0 && sim.duration_s <= limits::kMaxDuration_s))
+    fail("simulation.duration_s",
+         fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
+  c.in_range("simulation.output_interval_s", sim.output_interval_s, limits::kMinOutputInterval_s,
+             sim.duration_s, "s");
+  const double longest = std::max(sim.duration_s, s.validation.duration_s);
+  if (longest / sim.output_interval_s > limits::kMaxOutputRows)
+    fail("simulation.output_interval_s",
+         fmt::format("{:g} s over {:g} s gives {:g} output rows; at most {:g}",
+                     sim.output_interval_s, longest, longest / sim.output_interval_s,
+                     limits::kMaxOutputRows));
+  c.in_range("simulation.tolerance", sim.tolerance, limits::kMinTolerance, limits::kMaxTolerance,
+             "");
+
+  const auto& v = s.validation;
+  c.in_range("validation.duration_s", v.duration_s, 0.0, limits::kMaxDuration_s,
+             "s (0: simulation.duration_s)");
+  c.in_range("validation.reference_tolerance", v.reference_tolerance, limits::kMinTolerance,
+             limits::kMaxReferenceTolerance, "");
+  for (size_t i = 0; i < v.thresholds.size(); ++i) {
+    const auto& th = v.thresholds[i];
+    const std::string f = fmt::format("validation.thresholds[{}]", i);
+    bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
+    for (const auto& cf : s.outputs.constraint_forces) known |= cf.name == th.quantity;
+    if (!known)
+      fail(f + ".quantity",
+           fmt::format(
+               "'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
+               printable(th.quantity)));
+    if (!th.interpolation.empty() && !is_valid_name(th.interpolation))
+      fail(f + ".interpolation",
+           fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
+    if (!(th.max_error > 0.0 && th.max_error <= 1.0))
+      fail(f + ".max_error", fmt::format("must be in (0, 1] (a fraction; got {:g})", th.max_error));
+    c.in_range(f + ".grid_deg", th.grid_deg, limits::kMinGrid_deg, limits::kMaxGrid_deg, "degrees");
+    // The table is periodic over one turn: the grid must divide 360° into whole steps.
+    const double steps = 360.0 / th.grid_deg;
+    if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
+      fail(f + ".grid_deg",
+           fmt::format("{:g}° does not divide 360° into whole steps", th.grid_deg));
+  }
+  if (v.calibrate_cadence_Hz != 0.0 || v.calibrate_power_W != 0.0) {
+    if (!(v.calibrate_cadence_Hz > 0.0 && v.calibrate_cadence_Hz <= limits::kMaxCadence_Hz))
+      fail("validation.calibrate.cadence_Hz",
+           fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz,
+                       v.calibrate_cadence_Hz));
+    if (!(v.calibrate_power_W > 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
+      fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
+                                                       limits::kMaxPower_W, v.calibrate_power_W));
+  }
 }
 
 double resistance_torque(ResistanceLaw law, double c, double w) {
   switch (law) {
-    case ResistanceLaw::Constant: return w > 0 ? -c : w < 0 ? c : 0.0;
-    case ResistanceLaw::Viscous: return -c * w;
-    case ResistanceLaw::Quadratic: return -c * w * std::abs(w);
+    case ResistanceLaw::Constant:
+      return w > 0 ? -c : w < 0 ? c : 0.0;
+    case ResistanceLaw::Viscous:
+      return -c * w;
+    case ResistanceLaw::Quadratic:
+      return -c * w * std::abs(w);
   }
   return 0.0;
 }
@@ -193,7 +424,8 @@ std::optional<double> fixed_speed_ratio(const Scene& s, const std::string& body)
     if (j.name == s.independent) return 1.0;
     for (const auto& g : s.gears) {
       const Joint* driver = s.find_joint(g.driver);
-      if (g.driven == j.name && g.driver == s.independent && driver->parent == kGround)
+      // Called before check_scene (to turn `dissipates` into a coefficient): names may be unknown.
+      if (driver && g.driven == j.name && g.driver == s.independent && driver->parent == kGround)
         return g.ratio;
     }
   }

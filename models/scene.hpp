@@ -5,6 +5,7 @@
 // points out of it; positive rotations are counter-clockwise about z.
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -26,11 +27,13 @@ class SceneError : public std::runtime_error {
   const std::string& file() const { return file_; }
   int line() const { return line_; }  // 1-based; 0 when unknown
   const std::string& field() const { return field_; }
+  const std::string& message() const { return message_; }  // without file, line and field
 
  private:
   std::string file_;
   int line_;
   std::string field_;
+  std::string message_;
 };
 
 // A computation that failed on valid input (an integrator that cannot meet its tolerance or
@@ -42,6 +45,49 @@ class NumericalError : public std::runtime_error {
 };
 
 inline constexpr const char* kGround = "ground";
+
+// Ranges every scene value is checked against before any work starts (check_scene and the
+// YAML reader; documented in models/README.md, "Limits"). They bound what a typo can do:
+// no NaN/inf, no 1e308 products, no integrator that has to resolve a sub-microsecond time
+// constant, no output that fills the disk.
+namespace limits {
+// Names: [A-Za-z_][A-Za-z0-9_-]{0,63}. They become CSV columns, file names and HTML, and
+// '.' separates the parts of a --set key path, so it is not allowed inside a name.
+inline constexpr std::size_t kMaxNameLength = 64;
+inline constexpr std::size_t kMaxTextLength = 4096;  // description, note [characters]
+inline constexpr std::size_t kMaxItems = 1000;  // per list or map: bodies, joints, loads, points...
+inline constexpr double kMinMass_kg = 1e-6, kMaxMass_kg = 1e6;
+// Lower bounds far below any real part (1 mg; 1e-12 kg·m² is 1 mg at a 1 mm radius of
+// gyration), upper bounds far above any machine rdyn models; both far from under/overflow.
+inline constexpr double kMinInertia_kgm2 = 1e-12, kMaxInertia_kgm2 = 1e6;
+inline constexpr double kMaxCoordinate_m = 1e3;      // |x|, |y| of any point; prismatic q, guess
+inline constexpr double kMaxAngle_rad = 1e6;         // |revolute q|, guess, offset (~160 000 turns)
+inline constexpr double kMaxRate = 1e4;              // |q̇| [rad/s or m/s]; motor no-load speed
+inline constexpr double kMinMotorSpeed = 1e-3;       // |no-load speed| [rad/s or m/s]
+inline constexpr double kMaxGravity_m_s2 = 1e3;      // per component (≈ 100 g)
+inline constexpr double kMaxForce = 1e6;             // |joint torque| [N·m] or force [N]; |stall|
+inline constexpr double kMinGearRatio = 1e-3, kMaxGearRatio = 1e3;  // |ratio|
+inline constexpr double kMaxStiffness_N_per_m = 1e9;
+// Resistance: the coefficient may not exceed inertia/τ_min of its body (τ_min = 1e-6 s, with
+// a reference speed of 1 rad/s for the constant and quadratic laws). For the viscous law
+// this bounds the damping time constant of the whole mechanism: m1(q) ≥ I_body·r(q)² (the
+// body's own share of the kinetic energy) while the damping on q is c·r(q)², so
+// m1/(c·r²) ≥ I_body/c ≥ τ_min whatever the configuration.
+inline constexpr double kMinResistanceTimeConstant_s = 1e-6;
+inline constexpr double kMaxDuration_s = 1e5;
+inline constexpr double kMinOutputInterval_s = 1e-6;
+inline constexpr double kMaxOutputRows = 1e7;  // duration / output_interval
+inline constexpr double kMinTolerance = 1e-14, kMaxTolerance = 1e-1;
+inline constexpr double kMaxReferenceTolerance = 1e-3;  // validation.reference_tolerance
+inline constexpr double kMinGrid_deg = 0.05, kMaxGrid_deg = 90.0;
+inline constexpr double kMaxCadence_Hz = 20.0;  // dissipates / calibrate cadence
+inline constexpr double kMaxPower_W = 1e5;
+}  // namespace limits
+
+// Whether `name` matches [A-Za-z_][A-Za-z0-9_-]{0,63}.
+bool is_valid_name(const std::string& name);
+// The message for a name that is not valid (shows it with control characters escaped).
+std::string invalid_name_message(const std::string& name);
 
 struct Body {
   std::string name;
@@ -128,7 +174,9 @@ struct Motor {
   std::string name;
   std::string joint;
   double stall_torque = 0.0;        // [N·m] or [N]
-  double no_load_speed = 0.0;       // [rad/s] or [m/s], same sign as stall_torque's motion
+  // [rad/s] or [m/s]: the rate the motor drives toward, so it has the sign of stall_torque
+  // (a motor with opposite signs would push harder the faster it turns and run away).
+  double no_load_speed = 0.0;
 };
 
 struct Gravity {
@@ -208,8 +256,9 @@ struct Scene {
   int body_index(const std::string& name) const;   // −1 when absent (ground too)
 };
 
-// Checks topology and values (tree, one DOF, positive masses, known names...).
-// Throws SceneError naming the scene file and the offending field.
+// Checks topology, names and values (tree, one DOF, known and valid names, every number
+// finite and within `limits`). Throws SceneError naming the scene file and the offending
+// field: "bodies.<name>.mass_kg" (by name) or "bodies[<i>].name" for a bad name.
 void check_scene(const Scene& scene);
 
 // Resistance torque at angular rate ω [rad/s]: −c0·sgn ω, −c1·ω or −c2·ω|ω| [N·m].

@@ -1,6 +1,8 @@
 #include "models/scene_yaml.hpp"
 
+#include <fmt/format.h>
 #include <sys/stat.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +10,6 @@
 #include <fstream>
 #include <set>
 #include <sstream>
-
-#include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
 #include "models/bicycle_leg.hpp"
 
@@ -35,18 +34,185 @@ size_t edit_distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
+std::vector<std::string> split_key_path(const std::string& path);
+bool parse_index(const std::string& text, size_t size, size_t& index);
+
 int line_of(const YAML::Node& n) {
   const auto m = n.Mark();
   return m.is_null() ? 0 : m.line + 1;
 }
 
+// Limits on the text and its tree, checked before anything reads a value. Scenes are a few
+// kilobytes and a few hundred nodes; these bounds are orders of magnitude above that and
+// keep any input's memory and time small.
+constexpr size_t kMaxSceneBytes = 1 << 20;
+// yaml-cpp recurses once per nesting level while parsing (it stops itself at 2000 levels,
+// DeepRecursion) and so do the tree walks here: 64 is far more than a scene needs.
+constexpr int kMaxDepth = 64;
+// Aliases share nodes, so `&a [*b, *b, ...]` chains ("billion laughs") make a small text
+// whose tree is exponentially large when walked; an alias to its own ancestor makes a cycle.
+// Every walk over the tree is bounded by this many node visits and by kMaxDepth.
+constexpr size_t kMaxTreeNodes = 200000;
+constexpr size_t kMaxOverrideKeyLength = 1024;
+
+// Walks the tree once: keys are unique scalars, every mapping and list has at most
+// limits::kMaxItems entries, every scalar at most limits::kMaxTextLength characters, the
+// nesting at most kMaxDepth and the walk (aliases expanded) at most kMaxTreeNodes visits.
+void check_yaml_tree(const YAML::Node& node, const std::string& file, const std::string& path,
+                     int depth, size_t& visits) {
+  auto fail = [&](const YAML::Node& at, const std::string& field, const std::string& msg) {
+    // A path through a cycle is as long as the depth limit allows: keep the message readable.
+    throw SceneError(file, line_of(at), field.size() > 100 ? field.substr(0, 100) + "…" : field,
+                     msg);
+  };
+  if (++visits > kMaxTreeNodes)
+    fail(node, path,
+         fmt::format(
+             "the YAML tree has more than {} nodes (aliases expanded); a scene needs far fewer",
+             kMaxTreeNodes));
+  if (depth > kMaxDepth)
+    fail(node, path,
+         fmt::format("nested more than {} levels deep (or an alias refers to its own ancestor)",
+                     kMaxDepth));
+  auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
+  if (node.IsScalar()) {
+    if (node.Scalar().size() > limits::kMaxTextLength)
+      fail(node, path,
+           fmt::format("a value of {} characters; at most {}", node.Scalar().size(),
+                       limits::kMaxTextLength));
+  } else if (node.IsSequence()) {
+    if (node.size() > limits::kMaxItems)
+      fail(node, path,
+           fmt::format("a list of {} items; at most {}", node.size(), limits::kMaxItems));
+    for (size_t i = 0; i < node.size(); ++i)
+      check_yaml_tree(node[i], file, path + fmt::format("[{}]", i), depth + 1, visits);
+  } else if (node.IsMap()) {
+    if (node.size() > limits::kMaxItems)
+      fail(node, path,
+           fmt::format("a mapping of {} keys; at most {}", node.size(), limits::kMaxItems));
+    std::map<std::string, int> first_line;  // key → line of its first occurrence
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar())
+        fail(kv.first, path, "a key must be plain text, not a list or mapping");
+      const std::string& key = kv.first.Scalar();
+      const std::string shown = key.size() > 64 ? key.substr(0, 64) + "…" : key;
+      // yaml-cpp keeps both entries of a repeated key and reads the first: refuse instead.
+      const auto [it, inserted] = first_line.emplace(key, line_of(kv.first));
+      if (!inserted)
+        fail(kv.first, child(shown),
+             fmt::format("duplicate key '{}' (first given at line {})", shown, it->second));
+      check_yaml_tree(kv.second, file, child(shown), depth + 1, visits);
+    }
+  }
+}
+
+void check_yaml_tree(const YAML::Node& root, const std::string& file) {
+  size_t visits = 0;
+  check_yaml_tree(root, file, "", 0, visits);
+}
+
+// Parses scene text with the limits above (size, flow nesting, NUL bytes before parsing; the
+// tree after). Throws SceneError.
+YAML::Node load_checked_yaml(const std::string& text, const std::string& file) {
+  // Refuse anything huge before the YAML parser sees it.
+  if (text.size() > kMaxSceneBytes)
+    throw SceneError(
+        file, 0, "",
+        fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
+  {  // flow nesting, counted conservatively (brackets inside quotes count too)
+    int depth = 0, max_depth = 0;
+    for (char c : text) {
+      if (c == '[' || c == '{')
+        max_depth = std::max(max_depth, ++depth);
+      else if ((c == ']' || c == '}') && depth > 0)
+        --depth;
+    }
+    if (max_depth > kMaxDepth)
+      throw SceneError(
+          file, 0, "",
+          fmt::format("nested too deeply for a scene (more than {} levels of [ or {{)", kMaxDepth));
+  }
+  if (text.find('\0') != std::string::npos)
+    throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {  // ParserException, DeepRecursion (block nesting)
+    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
+  }
+  if (!root || root.IsNull()) throw SceneError(file, 0, "", "the scene file is empty");
+  if (!root.IsMap())
+    throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
+  check_yaml_tree(root, file);
+  return root;
+}
+
+// The node a field path names ("bodies[2].mass_kg", "loads.brake.coefficient",
+// "gravity.g_m_s2[1]": map keys, list items by index or by name), or the deepest ancestor
+// found when the field is not in the tree (a value derived from it, or generated).
+YAML::Node locate_field(const YAML::Node& root, const std::string& field) {
+  std::vector<std::string> parts;  // "a[2].b" → a, 2, b
+  for (const std::string& dotted : split_key_path(field)) {
+    const auto open = dotted.find('[');
+    parts.push_back(dotted.substr(0, open));
+    for (auto i = open; i != std::string::npos; i = dotted.find('[', i + 1))
+      parts.push_back(dotted.substr(i + 1, dotted.find(']', i) - i - 1));
+  }
+  YAML::Node cur;
+  cur.reset(root);
+  YAML::Node found;  // null: nothing matched
+  for (const auto& key : parts) {
+    YAML::Node next;
+    bool ok = false;
+    if (cur.IsMap() && cur[key]) {
+      next.reset(cur[key]);
+      ok = true;
+    } else if (cur.IsSequence()) {
+      size_t idx = 0;
+      if (parse_index(key, cur.size(), idx)) {
+        next.reset(cur[idx]);
+        ok = true;
+      }
+      for (size_t k = 0; k < cur.size() && !ok; ++k)
+        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
+            cur[k]["name"].Scalar() == key) {
+          next.reset(cur[k]);
+          ok = true;
+        }
+    }
+    if (!ok) break;
+    cur.reset(next);
+    found.reset(cur);
+  }
+  return found;
+}
+
+// What a reading needs besides the YAML: the file for messages, and the nodes that `--set`
+// overrides created or replaced, so that an error in one of them names the override.
+struct Context {
+  std::string file;
+  std::vector<std::pair<YAML::Node, std::string>> set_by_override;  // node, override key path
+
+  const std::string* override_of(const YAML::Node& n) const {
+    for (const auto& [node, path] : set_by_override)
+      if (n.IsDefined() && node.is(n)) return &path;
+    return nullptr;
+  }
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& field,
+                         const std::string& msg) const {
+    if (const std::string* o = override_of(n))
+      throw SceneError(file, 0, "--set " + *o, field + ": " + msg);
+    throw SceneError(file, line_of(n), field, msg);
+  }
+};
+
 // A YAML mapping whose keys are checked against the allowed set; typed getters throw
 // SceneError with file, line and dotted field path.
 class Fields {
  public:
-  Fields(const YAML::Node& node, std::string path, const std::string& file,
+  Fields(const YAML::Node& node, std::string path, const Context& ctx,
          std::vector<std::string> allowed)
-      : node_(node), path_(std::move(path)), file_(file), allowed_(std::move(allowed)) {
+      : node_(node), path_(std::move(path)), ctx_(ctx), allowed_(std::move(allowed)) {
     if (!node_.IsMap()) fail_at(node_, path_, "expected a mapping of keys to values");
     for (const auto& kv : node_) {
       const std::string key = kv.first.as<std::string>();
@@ -57,9 +223,8 @@ class Fields {
         const size_t d = edit_distance(key, a);
         if (d < best_d) best_d = d, best = a;
       }
-      fail_at(kv.first, join(key), best.empty()
-                                        ? "unknown key"
-                                        : fmt::format("unknown key (did you mean '{}'?)", best));
+      fail_at(ctx_.override_of(kv.second) ? kv.second : kv.first, join(key),
+              best.empty() ? "unknown key" : fmt::format("unknown key (did you mean '{}'?)", best));
     }
   }
 
@@ -70,7 +235,7 @@ class Fields {
 
   [[noreturn]] void fail_at(const YAML::Node& n, const std::string& field,
                             const std::string& msg) const {
-    throw SceneError(file_, line_of(n), field, msg);
+    ctx_.fail(n, field, msg);
   }
   [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
     fail_at(has(key) ? node_[key] : node_, join(key), msg);
@@ -83,6 +248,20 @@ class Fields {
 
   double num(const std::string& k) const { return to_num(required(k), join(k)); }
   double num_or(const std::string& k, double def) const { return has(k) ? num(k) : def; }
+  // A number given in a unit other than the scene's (degrees, hertz): checked in that unit,
+  // so the message quotes what the user typed.
+  double num_abs_max(const std::string& k, double def, double max, const char* unit) const {
+    const double v = num_or(k, def);
+    if (std::abs(v) > max)
+      fail(k, fmt::format("must be finite with |value| ≤ {:g} {} (got {:g})", max, unit, v));
+    return v;
+  }
+  double num_in(const std::string& k, double lo, double hi, const char* unit) const {
+    const double v = num(k);
+    if (v < lo || v > hi)
+      fail(k, fmt::format("must be in [{:g}, {:g}] {} (got {:g})", lo, hi, unit, v));
+    return v;
+  }
   std::string str(const std::string& k) const {
     const YAML::Node n = required(k);
     if (!n.IsScalar()) fail_at(n, join(k), "expected a text value");
@@ -90,6 +269,12 @@ class Fields {
   }
   std::string str_or(const std::string& k, const std::string& def) const {
     return has(k) ? str(k) : def;
+  }
+  // A name (see is_valid_name): checked here, where the line is known.
+  std::string name(const std::string& k) const {
+    const std::string v = str(k);
+    if (!is_valid_name(v)) fail(k, invalid_name_message(v));
+    return v;
   }
   bool flag_or(const std::string& k, bool def) const {
     if (!has(k)) return def;
@@ -106,8 +291,9 @@ class Fields {
     double v = 0.0;
     const std::string text = n.Scalar();
     if (!YAML::convert<double>::decode(n, v) || text.empty())
-      fail_at(n, field, fmt::format("expected a number, got '{}'", text));
-    if (!std::isfinite(v)) fail_at(n, field, fmt::format("must be finite, got '{}'", text));
+      fail_at(n, field, fmt::format("expected a number, got '{}'", text.substr(0, 40)));
+    if (!std::isfinite(v))
+      fail_at(n, field, fmt::format("must be finite, got '{}'", text.substr(0, 40)));
     return v;
   }
   Vec2 to_vec2(const YAML::Node& n, const std::string& field) const {
@@ -115,12 +301,13 @@ class Fields {
     return {to_num(n[0], field + "[0]"), to_num(n[1], field + "[1]")};
   }
 
-  const std::string& file() const { return file_; }
+  const Context& ctx() const { return ctx_; }
+  const std::string& file() const { return ctx_.file; }
 
  private:
   YAML::Node node_;
   std::string path_;
-  const std::string& file_;
+  const Context& ctx_;
   std::vector<std::string> allowed_;
 };
 
@@ -149,38 +336,61 @@ Vec2 read_point(const Fields& f, const std::string& key, const std::string& body
   f.fail(key, fmt::format("body '{}' has no point named '{}'", body, name));
 }
 
-void apply_override(YAML::Node root, const Override& o, const std::string& file) {
-  std::vector<std::string> parts;
-  std::stringstream ss(o.path);
-  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
-  auto fail = [&](const std::string& msg) {
-    throw SceneError(file, 0, "--set " + o.path, msg);
-  };
-  if (parts.empty() || std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
-    fail("malformed key path");
+// Splits a dotted key path; every part non-empty ("a..b", ".a" and "a." are malformed).
+std::vector<std::string> split_key_path(const std::string& path) {
+  std::vector<std::string> parts(1);
+  for (char c : path) {
+    if (c == '.')
+      parts.emplace_back();
+    else
+      parts.back() += c;
+  }
+  return parts;
+}
+
+// A list index: digits only, below `size`.
+bool parse_index(const std::string& text, size_t size, size_t& index) {
+  if (text.empty() || text.size() > 9 ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return false;
+  index = std::stoul(text);
+  return index < size;
+}
+
+// Applies one override to the YAML tree; records the nodes it created or set in `touched`
+// (so that a later error in them names the override).
+void apply_override(YAML::Node root, const Override& o, const std::string& file,
+                    std::vector<std::pair<YAML::Node, std::string>>* touched = nullptr) {
+  const std::vector<std::string> parts = split_key_path(o.path);
+  auto fail = [&](const std::string& msg) { throw SceneError(file, 0, "--set " + o.path, msg); };
+  if (std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
+    fail("malformed key path (empty part)");
   YAML::Node cur;
   cur.reset(root);
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     const std::string& key = parts[i];
     YAML::Node next;
     if (cur.IsSequence()) {
-      char* end = nullptr;
-      const long idx = std::strtol(key.c_str(), &end, 10);
+      size_t idx = 0;
       bool found = false;
-      if (*end == '\0' && idx >= 0 && static_cast<size_t>(idx) < cur.size()) {
+      if (parse_index(key, cur.size(), idx)) {
         next.reset(cur[idx]);
         found = true;
       } else {
         for (size_t k = 0; k < cur.size() && !found; ++k)
-          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == key) {
+          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
+              cur[k]["name"].Scalar() == key) {
             next.reset(cur[k]);
             found = true;
           }
       }
-      if (!found) fail(fmt::format("no list item '{}'", key));
+      if (!found)
+        fail(fmt::format("no list item '{}' (an index below {} or an item's name)", key,
+                         cur.size()));
     } else if (cur.IsMap()) {
       if (!cur[key]) {
         cur[key] = YAML::Node(YAML::NodeType::Map);  // allows setting a generator default
+        if (touched) touched->push_back({cur[key], o.path});
       }
       next.reset(cur[key]);
     } else {
@@ -190,16 +400,17 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file)
   }
   const std::string& last = parts.back();
   if (cur.IsSequence()) {  // e.g. one coordinate of a point: bodies.rocker.points.C.0=0.2
-    char* end = nullptr;
-    const long idx = std::strtol(last.c_str(), &end, 10);
-    if (*end != '\0' || idx < 0 || static_cast<size_t>(idx) >= cur.size() || !cur[idx].IsScalar())
-      fail(fmt::format("no scalar list item '{}'", last));
+    size_t idx = 0;
+    if (!parse_index(last, cur.size(), idx) || !cur[idx].IsScalar())
+      fail(fmt::format("no scalar list item '{}' (an index below {})", last, cur.size()));
     cur[idx] = o.value;
+    if (touched) touched->push_back({cur[idx], o.path});
     return;
   }
   if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
   if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
   cur[last] = o.value;
+  if (touched) touched->push_back({cur[last], o.path});
 }
 
 ResistanceLaw read_law(const Fields& f, const std::string& key) {
@@ -213,7 +424,7 @@ ResistanceLaw read_law(const Fields& f, const std::string& key) {
 void read_bicycle_leg(const Fields& f, Scene& s) {
   BicycleLegParams p;
   if (f.has("subject")) {
-    Fields sub(f.raw("subject"), f.join("subject"), f.file(), {"height_m", "mass_kg", "sex"});
+    Fields sub(f.raw("subject"), f.join("subject"), f.ctx(), {"height_m", "mass_kg", "sex"});
     p.height_m = sub.num_or("height_m", p.height_m);
     p.mass_kg = sub.num_or("mass_kg", p.mass_kg);
     p.sex = sub.str_or("sex", p.sex);
@@ -230,18 +441,18 @@ void read_bicycle_leg(const Fields& f, Scene& s) {
   p.pedal_stack_m = f.num_or("pedal_stack_m", p.pedal_stack_m);
   p.hip_torque_Nm = f.num_or("hip_torque_Nm", p.hip_torque_Nm);
   if (f.has("flywheel")) {
-    Fields fw(f.raw("flywheel"), f.join("flywheel"), f.file(),
+    Fields fw(f.raw("flywheel"), f.join("flywheel"), f.ctx(),
               {"gear_ratio", "inertia_kgm2", "mass_kg", "bike_mass_kg", "wheel_radius_m",
                "wheel_inertia_kgm2"});
     p.gear_ratio = fw.num_or("gear_ratio", p.gear_ratio);
-    p.flywheel_inertia_kgm2 = fw.num_or("inertia_kgm2", p.flywheel_inertia_kgm2);
+    if (fw.has("inertia_kgm2")) p.flywheel_inertia_kgm2 = fw.num("inertia_kgm2");
     p.flywheel_mass_kg = fw.num_or("mass_kg", p.flywheel_mass_kg);
     p.bike_mass_kg = fw.num_or("bike_mass_kg", p.bike_mass_kg);
     p.wheel_radius_m = fw.num_or("wheel_radius_m", p.wheel_radius_m);
     p.wheel_inertia_kgm2 = fw.num_or("wheel_inertia_kgm2", p.wheel_inertia_kgm2);
   }
   if (f.has("resistance")) {
-    Fields r(f.raw("resistance"), f.join("resistance"), f.file(), {"law", "power_W", "cadence_Hz"});
+    Fields r(f.raw("resistance"), f.join("resistance"), f.ctx(), {"law", "power_W", "cadence_Hz"});
     if (r.has("law")) p.resistance_law = read_law(r, "law");
     p.resistance_power_W = r.num_or("power_W", p.resistance_power_W);
     p.resistance_cadence_Hz = r.num_or("cadence_Hz", p.resistance_cadence_Hz);
@@ -258,15 +469,14 @@ void read_mechanism(const Fields& top, Scene& s) {
           top.to_vec2(kv.second, "ground_points." + kv.first.as<std::string>());
   }
   for_each_item(top, "bodies", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.file(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"});
+    Fields f(n, path, top.ctx(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"});
     Body b;
-    b.name = f.str("name");
-    b.mass_kg = f.num("mass_kg");
+    b.name = f.name("name");
+    b.mass_kg = f.num("mass_kg");  // ranges: check_scene
     b.com_m = f.has("com_m") ? f.vec2("com_m") : Vec2{};
     b.inertia_kgm2 = f.num("inertia_kgm2");
-    if (b.mass_kg <= 0.0) f.fail("mass_kg", "mass must be positive");
-    if (b.inertia_kgm2 <= 0.0) f.fail("inertia_kgm2", "inertia must be positive");
-    if (s.find_body(b.name) || b.name == kGround) f.fail("name", "duplicate body name '" + b.name + "'");
+    if (s.find_body(b.name) || b.name == kGround)
+      f.fail("name", "duplicate body name '" + b.name + "'");
     if (f.has("points")) {
       const YAML::Node pts = f.raw("points");
       if (!pts.IsMap()) f.fail("points", "expected a mapping name: [x, y]");
@@ -277,18 +487,22 @@ void read_mechanism(const Fields& top, Scene& s) {
     s.bodies.push_back(b);
   });
   for_each_item(top, "joints", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.file(),
+    Fields f(n, path, top.ctx(),
              {"name", "type", "parent", "child", "parent_point", "child_point", "axis",
               "offset_deg", "guess_deg", "guess_m"});
     Joint j;
-    j.name = f.str("name");
+    j.name = f.name("name");
     const std::string type = f.str("type");
-    if (type == "revolute") j.type = JointType::Revolute;
-    else if (type == "prismatic") j.type = JointType::Prismatic;
-    else f.fail("type", "expected revolute or prismatic");
+    if (type == "revolute")
+      j.type = JointType::Revolute;
+    else if (type == "prismatic")
+      j.type = JointType::Prismatic;
+    else
+      f.fail("type", "expected revolute or prismatic");
     j.parent = f.str("parent");
     j.child = f.str("child");
-    if (j.parent != kGround && !s.find_body(j.parent)) f.fail("parent", "unknown body '" + j.parent + "'");
+    if (j.parent != kGround && !s.find_body(j.parent))
+      f.fail("parent", "unknown body '" + j.parent + "'");
     if (!s.find_body(j.child)) f.fail("child", "unknown body '" + j.child + "'");
     j.parent_point = f.has("parent_point") ? read_point(f, "parent_point", j.parent, s) : Vec2{};
     j.child_point = f.has("child_point") ? read_point(f, "child_point", j.child, s) : Vec2{};
@@ -297,19 +511,22 @@ void read_mechanism(const Fields& top, Scene& s) {
       const double len = std::hypot(j.axis.x, j.axis.y);
       if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
       j.axis = {j.axis.x / len, j.axis.y / len};
-      if (f.has("offset_deg") || f.has("guess_deg")) f.fail("type", "prismatic joints take guess_m, not degrees");
+      if (f.has("offset_deg") || f.has("guess_deg"))
+        f.fail("type", "prismatic joints take guess_m, not degrees");
       j.guess = f.num_or("guess_m", 0.0);
     } else {
-      if (f.has("axis") || f.has("guess_m")) f.fail("type", "revolute joints take guess_deg and no axis");
-      j.offset_rad = f.num_or("offset_deg", 0.0) * kPi / 180.0;
-      j.guess = f.num_or("guess_deg", 0.0) * kPi / 180.0;
+      if (f.has("axis") || f.has("guess_m"))
+        f.fail("type", "revolute joints take guess_deg and no axis");
+      const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
+      j.offset_rad = f.num_abs_max("offset_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
+      j.guess = f.num_abs_max("guess_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
     }
     s.joints.push_back(j);
   });
   for_each_item(top, "loops", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.file(), {"name", "body_a", "point_a", "body_b", "point_b"});
+    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b"});
     Loop l;
-    l.name = f.str("name");
+    l.name = f.name("name");
     l.body_a = f.str("body_a");
     l.body_b = f.str("body_b");
     l.point_a = read_point(f, "point_a", l.body_a, s);
@@ -317,8 +534,8 @@ void read_mechanism(const Fields& top, Scene& s) {
     s.loops.push_back(l);
   });
   for_each_item(top, "gears", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.file(), {"name", "driver", "driven", "ratio"});
-    s.gears.push_back({f.str("name"), f.str("driver"), f.str("driven"), f.num("ratio")});
+    Fields f(n, path, top.ctx(), {"name", "driver", "driven", "ratio"});
+    s.gears.push_back({f.name("name"), f.str("driver"), f.str("driven"), f.num("ratio")});
   });
   s.independent = top.str("independent");
 }
@@ -332,40 +549,53 @@ struct PendingDissipation {
 void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pending) {
   std::set<std::string> names;
   for_each_item(top, "loads", [&](const YAML::Node& n, const std::string& path) {
-    if (!n.IsMap() || !n["type"]) throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
+    if (!n.IsMap() || !n["type"])
+      throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
     const std::string type = n["type"].as<std::string>();
-    const std::string name = n["name"] ? n["name"].as<std::string>() : fmt::format("load{}", names.size());
+    if (n["name"] && (!n["name"].IsScalar() || !is_valid_name(n["name"].Scalar())))
+      top.ctx().fail(
+          n["name"], path + ".name",
+          invalid_name_message(n["name"].IsScalar() ? n["name"].Scalar() : "(not text)"));
+    const std::string name = n["name"] ? n["name"].Scalar() : fmt::format("load{}", names.size());
     if (!names.insert(name).second)
-      throw SceneError(top.file(), line_of(n), path + ".name", "duplicate load name '" + name + "'");
+      throw SceneError(top.file(), line_of(n), path + ".name",
+                       "duplicate load name '" + name + "'");
     if (type == "joint_torque") {
-      Fields f(n, path, top.file(), {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
+      Fields f(n, path, top.ctx(),
+               {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
       JointTorque t{name, f.str("joint"), 0.0, std::nullopt};
-      if (f.has("torque_Nm") == f.has("force_N")) f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
+      if (f.has("torque_Nm") == f.has("force_N"))
+        f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
       t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num("force_N");
       if (f.has("active_when")) {
-        Fields g(f.raw("active_when"), f.join("active_when"), top.file(), {"joint", "rate"});
+        Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
         const std::string rate = g.str("rate");
-        if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+        if (rate != "positive" && rate != "negative")
+          g.fail("rate", "expected positive or negative");
         t.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
       }
       s.joint_torques.push_back(t);
     } else if (type == "resistance") {
-      Fields f(n, path, top.file(), {"type", "name", "body", "law", "coefficient", "dissipates"});
+      Fields f(n, path, top.ctx(), {"type", "name", "body", "law", "coefficient", "dissipates"});
       Resistance r{name, f.str("body"), read_law(f, "law"), 0.0};
       if (f.has("coefficient") == f.has("dissipates"))
         f.fail("coefficient", "give either coefficient or dissipates: {power_W, cadence_Hz}");
       if (f.has("coefficient")) {
         r.coefficient = f.num("coefficient");
       } else {
-        Fields d(f.raw("dissipates"), f.join("dissipates"), top.file(), {"power_W", "cadence_Hz"});
-        pending.push_back({s.resistances.size(), d.num("power_W"), d.num("cadence_Hz"), d.line()});
-        if (pending.back().power_W < 0.0 || pending.back().cadence_Hz <= 0.0)
-          d.fail("power_W", "power must be non-negative and cadence positive");
+        Fields d(f.raw("dissipates"), f.join("dissipates"), top.ctx(), {"power_W", "cadence_Hz"});
+        const double power_W = d.num_in("power_W", 0.0, limits::kMaxPower_W, "W");
+        const double cadence_Hz = d.num("cadence_Hz");
+        if (!(cadence_Hz > 0.0 && cadence_Hz <= limits::kMaxCadence_Hz))
+          d.fail("cadence_Hz", fmt::format("must be in (0, {:g}] Hz (got {:g})",
+                                           limits::kMaxCadence_Hz, cadence_Hz));
+        pending.push_back({s.resistances.size(), power_W, cadence_Hz, d.line()});
       }
       s.resistances.push_back(r);
     } else if (type == "spring") {
-      Fields f(n, path, top.file(),
-               {"type", "name", "body_a", "point_a", "body_b", "point_b", "stiffness_N_per_m", "rest_length_m"});
+      Fields f(n, path, top.ctx(),
+               {"type", "name", "body_a", "point_a", "body_b", "point_b", "stiffness_N_per_m",
+                "rest_length_m"});
       Spring sp;
       sp.name = name;
       sp.body_a = f.str("body_a");
@@ -376,27 +606,161 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       sp.rest_length_m = f.num("rest_length_m");
       s.springs.push_back(sp);
     } else if (type == "motor") {
-      Fields f(n, path, top.file(),
+      Fields f(n, path, top.ctx(),
                {"type", "name", "joint", "stall_torque_Nm", "stall_force_N", "no_load_speed_rad_s",
                 "no_load_speed_m_s"});
       Motor m{name, f.str("joint"), 0.0, 0.0};
       m.stall_torque = f.has("stall_force_N") ? f.num("stall_force_N") : f.num("stall_torque_Nm");
-      m.no_load_speed = f.has("no_load_speed_m_s") ? f.num("no_load_speed_m_s") : f.num("no_load_speed_rad_s");
+      m.no_load_speed =
+          f.has("no_load_speed_m_s") ? f.num("no_load_speed_m_s") : f.num("no_load_speed_rad_s");
       s.motors.push_back(m);
     } else {
-      throw SceneError(top.file(), line_of(n["type"]), path + ".type",
-                       "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
+      throw SceneError(
+          top.file(), line_of(n["type"]), path + ".type",
+          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
     }
   });
+}
+
+// Reads the YAML tree into `s` (names and shapes checked here, values by check_scene).
+void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
+  Fields top(
+      root, "", ctx,
+      {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
+       "independent", "loads", "gravity", "outputs", "initial", "simulation", "validation"});
+  s.name = top.name("name");
+  s.description = top.str_or("description", "");
+
+  // Initial conditions first: the generator places the mechanism at q0.
+  if (top.has("initial")) {
+    Fields f(top.raw("initial"), "initial", ctx, {"q", "q_deg", "qdot", "cadence_Hz"});
+    if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
+    if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
+    // Ranges in SI are check_scene's; the converted units are checked here, where the
+    // message can quote them (the generator places the mechanism at q before that).
+    s.initial.q = f.has("q_deg") ? f.num_abs_max("q_deg", 0.0, limits::kMaxAngle_rad * 180.0 / kPi,
+                                                 "degrees") *
+                                       kPi / 180.0
+                                 : f.num_abs_max("q", 0.0, limits::kMaxAngle_rad, "rad or m");
+    s.initial.qdot =
+        f.has("cadence_Hz")
+            ? f.num_abs_max("cadence_Hz", 0.0, limits::kMaxRate / (2.0 * kPi), "Hz") * 2.0 * kPi
+            : f.num_or("qdot", 0.0);
+  }
+  if (top.has("bicycle_leg")) {
+    for (const char* k : {"bodies", "joints", "loops", "gears", "independent", "ground_points"})
+      if (top.has(k))
+        top.fail(k, "a bicycle_leg scene generates its own mechanism; remove this key");
+    Fields f(top.raw("bicycle_leg"), "bicycle_leg", ctx,
+             {"subject", "legs", "crank_length_m", "crank_mass_kg", "seat_tube_angle_deg",
+              "knee_flexion_at_extension_deg", "ankle_angle_deg", "pedal_stack_m", "hip_torque_Nm",
+              "flywheel", "resistance"});
+    read_bicycle_leg(f, s);
+  } else {
+    read_mechanism(top, s);
+  }
+  std::vector<PendingDissipation> pending;
+  read_loads(top, s, pending);
+  for (const auto& p : pending) {
+    Resistance& r = s.resistances[p.index];
+    if (!s.find_body(r.body))
+      throw SceneError(ctx.file, p.line, "loads." + r.name + ".body",
+                       "unknown body '" + r.body + "'");
+    const auto ratio = fixed_speed_ratio(s, r.body);
+    if (!ratio)
+      throw SceneError(ctx.file, p.line, "loads." + r.name + ".dissipates",
+                       "'dissipates' needs a body turning at a fixed ratio to the independent "
+                       "coordinate (its child, or geared to it); give a coefficient instead");
+    const double omega = std::abs(*ratio) * 2.0 * kPi * p.cadence_Hz;
+    r.coefficient = p.power_W / std::pow(omega, dissipation_exponent(r.law));  // P = c·ωⁿ
+  }
+  if (top.has("gravity")) {
+    Fields f(top.raw("gravity"), "gravity", ctx, {"enabled", "g_m_s2"});
+    s.gravity.enabled = f.flag_or("enabled", true);
+    if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
+  }
+  if (top.has("outputs")) {
+    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies"});
+    for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
+      Fields c(n, path, ctx, {"name", "joint", "direction"});
+      ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
+      const Joint* j = s.find_joint(r.joint);
+      if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
+      const YAML::Node d = c.required("direction");
+      if (d.IsScalar()) {  // toward a named point of the child, from the joint
+        const Vec2 to = read_point(c, "direction", j->child, s);
+        r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
+      } else {
+        r.direction = c.vec2("direction");
+      }
+      const double len = std::hypot(r.direction.x, r.direction.y);
+      if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
+      r.direction = {r.direction.x / len, r.direction.y / len};
+      for (const auto& other : s.outputs.constraint_forces)
+        if (other.name == r.name) c.fail("name", "duplicate constraint force name");
+      s.outputs.constraint_forces.push_back(r);
+    });
+    if (f.has("bodies")) {
+      const YAML::Node b = f.raw("bodies");
+      if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
+      for (const auto& item : b) s.outputs.bodies.push_back(item.as<std::string>());
+    }
+  }
+  if (top.has("simulation")) {
+    Fields f(top.raw("simulation"), "simulation", ctx,
+             {"duration_s", "output_interval_s", "tolerance"});
+    s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
+    s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
+    s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
+  }
+  if (top.has("validation")) {
+    Fields f(top.raw("validation"), "validation", ctx,
+             {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
+              "reference_integrator"});
+    s.validation.duration_s = f.num_or("duration_s", 0.0);
+    s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
+    s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
+    const auto& ri = s.validation.reference_integrator;
+    if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
+      f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
+    s.validation.note = f.str_or("note", "");
+    for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
+      Fields t(n, path, ctx, {"quantity", "grid_deg", "interpolation", "max_error"});
+      Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
+                   t.num("max_error")};
+      // quantity, grid_deg, max_error: check_scene.
+      s.validation.thresholds.push_back(th);
+    });
+    if (f.has("calibrate")) {
+      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W"});
+      s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
+      s.validation.calibrate_power_W = c.num("power_W");
+      // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
+      if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
+      if (!(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
+    }
+  }
 }
 
 }  // namespace
 
 Override parse_override(const std::string& text) {
   const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0)
-    throw SceneError("", 0, "--set", "expected key=value, got '" + text + "'");
-  return {text.substr(0, eq), text.substr(eq + 1)};
+  const std::string shown = text.substr(0, 80) + (text.size() > 80 ? "…" : "");
+  if (eq == std::string::npos)
+    throw SceneError("", 0, "--set " + shown, "expected key.path=value (no '=')");
+  if (eq == 0) throw SceneError("", 0, "--set " + shown, "expected key.path=value (empty key)");
+  Override o{text.substr(0, eq), text.substr(eq + 1)};
+  if (o.path.size() > kMaxOverrideKeyLength)
+    throw SceneError("", 0, "--set " + shown,
+                     fmt::format("key path longer than {} characters", kMaxOverrideKeyLength));
+  if (o.value.size() > limits::kMaxTextLength)
+    throw SceneError("", 0, "--set " + shown,
+                     fmt::format("value longer than {} characters", limits::kMaxTextLength));
+  const auto parts = split_key_path(o.path);
+  if (std::any_of(parts.begin(), parts.end(), [](const std::string& p) { return p.empty(); }))
+    throw SceneError("", 0, "--set " + shown, "malformed key path (an empty part between dots)");
+  return o;
 }
 
 std::string resolve_scene_path(const std::string& name_or_path) {
@@ -421,148 +785,26 @@ std::string resolve_scene_path(const std::string& name_or_path) {
 
 Scene parse_scene(const std::string& text, const std::string& file,
                   const std::vector<Override>& overrides) {
-  // Scenes are a few kilobytes; refuse anything huge before the YAML parser sees it.
-  constexpr size_t kMaxSceneBytes = 1 << 20;
-  if (text.size() > kMaxSceneBytes)
-    throw SceneError(file, 0, "", fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
-  // yaml-cpp recurses once per nesting level: bound the depth so no input can exhaust the stack.
-  {
-    int depth = 0, max_depth = 0;
-    for (char c : text) {
-      if (c == '[' || c == '{') max_depth = std::max(max_depth, ++depth);
-      else if ((c == ']' || c == '}') && depth > 0) --depth;
-    }
-    if (max_depth > 64) throw SceneError(file, 0, "", "nested too deeply for a scene (more than 64 levels of [ or {)");
-  }
-  if (text.find('\0') != std::string::npos)
-    throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
-  }
-  if (!root || root.IsNull()) throw SceneError(file, 0, "", "the scene file is empty");
-  if (!root.IsMap()) throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
-  for (const auto& o : overrides) apply_override(root, o, file);
+  YAML::Node root = load_checked_yaml(text, file);
+  Context ctx{file, {}};
+  for (const auto& o : overrides) apply_override(root, o, file, &ctx.set_by_override);
+  // The overrides may have added nodes: check the tree they left (duplicates cannot arise,
+  // but depth and size can grow with created mappings).
+  if (!overrides.empty()) check_yaml_tree(root, file);
 
   Scene s;
   s.source_file = file;
   try {
-    Fields top(root, "", file,
-               {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops",
-                "gears", "independent", "loads", "gravity", "outputs", "initial", "simulation",
-                "validation"});
-    s.name = top.str("name");
-    s.description = top.str_or("description", "");
-
-    // Initial conditions first: the generator places the mechanism at q0.
-    if (top.has("initial")) {
-      Fields f(top.raw("initial"), "initial", file, {"q", "q_deg", "qdot", "cadence_Hz"});
-      if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
-      if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
-      s.initial.q = f.has("q_deg") ? f.num("q_deg") * kPi / 180.0 : f.num_or("q", 0.0);
-      s.initial.qdot = f.has("cadence_Hz") ? f.num("cadence_Hz") * 2.0 * kPi : f.num_or("qdot", 0.0);
-    }
-    if (top.has("bicycle_leg")) {
-      for (const char* k : {"bodies", "joints", "loops", "gears", "independent", "ground_points"})
-        if (top.has(k)) top.fail(k, "a bicycle_leg scene generates its own mechanism; remove this key");
-      Fields f(top.raw("bicycle_leg"), "bicycle_leg", file,
-               {"subject", "legs", "crank_length_m", "crank_mass_kg", "seat_tube_angle_deg",
-                "knee_flexion_at_extension_deg", "ankle_angle_deg", "pedal_stack_m",
-                "hip_torque_Nm", "flywheel", "resistance"});
-      read_bicycle_leg(f, s);
-    } else {
-      read_mechanism(top, s);
-    }
-    std::vector<PendingDissipation> pending;
-    read_loads(top, s, pending);
-    for (const auto& p : pending) {
-      Resistance& r = s.resistances[p.index];
-      if (!s.find_body(r.body))
-        throw SceneError(file, p.line, "loads." + r.name + ".body", "unknown body '" + r.body + "'");
-      const auto ratio = fixed_speed_ratio(s, r.body);
-      if (!ratio)
-        throw SceneError(file, p.line, "loads." + r.name + ".dissipates",
-                         "'dissipates' needs a body turning at a fixed ratio to the independent "
-                         "coordinate (its child, or geared to it); give a coefficient instead");
-      const double omega = std::abs(*ratio) * 2.0 * kPi * p.cadence_Hz;
-      r.coefficient = p.power_W / std::pow(omega, dissipation_exponent(r.law));  // P = c·ωⁿ
-    }
-    if (top.has("gravity")) {
-      Fields f(top.raw("gravity"), "gravity", file, {"enabled", "g_m_s2"});
-      s.gravity.enabled = f.flag_or("enabled", true);
-      if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
-    }
-    if (top.has("outputs")) {
-      Fields f(top.raw("outputs"), "outputs", file, {"constraint_forces", "bodies"});
-      for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
-        Fields c(n, path, file, {"name", "joint", "direction"});
-        ConstraintForceRequest r{c.str("name"), c.str("joint"), {}};
-        const Joint* j = s.find_joint(r.joint);
-        if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
-        const YAML::Node d = c.required("direction");
-        if (d.IsScalar()) {  // toward a named point of the child, from the joint
-          const Vec2 to = read_point(c, "direction", j->child, s);
-          r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
-        } else {
-          r.direction = c.vec2("direction");
-        }
-        const double len = std::hypot(r.direction.x, r.direction.y);
-        if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
-        r.direction = {r.direction.x / len, r.direction.y / len};
-        for (const auto& other : s.outputs.constraint_forces)
-          if (other.name == r.name) c.fail("name", "duplicate constraint force name");
-        s.outputs.constraint_forces.push_back(r);
-      });
-      if (f.has("bodies")) {
-        const YAML::Node b = f.raw("bodies");
-        if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
-        for (const auto& item : b) s.outputs.bodies.push_back(item.as<std::string>());
-      }
-    }
-    if (top.has("simulation")) {
-      Fields f(top.raw("simulation"), "simulation", file, {"duration_s", "output_interval_s", "tolerance"});
-      s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
-      s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
-      s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
-    }
-    if (top.has("validation")) {
-      Fields f(top.raw("validation"), "validation", file,
-               {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance", "reference_integrator"});
-      s.validation.duration_s = f.num_or("duration_s", 0.0);
-      s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
-      if (!(s.validation.reference_tolerance > 0 && s.validation.reference_tolerance < 1e-3))
-        f.fail("reference_tolerance", "must be in (0, 1e-3)");
-      s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
-      const auto& ri = s.validation.reference_integrator;
-      if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
-        f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
-      s.validation.note = f.str_or("note", "");
-      if (s.validation.duration_s < 0) f.fail("duration_s", "must be positive");
-      for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
-        Fields t(n, path, file, {"quantity", "grid_deg", "interpolation", "max_error"});
-        Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
-                     t.num("max_error")};
-        bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
-        for (const auto& c : s.outputs.constraint_forces) known |= c.name == th.quantity;
-        if (!known) t.fail("quantity", "expected qdot, mean_qdot or the name of a requested constraint force");
-        if (!(th.max_error > 0)) t.fail("max_error", "must be positive");
-        if (!(th.grid_deg > 0)) t.fail("grid_deg", "must be positive");
-        s.validation.thresholds.push_back(th);
-      });
-      if (f.has("calibrate")) {
-        Fields c(f.raw("calibrate"), "validation.calibrate", file, {"cadence_Hz", "power_W"});
-        s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
-        s.validation.calibrate_power_W = c.num("power_W");
-        if (!(s.validation.calibrate_cadence_Hz > 0) || !(s.validation.calibrate_power_W > 0))
-          c.fail("cadence_Hz", "cadence and power must be positive");
-      }
-    }
+    read_scene(root, ctx, s);
+    check_scene(s);
   } catch (const YAML::Exception& e) {
     throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.msg);
+  } catch (const SceneError& e) {
+    // check_scene and the generator know the field, not the line: find it in the tree.
+    if (e.line() > 0 || e.field().empty() || e.field().rfind("--set", 0) == 0) throw;
+    const YAML::Node n = locate_field(root, e.field());
+    ctx.fail(n, e.field(), e.message());
   }
-  check_scene(s);
   return s;
 }
 
@@ -596,7 +838,8 @@ bool find_path(YAML::Node root, const std::string& path, YAML::Node& parent, std
       found = true;
     } else if (cur.IsSequence()) {
       for (size_t k = 0; k < cur.size() && !found; ++k)
-        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == parts[i]) next.reset(cur[k]), found = true;
+        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].Scalar() == parts[i])
+          next.reset(cur[k]), found = true;
     }
     if (!found) return false;
     cur.reset(next);
@@ -609,23 +852,20 @@ bool find_path(YAML::Node root, const std::string& path, YAML::Node& parent, std
 
 bool scene_yaml_has(const std::string& text, const std::string& path) {
   try {
-    YAML::Node root = YAML::Load(text), parent;
+    YAML::Node root = load_checked_yaml(text, ""), parent;
     std::string last;
     return find_path(root, path, parent, last);
   } catch (const YAML::Exception&) {
     return false;
+  } catch (const SceneError&) {
+    return false;
   }
 }
 
-std::string rewrite_scene_yaml(const std::string& text, const std::string& file, const std::vector<Override>& overrides,
+std::string rewrite_scene_yaml(const std::string& text, const std::string& file,
+                               const std::vector<Override>& overrides,
                                const std::vector<std::string>& remove) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
-  }
-  if (!root.IsMap()) throw SceneError(file, 0, "", "a scene must be a YAML mapping of keys");
+  YAML::Node root = load_checked_yaml(text, file);
   for (const auto& path : remove) {
     YAML::Node parent;
     std::string last;

@@ -1,9 +1,15 @@
 // Scene reading: shipped scenes load; bad input gives SceneError naming file, line, field.
 #include "models/scene_yaml.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace rdyn::models {
 namespace {
@@ -17,6 +23,31 @@ std::string error_of(const std::string& yaml, std::vector<Override> o = {}) {
     return e.what();
   }
   return "";
+}
+
+// The SceneError of parsing `yaml` (with overrides); fails the test when it parses.
+SceneError refusal(const std::string& yaml, std::vector<Override> o = {}) {
+  try {
+    parse_scene(yaml, "test.yaml", o);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "parsed:\n" << yaml;
+  return SceneError("", 0, "", "");
+}
+
+// 1-based line of the first occurrence of `text` in `yaml`.
+int line_in(const std::string& yaml, const std::string& text) {
+  const auto at = yaml.find(text);
+  EXPECT_NE(at, std::string::npos) << text;
+  return 1 + static_cast<int>(std::count(yaml.begin(), yaml.begin() + static_cast<long>(at), '\n'));
+}
+
+// `yaml` with the first `from` replaced by `to`.
+std::string with(std::string yaml, const std::string& from, const std::string& to) {
+  const auto at = yaml.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? yaml : yaml.replace(at, from.size(), to);
 }
 
 const char* kFourbar = R"(
@@ -72,8 +103,9 @@ TEST(SceneYaml, UnknownKeySuggestsNearestAndNamesLine) {
 }
 
 TEST(SceneYaml, OverridesReachScalarsByPathAndName) {
-  const Scene s = parse_scene(kFourbar, "t.yaml", {parse_override("loads.bearing.coefficient=0.25"),
-                                                   parse_override("bodies.1.mass_kg=2.5")});
+  const Scene s = parse_scene(
+      kFourbar, "t.yaml",
+      {parse_override("loads.bearing.coefficient=0.25"), parse_override("bodies.1.mass_kg=2.5")});
   EXPECT_DOUBLE_EQ(s.resistances[0].coefficient, 0.25);
   EXPECT_DOUBLE_EQ(s.bodies[1].mass_kg, 2.5);
   const Scene b = load_scene("bicycle", {parse_override("bicycle_leg.hip_torque_Nm=50")});
@@ -86,7 +118,9 @@ TEST(SceneYaml, OverridesReachScalarsByPathAndName) {
 TEST(SceneYaml, BadValuesAreRefusedWithTheirField) {
   std::string y = kFourbar;
   y.replace(y.find("mass_kg: 0.9"), 12, "mass_kg: 0.0");
-  EXPECT_NE(error_of(y).find("bodies[2].mass_kg"), std::string::npos) << error_of(y);
+  // check_scene names the item by name; the reader finds its line (the rocker is on line 7).
+  EXPECT_NE(error_of(y).find("test.yaml:7: field 'bodies.rocker.mass_kg'"), std::string::npos)
+      << error_of(y);
   y = kFourbar;
   y.replace(y.find("mass_kg: 0.9"), 12, "mass_kg: .nan");
   EXPECT_NE(error_of(y).find("finite"), std::string::npos) << error_of(y);
@@ -118,6 +152,261 @@ TEST(SceneYaml, MissingSceneFileIsNamed) {
     FAIL();
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.yaml"), std::string::npos);
+  }
+}
+
+TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
+  // Names, ranges and duplicate keys are checked: every scene shipped must still load.
+  int n = 0;
+  for (const char* dir : {RDYN_SCENES, RDYN_SCENES "/hard"})
+    for (const auto& f : std::filesystem::directory_iterator(dir))
+      if (f.path().extension() == ".yaml") {
+        EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
+        ++n;
+      }
+  EXPECT_EQ(n, 11);
+}
+
+TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
+  const std::string fb = kFourbar;
+  struct Case {
+    std::string yaml, field, second;  // scene, key path, text on the line of the repeated key
+  };
+  const std::string bike =
+      "name: b\nbicycle_leg:\n  legs: 2\n  flywheel: {gear_ratio: 3, gear_ratio: 2}\n";
+  const Case cases[] = {
+      {fb + "name: again\n", "name", "name: again"},
+      {with(fb, "mass_kg: 0.9,", "mass_kg: 0.9, mass_kg: 2,"), "bodies[2].mass_kg", "mass_kg: 2"},
+      {with(fb, "points: {C: [0.2, 0]}", "points: {C: [0.2, 0], C: [0.3, 0]}"),
+       "bodies[2].points.C", "C: [0.3"},
+      {with(fb, "D: [0.3, 0]}", "D: [0.3, 0], A: [1, 1]}"), "ground_points.A", "A: [1, 1]"},
+      {with(fb, "coefficient: 1.0e-3}", "coefficient: 1.0e-3, law: quadratic}"), "loads[0].law",
+       "law: quadratic"},
+      {fb + "validation:\n  duration_s: 1\n  note: x\n  duration_s: 2\n", "validation.duration_s",
+       "duration_s: 2"},
+      {bike, "bicycle_leg.flywheel.gear_ratio", "gear_ratio: 2"},
+  };
+  for (const auto& c : cases) {
+    const SceneError e = refusal(c.yaml);
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_EQ(e.line(), line_in(c.yaml, c.second)) << e.what();
+    EXPECT_NE(std::string(e.what()).find("duplicate key"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
+  const std::string fb =
+      std::string(kFourbar) +
+      "outputs:\n  constraint_forces:\n    - {name: axial, joint: rocker, direction: C}\n";
+  // YAML spellings of a space, comma, quote, apostrophe, newline, slash, angle bracket, dot.
+  for (const std::string bad :
+       {"'a b'", "'a,b'", "'a\"b'", "\"a'b\"", "\"a\\nb\"", "a/b", "'<b>'", "a.b", "1a"}) {
+    struct Case {
+      std::string from, to, field;
+    };
+    const Case cases[] = {
+        {"name: fb", "name: " + bad, "name"},
+        {"name: coupler,", "name: " + bad + ",", "bodies[1].name"},
+        {"{name: rocker, type", "{name: " + bad + ", type", "joints[2].name"},
+        {"{name: C,", "{name: " + bad + ",", "loops[0].name"},
+        {"name: bearing", "name: " + bad, "loads[0].name"},
+        {"name: axial", "name: " + bad, "outputs.constraint_forces[0].name"},
+    };
+    for (const auto& c : cases) {
+      const std::string y = with(fb, c.from, c.to);
+      const SceneError e = refusal(y);
+      EXPECT_EQ(e.field(), c.field) << e.what();
+      EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is not a valid name"), std::string::npos) << e.what();
+    }
+  }
+  // Point names too (they are map keys).
+  const std::string y = with(fb, "points: {B: [0.08, 0]}", "points: {B: [0.08, 0], 'a b': [0, 0]}");
+  EXPECT_EQ(refusal(y).field(), "bodies.crank.points");
+  EXPECT_EQ(refusal(y).line(), line_in(y, "'a b'"));
+}
+
+TEST(SceneYaml, DuplicateNamesWithinAKindAreRefused) {
+  const std::string fb = kFourbar;
+  std::string y =
+      with(fb, "independent:",
+           "  - {name: C, body_a: coupler, point_a: C, body_b: crank, point_b: B}\nindependent:");
+  EXPECT_EQ(refusal(y).field(), "loops[1].name");
+  EXPECT_EQ(refusal(y).line(), line_in(y, "body_b: crank"));
+  y = with(fb, "{name: coupler, type", "{name: crank, type");
+  EXPECT_EQ(refusal(y).field(), "joints[1].name");
+  EXPECT_EQ(refusal(y).line(), line_in(y, "{name: crank, type: revolute, parent: crank"));
+  y = fb + "  - {type: joint_torque, name: bearing, joint: crank, torque_Nm: 1}\n";
+  EXPECT_EQ(refusal(y).field(), "loads[1].name");
+}
+
+TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
+  const std::string fb = std::string(kFourbar) + "gravity: {enabled: true}\n";
+  struct Case {
+    std::string from, to, field;
+  };
+  const Case cases[] = {
+      {"mass_kg: 0.9", "mass_kg: 1.0e308", "bodies.rocker.mass_kg"},
+      {"inertia_kgm2: 3.0e-3", "inertia_kgm2: 1.0e7", "bodies.rocker.inertia_kgm2"},
+      {"C: [0.2, 0]", "C: [0.2, -1.0e4]", "bodies.rocker.points.C[1]"},
+      {"D: [0.3, 0]", "D: [1.0e300, 0]", "ground_points.D[0]"},
+      {"guess_deg: 90", "guess_deg: 1.0e300", "joints[2].guess_deg"},
+      {"coefficient: 1.0e-3", "coefficient: 1.0e9", "loads.bearing.coefficient"},
+      {"coefficient: 1.0e-3", "coefficient: -1", "loads.bearing.coefficient"},
+      {"coefficient: 1.0e-3", "dissipates: {power_W: -5, cadence_Hz: 1}",
+       "loads[0].dissipates.power_W"},
+      {"coefficient: 1.0e-3", "dissipates: {power_W: 5, cadence_Hz: 0}",
+       "loads[0].dissipates.cadence_Hz"},
+      {"gravity: {enabled: true}", "gravity: {g_m_s2: [0, -1.0e308]}", "gravity.g_m_s2[1]"},
+      {"gravity: {enabled: true}", "initial: {q_deg: 1.0e300}", "initial.q_deg"},
+      {"gravity: {enabled: true}", "initial: {cadence_Hz: -1.0e4}", "initial.cadence_Hz"},
+      {"gravity: {enabled: true}", "initial: {qdot: 1.0e5}", "initial.qdot"},
+      {"gravity: {enabled: true}", "simulation: {duration_s: 0}", "simulation.duration_s"},
+      {"gravity: {enabled: true}", "simulation: {duration_s: 1.0e6}", "simulation.duration_s"},
+      {"gravity: {enabled: true}", "simulation: {output_interval_s: 1.0e-9}",
+       "simulation.output_interval_s"},
+      {"gravity: {enabled: true}", "simulation: {duration_s: 1.0e4, output_interval_s: 1.0e-4}",
+       "simulation.output_interval_s"},  // 1e8 rows
+      {"gravity: {enabled: true}", "simulation: {tolerance: 1}", "simulation.tolerance"},
+      {"gravity: {enabled: true}",
+       "validation: {thresholds: [{quantity: qdot, grid_deg: 7, max_error: 0.01}]}",
+       "validation.thresholds[0].grid_deg"},
+      {"gravity: {enabled: true}",
+       "validation: {thresholds: [{quantity: qdot, grid_deg: 10, max_error: 2}]}",
+       "validation.thresholds[0].max_error"},
+      {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 50, power_W: 10}}",
+       "validation.calibrate.cadence_Hz"},
+      {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 1.0e6}}",
+       "validation.calibrate.power_W"},
+      {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}",
+       "validation.reference_tolerance"},
+  };
+  for (const auto& c : cases) {
+    const std::string y = with(fb, c.from, c.to);
+    const SceneError e = refusal(y);
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
+  }
+}
+
+TEST(SceneYaml, AGearCouplingAJointToItselfIsRefused) {
+  // Two free wheels: joints (2) − gears (1) counted one degree of freedom, and ran with two.
+  const std::string y = R"(name: wheels
+ground_points: {A: [0, 0], B: [0.3, 0]}
+bodies:
+  - {name: wheel, mass_kg: 2, inertia_kgm2: 0.04}
+  - {name: pinion, mass_kg: 0.5, inertia_kgm2: 1.0e-3}
+joints:
+  - {name: wheel, type: revolute, parent: ground, parent_point: A, child: wheel}
+  - {name: pinion, type: revolute, parent: ground, parent_point: B, child: pinion}
+gears:
+  - {name: mesh, driver: wheel, driven: wheel, ratio: 2}
+independent: wheel
+)";
+  const SceneError e = refusal(y);
+  EXPECT_EQ(e.field(), "gears.mesh.driven");
+  EXPECT_EQ(e.line(), line_in(y, "driven: wheel"));
+  const std::string ok = with(y, "driven: wheel", "driven: pinion");
+  EXPECT_NO_THROW(parse_scene(ok, "t.yaml"));
+  EXPECT_EQ(refusal(with(ok, "ratio: 2", "ratio: 0")).field(), "gears.mesh.ratio");
+  EXPECT_EQ(refusal(with(ok, "ratio: 2", "ratio: 2.0e3")).field(), "gears.mesh.ratio");
+}
+
+TEST(SceneYaml, DissipatesThroughAGearFromAnUnknownJointIsRefused) {
+  // Crashed (null joint) before check_scene could refuse the unknown names.
+  const std::string y = R"(name: g
+bodies:
+  - {name: wheel, mass_kg: 2, inertia_kgm2: 0.04}
+joints:
+  - {name: wheel, type: revolute, parent: ground, child: wheel}
+gears:
+  - {name: mesh, driver: nosuch, driven: wheel, ratio: 2}
+independent: nosuch
+loads:
+  - {type: resistance, name: brake, body: wheel, law: viscous, dissipates: {power_W: 10, cadence_Hz: 1}}
+)";
+  EXPECT_EQ(refusal(y).field(), "loads.brake.dissipates");
+}
+
+TEST(SceneYaml, AMotorRunningAwayIsRefused) {
+  const std::string y = with(read_scene_text("slider-crank"), "no_load_speed_rad_s: 60.0",
+                             "no_load_speed_rad_s: -60.0");
+  const SceneError e = refusal(y);
+  EXPECT_EQ(e.field(), "loads.motor.no_load_speed_rad_s");
+  EXPECT_EQ(e.line(), line_in(y, "no_load_speed_rad_s: -60.0"));
+  EXPECT_NE(std::string(e.what()).find("opposite sign"), std::string::npos);
+  // Both negative: a motor driving the other way is meant.
+  EXPECT_NO_THROW(parse_scene(with(y, "stall_torque_Nm: 6.0", "stall_torque_Nm: -6.0"), "t.yaml"));
+}
+
+TEST(SceneYaml, MalformedOverridesAreRefusedNamingThem) {
+  for (const char* bad : {"novalue", "=3", "a..b=1", ".a=1", "a.=1"}) {
+    try {
+      parse_override(bad);
+      ADD_FAILURE() << bad;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(e.field().rfind("--set " + std::string(bad).substr(0, 3), 0), 0u) << e.what();
+    }
+  }
+  EXPECT_THROW(parse_override("k=" + std::string(5000, 'x')), SceneError);
+  struct Case {
+    std::string override_text, field, says;
+  };
+  const Case cases[] = {
+      {"bodies.0.mas_kg=3", "--set bodies.0.mas_kg", "did you mean 'mass_kg'"},  // unknown key
+      {"nosuch=3", "--set nosuch", "unknown key"},  // unknown top-level key
+      {"bodies.1.mass_kg=heavy", "--set bodies.1.mass_kg", "expected a number"},  // not a number
+      {"bodies.7.mass_kg=1", "--set bodies.7.mass_kg", "no list item '7'"},  // index out of range
+      {"bodies.rocker.points.C.2=1", "--set bodies.rocker.points.C.2", "no scalar list item"},
+      {"bodies.rocker.mass_kg=-1", "--set bodies.rocker.mass_kg",
+       "must be in [1e-06"},  // out of range
+      {"loads.bearing.coefficient=.nan", "--set loads.bearing.coefficient", "finite"},
+      {"name=a b", "--set name", "not a valid name"},
+      {"bodies=3", "--set bodies", "only scalar values"},
+      {"independent.x=3", "--set independent.x", "not a mapping"},
+  };
+  for (const auto& c : cases) {
+    const SceneError e = refusal(kFourbar, {parse_override(c.override_text)});
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
+  std::string laughs =
+      "name: x\na0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";  // 10^30 nodes when expanded
+  for (int i = 1; i < 30; ++i) {
+    laughs += fmt::format("a{}: &a{} [", i, i);
+    for (int k = 0; k < 10; ++k) laughs += fmt::format("{}*a{}", k ? ", " : "", i - 1);
+    laughs += "]\n";
+  }
+  std::string many = "name: many\nbodies:\n";
+  for (int i = 0; i < 1001; ++i)
+    many += fmt::format("  - {{name: b{}, mass_kg: 1, inertia_kgm2: 1}}\n", i);
+  std::string block_nest = "name: x\nbodies: ";
+  for (int i = 0; i < 5000; ++i) block_nest += "- ";
+  block_nest += "x\n";
+  struct Case {
+    std::string what, yaml, says;
+  };
+  const Case cases[] = {
+      {"billion laughs", laughs, "more than 200000 nodes"},
+      {"alias cycle", "name: x\nbodies: &a [*a]\n", "refers to its own ancestor"},
+      {"1001 bodies", many, "at most 1000"},
+      {"long string", "name: x\ndescription: " + std::string(5000, 'x') + "\n", "at most 4096"},
+      {"long name", "name: " + std::string(65, 'x') + "\n", "not a valid name"},
+      {"deep flow", "name: x\nbodies: " + std::string(100, '[') + std::string(100, ']') + "\n",
+       "nested too deeply"},
+      {"deep block", block_nest, "test.yaml"},
+      {"complex key", "name: x\n? [a, b]\n: 1\n", "plain text"},
+  };
+  for (const auto& c : cases) {
+    const auto start = std::chrono::steady_clock::now();
+    const SceneError e = refusal(c.yaml);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << c.what << ": " << e.what();
+    EXPECT_LT(seconds, 2.0) << c.what;  // a walk over 10^30 nodes would never return
   }
 }
 
