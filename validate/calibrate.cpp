@@ -9,6 +9,7 @@
 #include <gsl/gsl_roots.h>
 
 #include "engine/forward_dynamics.hpp"
+#include "engine/full_model.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
@@ -81,8 +82,7 @@ double cadence_error(double T, void* p) {
 
 }  // namespace
 
-CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
-  const auto start = std::chrono::steady_clock::now();
+void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw models::SceneError(scene.source_file, 0, field, msg);
   };
@@ -90,8 +90,20 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   if (scene.resistances.size() != 1) fail("loads", "calibration needs exactly one resistance");
   if (!(opt.cadence_hz > 0) || !(opt.power_w > 0)) fail("--cadence-hz/--power-w", "must be positive");
   const auto& res = scene.resistances[0];
+  if (!models::fixed_speed_ratio(scene, res.body))
+    fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
+  const engine::FullModel model(scene);
+  const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
+}
+
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, 0, field, msg);
+  };
+  check_calibratable(scene, opt);
+  const auto& res = scene.resistances[0];
   const auto ratio = models::fixed_speed_ratio(scene, res.body);
-  if (!ratio) fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
   CalibrationResult r;
   const double omega_b = std::abs(*ratio) * 2 * M_PI * opt.cadence_hz;
   r.resistance_coefficient = opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n

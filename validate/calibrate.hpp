@@ -39,8 +39,14 @@ struct CalibrationResult {
   double wall_time_s = 0.0;
 };
 
-// Throws models::SceneError when the scene has no drive torque or not exactly one
-// resistance turning at a fixed ratio, and reduced::TableError if no torque reaches F.
+// Checks that `scene` can be calibrated at all (a drive torque to scale, exactly one resistance
+// turning at a fixed ratio to q, positive cadence and power) and that it assembles; throws
+// models::SceneError / engine::EngineError (bad input) otherwise. Cheap: sweeps call it on the
+// base scene before any case runs.
+void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt);
+
+// Throws as check_calibratable, and models::NumericalError when no torque reaches F or the
+// result misses its target.
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress);
 
 // The scene's YAML rewritten with the calibrated torque, resistance and steady initial

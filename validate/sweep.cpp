@@ -48,6 +48,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   if (!(copt.cadence_hz > 0) || !(copt.power_w > 0))
     throw models::SceneError(base.source_file, 0, "--cadence-hz/--power-w",
                              "give them, or a validation.calibrate block in the scene");
+  check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
   // Every axis at both ends of its range on the base scene: unknown keys and values out of
   // range fail here, before any thread starts.
   for (const auto& a : opt.axes)

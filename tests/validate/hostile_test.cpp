@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <regex>
+#include <set>
 
 #include "tests/validate/run_rdyn.hpp"
 
@@ -302,10 +303,124 @@ void outputs(std::vector<Case>& cs) {
                 "--quick"});
 }
 
+// Scenes: values, names, structure and YAML tricks, through every subcommand that reads a
+// scene: exit 2 with the field named, nothing written.
+void scenes(std::vector<Case>& cs) {
+  const std::string fb = scene_text("fourbar");
+  struct Bad {
+    std::string tag, text, field;  // field: expected in the message
+  };
+  const std::string crank = "{name: crank,   mass_kg: 0.50, com_m: [0.04, 0], inertia_kgm2: 2.667e-4, points: {B: [0.08, 0]}}";
+  auto crank_with = [&](const std::string& from, const std::string& to) { return edit(fb, crank, edit(crank, from, to)); };
+  const std::vector<Bad> bad{
+      {"mass_nan", crank_with("mass_kg: 0.50", "mass_kg: .nan"), "mass_kg"},
+      {"mass_negative", crank_with("mass_kg: 0.50", "mass_kg: -0.5"), "mass_kg"},
+      {"mass_zero", crank_with("mass_kg: 0.50", "mass_kg: 0"), "mass_kg"},
+      {"mass_huge", crank_with("mass_kg: 0.50", "mass_kg: 1e300"), "mass_kg"},
+      {"mass_text", crank_with("mass_kg: 0.50", "mass_kg: heavy"), "mass_kg"},
+      {"mass_list", crank_with("mass_kg: 0.50", "mass_kg: [1, 2]"), "mass_kg"},
+      {"inertia_zero", crank_with("inertia_kgm2: 2.667e-4", "inertia_kgm2: 0"), "inertia_kgm2"},
+      {"inertia_inf", crank_with("inertia_kgm2: 2.667e-4", "inertia_kgm2: .inf"), "inertia_kgm2"},
+      {"point_huge", crank_with("B: [0.08, 0]", "B: [1e9, 0]"), "B"},
+      {"point_nan", crank_with("B: [0.08, 0]", "B: [.nan, 0]"), "B"},
+      {"point_short", crank_with("B: [0.08, 0]", "B: [0.08]"), "B"},
+      {"com_nan", crank_with("com_m: [0.04, 0]", "com_m: [0.04, .nan]"), "com_m"},
+      {"duplicate_key", crank_with("mass_kg: 0.50,", "mass_kg: 0.50, mass_kg: 0.6,"), "duplicate key"},
+      {"duplicate_top_key", fb + "gravity: {enabled: false}\n", "duplicate key"},
+      {"name_comma", edit(fb, "name: fourbar", "name: \"four,bar\""), "not a valid name"},
+      {"name_newline", edit(fb, "name: fourbar", "name: \"four\\nbar\""), "not a valid name"},
+      {"name_html", edit(fb, "name: fourbar", "name: \"<script>x</script>\""), "not a valid name"},
+      {"name_quote", edit(fb, "name: fourbar", "name: \"a'b\""), "not a valid name"},
+      {"name_slash", edit(fb, "name: fourbar", "name: \"../../etc\""), "not a valid name"},
+      {"name_space", edit(fb, "name: fourbar", "name: \"four bar\""), "not a valid name"},
+      {"name_long", edit(fb, "name: fourbar", "name: " + std::string(100, 'x')), "not a valid name"},
+      {"force_name_comma", edit(fb, "name: rocker_axial", "name: \"a,b\""), "not a valid name"},
+      {"body_duplicate", edit(fb, "{name: coupler, mass_kg", "{name: crank, mass_kg"), "crank"},
+      {"gear_self", edit(fb, "independent: crank", "gears: [{name: g, driver: crank, driven: crank, ratio: 2}]\nindependent: crank"), "driven"},
+      {"gear_ratio_zero", edit(fb, "independent: crank", "gears: [{name: g, driver: crank, driven: rocker, ratio: 0}]\nindependent: crank"), "ratio"},
+      {"motor_opposite_sign", edit(fb, "loads:\n", "loads:\n  - {type: motor, name: m, joint: crank, stall_torque_Nm: 1, no_load_speed_rad_s: -5}\n"), "sign"},
+      {"motor_zero_speed", edit(fb, "loads:\n", "loads:\n  - {type: motor, name: m, joint: crank, stall_torque_Nm: 1, no_load_speed_rad_s: 0}\n"), "no_load_speed"},
+      {"resistance_huge", edit(fb, "coefficient: 1.0e-3", "coefficient: 1.0e12"), "coefficient"},
+      {"resistance_negative", edit(fb, "coefficient: 1.0e-3", "coefficient: -1"), "coefficient"},
+      {"resistance_law", edit(fb, "law: viscous", "law: magic"), "law"},
+      {"tolerance_zero", edit(fb, "tolerance: 1.0e-9", "tolerance: 0"), "tolerance"},
+      {"interval_tiny", edit(fb, "output_interval_s: 0.002", "output_interval_s: 1e-12"), "output_interval_s"},
+      {"duration_huge", edit(fb, "duration_s: 3", "duration_s: 1e9"), "duration_s"},
+      {"duration_negative", edit(fb, "duration_s: 3", "duration_s: -3"), "duration_s"},
+      {"qdot_nan", edit(fb, "qdot: 8.0", "qdot: .nan"), "qdot"},
+      {"qdot_huge", edit(fb, "qdot: 8.0", "qdot: 1e30"), "qdot"},
+      {"gravity_inf", edit(fb, "g_m_s2: [0, -9.81]", "g_m_s2: [0, .inf]"), "g_m_s2"},
+      {"unknown_key", fb + "bogus: 1\n", "bogus"},
+      {"unknown_joint_ref", edit(fb, "independent: crank", "independent: nosuch"), "independent"},
+      {"direction_zero", edit(fb, "direction: C", "direction: [0, 0]"), "direction"},
+      {"joint_type", edit(fb, "type: revolute, parent: crank", "type: spherical, parent: crank"), "type"},
+      {"truncated", fb.substr(0, fb.size() / 2) + "\n  - {name: [", ""},
+      {"binary", std::string("\x00\x01\xff\xfe garbage", 16), ""},
+      {"empty", "", ""},
+      {"not_a_map", "- 1\n- 2\n", ""},
+      {"deep_nesting", std::string(200, '[') + std::string(200, ']') + "\n", "nest"},
+      {"billion_laughs",
+       "a: &a [x, x, x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+       "c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b, *b]\nd: &d [*c, *c, *c, *c, *c, *c, *c, *c, *c, *c]\n"
+       "e: &e [*d, *d, *d, *d, *d, *d, *d, *d, *d, *d]\nf: &f [*e, *e, *e, *e, *e, *e, *e, *e, *e, *e]\n",
+       ""},
+      {"too_large", fb + "# " + std::string(1 << 21, 'x') + "\n", "too large"},
+      {"loop_cannot_close", edit(fb, "ground_points: {A: [0.0, 0.0], D: [0.30, 0.0]}", "ground_points: {A: [0.0, 0.0], D: [3.0, 0.0]}"), "C"},
+  };
+  for (const auto& b : bad) {
+    cs.push_back({"scene_" + b.tag + "_simulate", {"simulate", "s.yaml", "--duration", "0.1", "--out", "o"}, 2,
+                  b.field, {{"s.yaml", b.text}}, nullptr, "o"});
+  }
+  // The same scene errors through the other subcommands (a sample of them).
+  for (const auto& b : bad) {
+    static const std::set<std::string> sample{"mass_nan", "duplicate_key", "name_comma", "gear_self",
+                                              "resistance_huge", "billion_laughs"};
+    if (!sample.count(b.tag)) continue;
+    cs.push_back({"scene_" + b.tag + "_extract", {"extract", "s.yaml", "--out", "t.csv"}, 2, b.field,
+                  {{"s.yaml", b.text}}, nullptr, "t.csv"});
+    cs.push_back({"scene_" + b.tag + "_validate", {"validate", "s.yaml", "--out", "o"}, 2, b.field,
+                  {{"s.yaml", b.text}}, nullptr, "o"});
+    cs.push_back({"scene_" + b.tag + "_calibrate", {"calibrate", "s.yaml", "--write-scene", "c.yaml"}, 2, b.field,
+                  {{"s.yaml", b.text}}, nullptr, "c.yaml"});
+    cs.push_back({"scene_" + b.tag + "_sweep",
+                  {"sweep", "s.yaml", "--vary", "bodies.crank.mass_kg=0.4:0.6:2", "--cadence-hz", "1", "--power-w",
+                   "1", "--out", "w.csv"},
+                  2, b.field, {{"s.yaml", b.text}}, nullptr, "w.csv"});
+  }
+  // A bad scene inside a suite is that scene's error; the others still run, the suite fails.
+  // Overrides.
+  const std::vector<std::pair<std::string, std::string>> sets{
+      {"bodies.crank.mass_kg=nan", "mass_kg"},   {"bodies.crank.mass_kg=-1", "mass_kg"},
+      {"bodies.crank.mass_kg=abc", "mass_kg"},   {"nosuch.key=1", "nosuch"},
+      {"=1", "--set"},                            {"bodies.crank.mass_kg", "--set"},
+      {"bodies.7.mass_kg=1", "7"},                {"name=a,b", "not a valid name"},
+      {"simulation.tolerance=0", "tolerance"},    {"initial.qdot=inf", "qdot"},
+      {"gravity.g_m_s2.1=1e400", "g_m_s2"},      {"bodies.crank.points.B.0=1e9", "B"}};
+  for (size_t k = 0; k < sets.size(); ++k)
+    cs.push_back({"set_bad" + std::to_string(k),
+                  {"simulate", "fourbar", "--duration", "0.1", "--set", sets[k].first, "--out", "o"}, 2,
+                  sets[k].second, {}, nullptr, "o"});
+  // The bicycle-leg generator refuses values it cannot mean instead of replacing them.
+  const std::vector<std::string> leg{"bicycle_leg.subject.height_m=-1.7", "bicycle_leg.subject.mass_kg=0",
+                                     "bicycle_leg.crank_length_m=-0.17", "bicycle_leg.hip_torque_Nm=-5",
+                                     "bicycle_leg.flywheel.inertia_kgm2=0", "bicycle_leg.subject.height_m=nan",
+                                     "bicycle_leg.flywheel.gear_ratio=1e9"};
+  for (size_t k = 0; k < leg.size(); ++k)
+    cs.push_back({"bicycle_leg_bad" + std::to_string(k),
+                  {"simulate", "bicycle", "--duration", "0.1", "--set", leg[k], "--out", "o"}, 2,
+                  leg[k].substr(0, leg[k].find('=')), {}, nullptr, "o"});
+  // Things that used to hang: each now refused before work, or bounded.
+  cs.push_back({"hang_dt_out_tiny", {"simulate", "fourbar", "--dt-out", "1e-12", "--out", "o"}, 2, "--dt-out", {},
+                nullptr, "o"});
+  cs.push_back({"oom_grid_tiny", {"extract", "fourbar", "--grid-deg", "1e-6", "--out", "t.csv"}, 2, "--grid-deg", {},
+                nullptr, "t.csv"});
+}
+
 std::vector<Case> all_cases() {
   std::vector<Case> cs;
   bad_numbers(cs);
   outputs(cs);
+  scenes(cs);
   return cs;
 }
 

@@ -2,6 +2,11 @@
 #include "validate/sweep.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "models/scene.hpp"
 
@@ -56,20 +61,43 @@ TEST(Sweep, UnknownKeysAndOutOfRangeEndsFailBeforeWork) {
   EXPECT_THROW(run_sweep(o, false), models::SceneError);
 }
 
-// A failing case is a row with status "error" and its message, and it is counted: the
-// four-bar has no drive torque, so no case can be calibrated.
-TEST(Sweep, FailingCasesAreCountedAndReported) {
+// A scene that cannot be calibrated at all (the four-bar has no drive torque) fails before
+// any case runs.
+TEST(Sweep, UncalibratableSceneFailsBeforeWork) {
   SweepOptions o;
   o.scene = "fourbar";
   o.cadence_hz = 1.0;
   o.power_w = 1.0;
   o.axes = {parse_sweep_axis("bodies.crank.mass_kg=0.4:0.6:3")};
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+}
+
+// A failing case is a row with status "error" and its message, and it is counted: the
+// four-bar driven by a crank torque, with the ground pivot D moved so far in the second case
+// that the loop cannot close.
+TEST(Sweep, FailingCasesAreCountedAndReported) {
+  namespace fs = std::filesystem;
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_" + std::to_string(::getpid()) + ".yaml");
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.01}\n");
+  std::ofstream(scene) << yaml;
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 1.0;
+  o.power_w = 0.01;
+  o.sets = {"gravity.enabled=false"};  // no stall: the torque–cadence map is monotonic
+  o.axes = {parse_sweep_axis("ground_points.D.0=0.30:3.0:2")};
   o.threads = 2;
   const SweepResult r = run_sweep(o, false);
-  EXPECT_EQ(r.cases, 3);
-  EXPECT_EQ(r.failed, 3) << r.csv;
-  EXPECT_NE(r.csv.find(",error,,,,,,"), std::string::npos) << r.csv;
-  EXPECT_NE(r.csv.find("joint torque"), std::string::npos) << r.csv;
+  fs::remove(scene);
+  EXPECT_EQ(r.cases, 2);
+  EXPECT_EQ(r.failed, 1) << r.csv;
+  const auto lines = r.csv.substr(r.csv.find('\n') + 1);
+  EXPECT_EQ(lines.find("0,0.3,ok,"), 0u) << r.csv;                 // the first case calibrates
+  EXPECT_NE(lines.find("1,3,error,,,,,,"), std::string::npos) << r.csv;  // the second names its loop
 }
 
 }  // namespace
