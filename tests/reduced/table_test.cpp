@@ -85,5 +85,26 @@ TEST(Table, FusedEvaluationMatchesSingleColumns) {
   for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(out[k], t.eval(cols[k], 1.2345));
 }
 
+TEST(Table, InconsistentSamplesAndOversizedFourierAreRefused) {
+  auto ragged = periodic_samples(8);
+  ragged.columns[1].pop_back();
+  EXPECT_THROW(build_table(ragged, Interpolation::CubicSpline), TableError);
+  auto no_step = periodic_samples(8);
+  no_step.step = NAN;
+  EXPECT_THROW(build_table(no_step, Interpolation::CubicSpline), TableError);
+  EXPECT_THROW(build_table(periodic_samples(3), Interpolation::CubicSpline), TableError);
+  // Fourier: the limit itself builds (and interpolates), one more point is refused.
+  const auto at_limit = periodic_samples(kMaxFourierPoints);
+  const Table t = build_table(at_limit, Interpolation::Fourier);
+  EXPECT_LT(max_error(t, 2, f_exact), 1e-9);
+  try {
+    build_table(periodic_samples(kMaxFourierPoints + 1), Interpolation::Fourier);
+    ADD_FAILURE() << "fourier accepted more than its limit";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 1440 grid points"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(build_table(periodic_samples(kMaxFourierPoints + 1), Interpolation::CubicSpline));
+}
+
 }  // namespace
 }  // namespace rdyn::reduced
