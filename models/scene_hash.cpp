@@ -60,7 +60,8 @@ std::string canonical_scene_text(const Scene& s) {
   for (const auto& l : s.loops)
     c.str("name", l.name).str("a", l.body_a).vec("pa", l.point_a).str("b", l.body_b).vec("pb", l.point_b);
   c.open("gears", s.gears.size());
-  for (const auto& g : s.gears) c.str("name", g.name).str("driver", g.driver).str("driven", g.driven).num("ratio", g.ratio);
+  for (const auto& g : s.gears)
+    c.str("name", g.name).str("driver", g.driver).str("driven", g.driven).num("ratio", g.ratio);
   c.str("independent", s.independent);
   c.integer("gravity", s.gravity.enabled ? 1 : 0).vec("g", s.gravity.g_m_s2);
   c.open("constraint_forces", s.outputs.constraint_forces.size());

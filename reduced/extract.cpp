@@ -144,9 +144,9 @@ std::string method_name(Method m) {
 
 long check_grid_step(double step_rad) {
   const double deg = step_rad * 180 / kPi;
-  const auto range = fmt::format("valid grid steps are {}° to {}° (at most {} and at least {} points a turn) "
-                                 "and divide 360°",
-                                 kMinGridDeg, kMaxGridDeg, std::lround(360 / kMinGridDeg), std::lround(360 / kMaxGridDeg));
+  const auto range = fmt::format(
+      "valid grid steps are {}° to {}° (at most {} and at least {} points a turn) and divide 360°", kMinGridDeg,
+      kMaxGridDeg, std::lround(360 / kMinGridDeg), std::lround(360 / kMaxGridDeg));
   if (!std::isfinite(deg)) throw TableError(fmt::format("grid step {}° is not a finite number; {}", deg, range));
   // The bounds hold to rounding, so 360/36000 written in radians is still accepted.
   if (deg < kMinGridDeg * (1 - 1e-9) || deg > kMaxGridDeg * (1 + 1e-9))
@@ -154,7 +154,8 @@ long check_grid_step(double step_rad) {
   const double n_real = 360.0 / deg;
   const long n = std::lround(n_real);
   if (std::abs(n_real - static_cast<double>(n)) > 1e-6)
-    throw TableError(fmt::format("grid step {:.6g}° does not divide 360° ({:.6g} points a turn): {}", deg, n_real, range));
+    throw TableError(
+        fmt::format("grid step {:.6g}° does not divide 360° ({:.6g} points a turn): {}", deg, n_real, range));
   return n;
 }
 

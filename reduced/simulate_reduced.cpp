@@ -308,7 +308,8 @@ void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, dou
   // No NaN in an output: a sample that is not finite fails the run, naming what and when.
   auto finite = [&](double v, const std::string& what) {
     if (!std::isfinite(v))
-      throw models::NumericalError(fmt::format("reduced model output {} is not finite ({}) at t = {:.6g} s", what, v, t));
+      throw models::NumericalError(
+          fmt::format("reduced model output {} is not finite ({}) at t = {:.6g} s", what, v, t));
   };
   finite(q, "q");
   finite(qdot, "q̇");
@@ -339,9 +340,9 @@ void check_reduced_options(const ReducedOptions& opt) {
         fmt::format("reduced simulation output interval {:g} s must be finite and positive", opt.output_interval_s));
   const double rows = std::floor(opt.duration_s / opt.output_interval_s) + 1;
   if (!(rows <= static_cast<double>(kMaxOutputRows)))
-    throw TableError(fmt::format("reduced simulation: duration {:g} s / output interval {:g} s gives {:.3g} output rows, "
-                                 "more than the limit of {}",
-                                 opt.duration_s, opt.output_interval_s, rows, kMaxOutputRows));
+    throw TableError(fmt::format(
+        "reduced simulation: duration {:g} s / output interval {:g} s gives {:.3g} output rows, more than the limit of {}",
+        opt.duration_s, opt.output_interval_s, rows, kMaxOutputRows));
   if (!(opt.max_steps > 0) || !(opt.max_wall_s > 0))
     throw TableError("reduced simulation step and wall-time budgets must be positive");
   if (opt.integrator == "rk4-fixed") {
@@ -398,9 +399,8 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       // Budgets (the step count was checked against the duration; this also catches a time
       // that stops advancing in floating point). The clock is read every 64 steps.
       if (ts.stats.steps_taken >= opt.max_steps)
-        throw models::NumericalError(fmt::format("reduced integration stopped at t = {:.6g} s: it used its budget of {} "
-                                                 "fixed steps",
-                                                 ws.t, opt.max_steps));
+        throw models::NumericalError(fmt::format(
+            "reduced integration stopped at t = {:.6g} s: it used its budget of {} fixed steps", ws.t, opt.max_steps));
       if (ts.stats.steps_taken % 64 == 0 &&
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > opt.max_wall_s)
         throw models::NumericalError(fmt::format(
@@ -415,9 +415,10 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       const double E = calc_energy(m, b.q, b.qdot);  // divergence guard, as for the adaptive path
       E_scale = std::max(E_scale, std::abs(E));
       if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
-        throw models::NumericalError(fmt::format("reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J "
-                                     "— the table or the fixed step is too coarse for this run",
-                                     b.t, E - E0 - b.work));
+        throw models::NumericalError(fmt::format(
+            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J — the table or the fixed "
+            "step is too coarse for this run",
+            b.t, E - E0 - b.work));
       // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
       // interpolation there, with the gates that held at each sample's time (the fixed-step
       // path is the real-time one; accuracy is secondary).

@@ -127,7 +127,8 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
   if (npts < 4) throw TableError("a reduced table needs at least 4 grid points");
   if (!(std::isfinite(samples.step) && samples.step > 0) || !std::isfinite(samples.q0))
     throw TableError("a reduced table needs a finite positive grid step and a finite first point");
-  if (samples.columns.size() != samples.names.size()) throw TableError("reduced table: columns and names differ in number");
+  if (samples.columns.size() != samples.names.size())
+    throw TableError("reduced table: columns and names differ in number");
   for (size_t c = 0; c < samples.columns.size(); ++c)
     if (samples.columns[c].size() != npts)
       throw TableError(fmt::format("reduced table: column '{}' has {} values for {} grid points", samples.names[c],

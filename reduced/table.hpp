@@ -48,9 +48,10 @@ inline constexpr int kMaxFourierPoints = 1440;
 
 // Builds the table. Throws TableError when the samples are inconsistent (fewer than 4 points,
 // a step that is not finite and positive, columns of another length than the grid) or when
-// Fourier interpolation is asked of more than kMaxFourierPoints points. energy_consistent_m2 replaces m2 by ½ dm1/dq of the m1 interpolant
-// (Eksergian's identity) and Q_cons by −dV/dq of the V interpolant, so that ½ m1 q̇² + V is
-// conserved exactly by the reduced equation when no non-conservative load acts.
+// Fourier interpolation is asked of more than kMaxFourierPoints points. energy_consistent_m2
+// replaces m2 by ½ dm1/dq of the m1 interpolant (Eksergian's identity) and Q_cons by −dV/dq of
+// the V interpolant, so that ½ m1 q̇² + V is conserved exactly by the reduced equation when no
+// non-conservative load acts.
 Table build_table(const Samples& samples, Interpolation interp, bool energy_consistent_m2 = false);
 
 }  // namespace rdyn::reduced
