@@ -172,6 +172,16 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   const double h = 2 * kPi / n;
   const int nk = src.num_constraint_forces(), nj = src.num_joints();
   const auto& forces = scene.outputs.constraint_forces;
+  if (nk != static_cast<int>(forces.size()) || nj != static_cast<int>(scene.joints.size()))
+    throw TableError("the kinetostatic source does not match the scene (constraint forces or joints differ)");
+  // The table must be one the reader accepts (samples.hpp limits): count its columns first
+  // (m1, m2, Q_cons, V; me1, me2, Qx_cons per force; r per joint; rx per force and joint;
+  // w and wx per resistance) and refuse before allocating.
+  const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk);
+  if (cols + 1 > kMaxTableColumns || (cols + 1) * n > kMaxTableValues)
+    throw TableError(fmt::format("a {:g}° table of this scene would have {} points × {} columns, more than the limits "
+                                 "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
+                                 opt.step_rad * 180 / kPi, n, cols + 1, kMaxTableColumns, kMaxTableValues));
 
   // Grid anchored at 0, visited from the point nearest the initial q.
   const long first = std::lround(scene.initial.q / h);

@@ -133,5 +133,25 @@ TEST(Extract, SamplesRecordTheirScene) {
   EXPECT_NE(*a.scene_hash, *b.scene_hash);
 }
 
+TEST(Extract, TablesOverTheReaderLimitsAreRefusedBeforeAnyWork) {
+  // 200 constraint forces on the analytic scene at 0.01°: 36 000 points × 1007 columns (q, then
+  // 4 + 3·200 + 2 + 200·2) is over the 2·10⁷ values a table may hold, so the reader could not
+  // read it back.
+  struct ManyForces : test::AnalyticSource {
+    int num_constraint_forces() const override { return 200; }
+  } src;
+  auto scene = test::analytic_scene();
+  scene.outputs.constraint_forces.assign(200, scene.outputs.constraint_forces[0]);
+  ExtractOptions opt;
+  opt.step_rad = 0.01 * M_PI / 180;
+  try {
+    extract_samples(src, scene, opt);
+    ADD_FAILURE() << "an oversized table was extracted";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("36000 points × 1007 columns"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(src.calls, 0);
+}
+
 }  // namespace
 }  // namespace rdyn::reduced
