@@ -135,11 +135,11 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
                                    samples.columns[c].size(), npts));
   if (interp == Interpolation::Fourier) {
     if (!samples.periodic) throw TableError("fourier interpolation needs a periodic table");
-    if (npts > static_cast<size_t>(kMaxFourierPoints))
-      throw TableError(fmt::format("fourier interpolation takes at most {} grid points (a grid of 0.25° or coarser); "
-                                   "this table has {}: use cubic interpolation for finer grids",
-                                   kMaxFourierPoints, npts));
     const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 180.0) - 1e-9)));
+    // At 1° or finer the resampling grid is the sample grid, where the trigonometric
+    // interpolant equals the samples: skip its direct DFT, which costs N² per column (36 000
+    // points: minutes), and build the cubic table from the samples themselves.
+    if (refine == 1) return build_table(samples, Interpolation::CubicSpline, energy_consistent_m2);
     return build_table(fourier_resample(samples, refine), Interpolation::CubicSpline, energy_consistent_m2);
   }
   const Samples& s = samples;

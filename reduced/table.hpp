@@ -41,14 +41,9 @@ struct Table {
   int column(const std::string& name) const;  // −1 when absent
 };
 
-// The Fourier interpolant's direct DFT costs N² operations per column: it takes grids of at most
-// 1440 points (0.25°; measured ~0.2 s per column there on one core, so ~10 s for a 50-column
-// table), where cubic splines are already accurate to ~1e-9 relative.
-inline constexpr int kMaxFourierPoints = 1440;
-
 // Builds the table. Throws TableError when the samples are inconsistent (fewer than 4 points,
-// a step that is not finite and positive, columns of another length than the grid) or when
-// Fourier interpolation is asked of more than kMaxFourierPoints points. energy_consistent_m2
+// a step that is not finite and positive, columns of another length than the grid).
+// energy_consistent_m2
 // replaces m2 by ½ dm1/dq of the m1 interpolant (Eksergian's identity) and Q_cons by −dV/dq of
 // the V interpolant, so that ½ m1 q̇² + V is conserved exactly by the reduced equation when no
 // non-conservative load acts.
