@@ -9,6 +9,8 @@
 #include <gsl/gsl_roots.h>
 #include <gsl/gsl_spline.h>
 
+#include "models/scene_hash.hpp"
+
 namespace rdyn::reduced {
 
 namespace {
@@ -20,13 +22,17 @@ constexpr double kPi = 3.14159265358979323846;
 std::vector<int> revolute_path(const models::Scene& s, const std::string& body) {
   std::vector<int> path;
   std::string cur = body;
-  while (cur != models::kGround) {
-    for (size_t j = 0; j < s.joints.size(); ++j) {
+  // A checked scene is a tree, so ground is reached in at most one hop per joint.
+  for (size_t hops = 0; cur != models::kGround; ++hops) {
+    if (hops > s.joints.size()) throw TableError("body '" + body + "' is not connected to ground by joints");
+    bool found = false;
+    for (size_t j = 0; j < s.joints.size() && !found; ++j) {
       if (s.joints[j].child != cur) continue;
       if (s.joints[j].type == models::JointType::Revolute) path.push_back(static_cast<int>(j));
       cur = s.joints[j].parent;
-      break;
+      found = true;
     }
+    if (!found) throw TableError("body '" + body + "' is not connected to ground by joints");
   }
   return path;
 }
@@ -136,25 +142,52 @@ std::string method_name(Method m) {
   return "?";
 }
 
+long check_grid_step(double step_rad) {
+  const double deg = step_rad * 180 / kPi;
+  const auto range = fmt::format(
+      "valid grid steps are {}° to {}° (at most {} and at least {} points a turn) and divide 360°", kMinGridDeg,
+      kMaxGridDeg, std::lround(360 / kMinGridDeg), std::lround(360 / kMaxGridDeg));
+  if (!std::isfinite(deg)) throw TableError(fmt::format("grid step {}° is not a finite number; {}", deg, range));
+  // The bounds hold to rounding, so 360/36000 written in radians is still accepted.
+  if (deg < kMinGridDeg * (1 - 1e-9) || deg > kMaxGridDeg * (1 + 1e-9))
+    throw TableError(fmt::format("grid step {:.6g}° is out of range: {}", deg, range));
+  const double n_real = 360.0 / deg;
+  const long n = std::lround(n_real);
+  if (std::abs(n_real - static_cast<double>(n)) > 1e-6)
+    throw TableError(
+        fmt::format("grid step {:.6g}° does not divide 360° ({:.6g} points a turn): {}", deg, n_real, range));
+  return n;
+}
+
 Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, const ExtractOptions& opt) {
   gsl_set_error_handler_off();  // GSL reports through return codes, never abort()
-  const auto& ind = *scene.find_joint(scene.independent);
+  const long n = check_grid_step(opt.step_rad);  // before any allocation
+  const auto* ind_joint = scene.find_joint(scene.independent);
+  if (!ind_joint) throw TableError("the independent joint '" + scene.independent + "' does not exist");
+  const auto& ind = *ind_joint;
   if (ind.type != models::JointType::Revolute)
     throw TableError("reduced tables over a range of a prismatic coordinate are not supported yet; "
                      "the independent coordinate must be a revolute joint turning fully");
-  const double n_real = 2 * kPi / opt.step_rad;
-  const long n = std::lround(n_real);
-  if (!(opt.step_rad > 0) || n < 4 || std::abs(n_real - n) > 1e-6)
-    throw TableError(fmt::format("grid step {:.6g}° must divide 360° into at least 4 parts",
-                                 opt.step_rad * 180 / kPi));
+  if (!std::isfinite(scene.initial.q)) throw TableError("the initial q is not finite");
   const double h = 2 * kPi / n;
   const int nk = src.num_constraint_forces(), nj = src.num_joints();
   const auto& forces = scene.outputs.constraint_forces;
+  if (nk != static_cast<int>(forces.size()) || nj != static_cast<int>(scene.joints.size()))
+    throw TableError("the kinetostatic source does not match the scene (constraint forces or joints differ)");
+  // The table must be one the reader accepts (samples.hpp limits): count its columns first
+  // (m1, m2, Q_cons, V; me1, me2, Qx_cons per force; r per joint; rx per force and joint;
+  // w and wx per resistance) and refuse before allocating.
+  const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk);
+  if (cols + 1 > kMaxTableColumns || (cols + 1) * n > kMaxTableValues)
+    throw TableError(fmt::format("a {:g}° table of this scene would have {} points × {} columns, more than the limits "
+                                 "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
+                                 opt.step_rad * 180 / kPi, n, cols + 1, kMaxTableColumns, kMaxTableValues));
 
   // Grid anchored at 0, visited from the point nearest the initial q.
   const long first = std::lround(scene.initial.q / h);
   Samples s;
   s.scene = scene.name;
+  s.scene_hash = models::scene_hash(scene);
   s.method = method_name(opt.method);
   s.periodic = true;
   s.revolute = true;
@@ -187,6 +220,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     const double qdd = -c3 * c4 * c4 * std::cos(c5);
     for (long i = 0; i < n; ++i) {
       const auto p = src.harmonic_sweep(law, i * tau);
+      if (!p) throw TableError("this source cannot run prescribed-motion sweeps");
       m1[i] = p->driving_force / qdd;
       for (int k = 0; k < nk; ++k) me1[k][i] = p->constraint_forces[k] / qdd;
     }
@@ -313,6 +347,20 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     s.add("w_" + res.body, w);
     for (int k = 0; k < nk; ++k) s.add("wx_" + forces[k].name + "_" + res.body, wx[k]);
   }
+  // Nothing non-finite leaves extraction: a sample the full model could not compute (a
+  // singular configuration the repair could not bridge, a redundant loop) fails the run.
+  for (size_t c = 0; c < s.columns.size(); ++c)
+    for (long i = 0; i < n; ++i)
+      if (!std::isfinite(s.columns[c][i]))
+        throw models::NumericalError(fmt::format(
+            "extraction produced a non-finite value ({}) in column '{}' at q = {:.6g}° of scene '{}'; the full model "
+            "cannot be sampled there (a singular or redundant configuration)",
+            s.columns[c][i], s.names[c], s.q[i] * 180 / kPi, scene.name));
+  for (const auto& [col, rs] : s.roots)
+    for (double r : rs)
+      if (!std::isfinite(r))
+        throw models::NumericalError(
+            fmt::format("extraction located a non-finite switch angle of column '{}' in scene '{}'", col, scene.name));
   return s;
 }
 

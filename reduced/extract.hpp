@@ -18,6 +18,17 @@ enum class Method {
 Method parse_method(const std::string& name);  // throws TableError
 std::string method_name(Method m);
 
+// Extraction grid [deg]: from 0.01° (36 000 points a turn: the finest grid, a few seconds of
+// kinetostatic calls) to 90° (4 points, the fewest a periodic spline takes). The step must
+// divide 360°.
+inline constexpr double kMinGridDeg = 0.01;
+inline constexpr double kMaxGridDeg = 90.0;
+
+// Number of grid points a turn for a grid step [rad]; throws TableError naming the valid range
+// when the step is not finite, outside [kMinGridDeg, kMaxGridDeg] or does not divide 360°.
+// Allocates nothing: call it before any work that depends on the grid.
+long check_grid_step(double step_rad);
+
 struct ExtractOptions {
   double step_rad = 10.0 * 3.14159265358979323846 / 180.0;  // grid step (revolute) [rad]
   Method method = Method::Kinetostatic;
@@ -25,7 +36,8 @@ struct ExtractOptions {
 
 // Samples one period of a revolute independent coordinate, starting from the grid point
 // nearest the scene's initial q and continuing from point to point (so the full model stays
-// on its assembled branch). The step must divide 360° evenly. Throws TableError.
+// on its assembled branch). The step must divide 360° evenly (check_grid_step, before any
+// allocation). Throws TableError on bad options, NumericalError when a sample is not finite.
 Samples extract_samples(KinetostaticSource& source, const models::Scene& scene, const ExtractOptions& options);
 
 }  // namespace rdyn::reduced

@@ -5,10 +5,22 @@
 
 #include <fmt/format.h>
 
+#include "models/scene_hash.hpp"
+
 namespace rdyn::reduced {
 
 ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
                                 bool energy_consistent_m2) {
+  // A table fits only the scene it was extracted from (same mechanism, branch, grid anchor and
+  // load placement): compare the fingerprints before anything else.
+  const std::string what = s.file.empty() ? fmt::format("the table of scene '{}'", s.scene) : "table " + s.file;
+  if (!s.scene_hash)
+    throw TableError(what + " does not record the scene it was extracted from; re-extract it with `rdyn extract`");
+  const std::uint64_t h = models::scene_hash(scene);
+  if (*s.scene_hash != h)
+    throw TableError(fmt::format("{} was extracted from a different scene (mechanism/loads differ: hash {} vs {}); "
+                                 "re-extract it for scene '{}'",
+                                 what, models::scene_hash_hex(*s.scene_hash), models::scene_hash_hex(h), scene.name));
   ReducedModel m;
   m.table = build_table(s, interp, energy_consistent_m2);
   m.c_m1 = s.require("m1");

@@ -63,8 +63,10 @@ struct ReducedModel {
   std::vector<int> record_cols;  // rhs_cols then out_cols: one lookup per output sample
 };
 
-// Joins the sampled parameters with the scene's loads. Throws TableError when a column the
-// loads need is missing (a table extracted from another scene).
+// Joins the sampled parameters with the scene's loads. Throws TableError when the samples were
+// extracted from another scene (their scene_hash differs from models::scene_hash(scene), or they
+// record none), when a column the loads need is missing, or when the interpolated m1 is not
+// positive.
 ReducedModel make_reduced_model(const Samples& samples, const models::Scene& scene, Interpolation interp,
                                 bool energy_consistent_m2 = false);
 

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <string>
 #include <fstream>
 #include <sstream>
 
@@ -37,11 +39,38 @@ void Samples::add(const std::string& name, std::vector<double> values) {
   columns.push_back(std::move(values));
 }
 
+namespace {
+
+constexpr const char* kHeader = "# rdyn-table v1 ";
+constexpr const char* kOldHeader = "# rdyn reduced table:";
+
+// The scene name as one metadata token (informational: the hash identifies the scene).
+std::string token(const std::string& name) {
+  std::string t = name.empty() ? "-" : name;
+  for (char& c : t)
+    if (c <= ' ' || c == '=' || c == ',' || c == 0x7f) c = '_';
+  return t;
+}
+
+// Column names a reduced table can carry (samples.hpp): fixed names and prefixed families.
+bool known_column(const std::string& n) {
+  if (n == "m1" || n == "m2" || n == "Q_cons" || n == "V") return true;
+  for (const char* prefix : {"me1_", "me2_", "Qx_cons_", "rx_", "r_", "wx_", "w_"}) {
+    const size_t len = std::char_traits<char>::length(prefix);
+    if (n.size() > len && n.compare(0, len, prefix) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 void write_samples_csv(const std::string& path, const Samples& s) {
+  if (!s.scene_hash) throw TableError(path + ": the samples record no scene hash; extract them from a scene");
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) throw TableError(path + ": cannot open for writing");
-  fmt::print(f, "# rdyn reduced table: scene={} method={} periodic={} q0={:.17g} step={:.17g}\n", s.scene,
-             s.method, s.periodic ? 1 : 0, s.q0, s.step);
+  fmt::print(f, "{}scene={:016x} name={} method={} periodic={} q0={:.17g} step={:.17g} grid_deg={:.17g}\n", kHeader,
+             *s.scene_hash, token(s.scene), token(s.method), s.periodic ? 1 : 0, s.q0, s.step,
+             s.revolute ? s.step * 180.0 / kPi : s.step);
   if (!s.singular_q.empty()) {
     fmt::print(f, "# singular:");
     for (double q : s.singular_q) fmt::print(f, " {:.17g}", q);
@@ -63,90 +92,176 @@ void write_samples_csv(const std::string& path, const Samples& s) {
   if (std::fclose(f) != 0) throw TableError(path + ": write failed");
 }
 
-Samples read_samples_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw TableError(path + ": cannot open reduced table");
-  auto fail = [&](int line, const std::string& msg) {
-    throw TableError(fmt::format("{}:{}: {}", path, line, msg));
+Samples parse_samples_csv(const std::string& text, const std::string& name) {
+  auto fail = [&](long line, const std::string& msg) {
+    throw TableError(fmt::format("{}:{}: {}", name, line, msg));
   };
-  Samples s;
+  if (static_cast<long long>(text.size()) > kMaxTableBytes)
+    fail(1, fmt::format("the table has {} bytes, more than the limit of {} bytes", text.size(), kMaxTableBytes));
+  // Lines without their end-of-line (\n or \r\n).
+  size_t pos = 0;
+  long ln = 0;
   std::string line;
-  int ln = 1;
-  if (!std::getline(in, line) || line.rfind("# rdyn reduced table:", 0) != 0)
-    fail(1, "not an rdyn reduced table (missing '# rdyn reduced table:' line)");
+  auto next_line = [&]() {
+    if (pos >= text.size()) return false;
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    line.assign(text, pos, end - pos);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    pos = end + 1;
+    ++ln;
+    return true;
+  };
+  auto number = [&](const std::string& cell, const std::string& what) {
+    char* end = nullptr;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
+      fail(ln, fmt::format("{}: not a finite number: '{}'", what, cell.substr(0, 40)));
+    return v;
+  };
+
+  Samples s;
+  s.file = name;
+  if (!next_line()) fail(1, "empty file: not an rdyn reduced table");
+  if (line.rfind(kOldHeader, 0) == 0)
+    fail(1, "this table was written by an older rdyn and does not record the scene it was extracted from; "
+            "re-extract it with `rdyn extract`");
+  if (line.rfind(kHeader, 0) != 0)
+    fail(1, fmt::format("not an rdyn reduced table (the first line must start with '{}')", kHeader));
   {
-    std::istringstream meta(line.substr(21));
+    std::istringstream meta(line.substr(std::char_traits<char>::length(kHeader)));
+    bool have_q0 = false, have_step = false, have_periodic = false;
+    double grid = NAN;
     for (std::string kv; meta >> kv;) {
       const auto eq = kv.find('=');
-      if (eq == std::string::npos) fail(1, "malformed metadata '" + kv + "'");
+      if (eq == std::string::npos) fail(1, "malformed metadata '" + kv.substr(0, 40) + "' (key=value)");
       const std::string k = kv.substr(0, eq), v = kv.substr(eq + 1);
-      try {
-        if (k == "scene") s.scene = v;
-        else if (k == "method") s.method = v;
-        else if (k == "periodic") s.periodic = v == "1";
-        else if (k == "q0") s.q0 = std::stod(v);
-        else if (k == "step") s.step = std::stod(v);
-      } catch (const std::exception&) {
-        fail(1, "malformed metadata '" + kv + "'");
+      if (k == "scene") {
+        if (v.size() != 16 || v.find_first_not_of("0123456789abcdef") != std::string::npos)
+          fail(1, "field 'scene': the scene hash must be 16 lowercase hexadecimal digits");
+        s.scene_hash = std::stoull(v, nullptr, 16);
+      } else if (k == "name") {
+        s.scene = v;
+      } else if (k == "method") {
+        s.method = v;
+      } else if (k == "periodic") {
+        if (v != "0" && v != "1") fail(1, "field 'periodic' must be 0 or 1");
+        s.periodic = v == "1";
+        have_periodic = true;
+      } else if (k == "q0") {
+        s.q0 = number(v, "field 'q0'");
+        have_q0 = true;
+      } else if (k == "step") {
+        s.step = number(v, "field 'step'");
+        have_step = true;
+      } else if (k == "grid_deg") {
+        grid = number(v, "field 'grid_deg'");
+      } else {
+        fail(1, "unknown metadata field '" + k.substr(0, 40) + "'");
       }
     }
+    if (!s.scene_hash)
+      fail(1, "field 'scene' (the scene hash) is missing; re-extract the table with `rdyn extract`");
+    if (!have_q0 || !have_step || !have_periodic) fail(1, "fields 'q0', 'step' and 'periodic' are required");
+    if (!(s.step > 0)) fail(1, "field 'step' must be positive");
+    if (std::isfinite(grid) && std::abs(grid - s.step * 180.0 / kPi) > 1e-9 * grid &&
+        std::abs(grid - s.step) > 1e-12 * grid)
+      fail(1, "field 'grid_deg' disagrees with 'step'");
   }
-  ++ln;
-  // Optional "# roots <column>: r1 r2 ..." lines.
-  while (std::getline(in, line) && (line.rfind("# roots ", 0) == 0 || line.rfind("# singular:", 0) == 0)) {
-    if (line.rfind("# singular:", 0) == 0) {
-      std::istringstream vals(line.substr(11));
-      for (double x; vals >> x;) s.singular_q.push_back(x);
-      ++ln;
-      continue;
-    }
+  // Optional "# singular: q..." and "# roots <column>: r1 r2 ..." lines.
+  bool have_line = next_line();
+  while (have_line && (line.rfind("# roots ", 0) == 0 || line.rfind("# singular:", 0) == 0)) {
+    const bool singular = line.rfind("# singular:", 0) == 0;
     const auto colon = line.find(':');
-    if (colon == std::string::npos) fail(ln, "malformed roots line");
-    std::vector<double> rs;
-    std::istringstream vals(line.substr(colon + 1));
-    for (std::string v; vals >> v;) {
-      char* end = nullptr;
-      const double x = std::strtod(v.c_str(), &end);
-      if (*end != '\0' || !std::isfinite(x)) fail(ln, "malformed root '" + v + "'");
-      rs.push_back(x);
+    if (!singular && colon == std::string::npos) fail(ln, "malformed roots line (# roots <column>: values)");
+    std::vector<double> vals;
+    std::istringstream in(line.substr(colon + 1));
+    for (std::string v; in >> v;) {
+      if (static_cast<long>(vals.size()) >= kMaxTableRows)
+        fail(ln, fmt::format("more than {} values on one line", kMaxTableRows));
+      vals.push_back(number(v, singular ? "singular angle" : "root"));
     }
-    s.roots.emplace_back(line.substr(8, colon - 8), rs);
-    ++ln;
+    for (size_t i = 1; i < vals.size(); ++i)
+      if (!(vals[i] > vals[i - 1])) fail(ln, "values must be strictly increasing");
+    if (singular) {
+      s.singular_q.insert(s.singular_q.end(), vals.begin(), vals.end());
+    } else {
+      const std::string col = line.substr(8, colon - 8);
+      if (s.roots_of(col)) fail(ln, "duplicate roots line for column '" + col.substr(0, 40) + "'");
+      if (static_cast<long>(s.roots.size()) >= kMaxTableColumns) fail(ln, "too many roots lines");
+      s.roots.emplace_back(col, std::move(vals));
+    }
+    have_line = next_line();
   }
-  if (line.empty() && in.eof()) fail(ln, "missing header");
+  if (!have_line) fail(ln + 1, "missing the column header line (q_deg or q_m, then the columns)");
   std::vector<std::string> header;
   {
     std::istringstream h(line);
-    for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+    for (std::string cell; std::getline(h, cell, ',');) {
+      if (static_cast<long>(header.size()) > kMaxTableColumns)
+        fail(ln, fmt::format("more than {} columns", kMaxTableColumns));
+      header.push_back(cell);
+    }
+    if (!line.empty() && line.back() == ',') header.emplace_back();
   }
   if (header.empty() || (header[0] != "q_deg" && header[0] != "q_m")) fail(ln, "first column must be q_deg or q_m");
   s.revolute = header[0] == "q_deg";
-  s.names.assign(header.begin() + 1, header.end());
+  const long header_line = ln;
+  for (size_t c = 1; c < header.size(); ++c) {
+    if (!known_column(header[c]))
+      fail(ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*)",
+                           header[c].substr(0, 40)));
+    if (s.column(header[c]) >= 0) fail(ln, "duplicate column '" + header[c].substr(0, 40) + "'");
+    s.names.push_back(header[c]);
+  }
+  for (const auto& [col, rs] : s.roots)
+    if (s.column(col) < 0) fail(header_line, "roots are given for column '" + col.substr(0, 40) + "', which is absent");
   s.columns.assign(s.names.size(), {});
-  while (std::getline(in, line)) {
-    ++ln;
+  while (next_line()) {
     if (line.empty()) continue;
-    std::istringstream row(line);
-    std::vector<double> vals;
-    for (std::string cell; std::getline(row, cell, ',');) {
-      char* end = nullptr;
-      const double v = std::strtod(cell.c_str(), &end);
-      if (end == cell.c_str() || *end != '\0' || !std::isfinite(v)) fail(ln, "not a finite number: '" + cell + "'");
-      vals.push_back(v);
+    if (static_cast<long>(s.q.size()) >= kMaxTableRows)
+      fail(ln, fmt::format("more than {} grid points (the finest extraction grid is 0.01°)", kMaxTableRows));
+    if (static_cast<long>((s.q.size() + 1) * header.size()) > kMaxTableValues)
+      fail(ln, fmt::format("more than {} values", kMaxTableValues));
+    size_t c = 0, start = 0;
+    for (;; ++c) {
+      const size_t comma = line.find(',', start);
+      const std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (c >= header.size()) fail(ln, fmt::format("more values than the {} columns of the header", header.size()));
+      const double v = number(cell, "column '" + header[c].substr(0, 40) + "'");
+      if (c == 0) s.q.push_back(s.revolute ? v * kPi / 180.0 : v);
+      else s.columns[c - 1].push_back(v);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
     }
-    if (vals.size() != header.size())
-      fail(ln, fmt::format("{} values, the header has {}", vals.size(), header.size()));
-    s.q.push_back(s.revolute ? vals[0] * kPi / 180.0 : vals[0]);
-    for (size_t c = 0; c < s.names.size(); ++c) s.columns[c].push_back(vals[c + 1]);
+    if (c + 1 != header.size()) fail(ln, fmt::format("{} values, the header has {}", c + 1, header.size()));
   }
   if (s.q.size() < 4) fail(ln, "a reduced table needs at least 4 grid points");
-  if (!(s.step > 0)) fail(1, "step must be positive");
+  // The grid: increasing, equally spaced by step, starting at q0; a periodic one covers one turn.
+  const double tol = 1e-9 * std::max(1.0, std::abs(s.q0) + s.step * static_cast<double>(s.q.size()));
+  if (std::abs(s.q[0] - s.q0) > tol) fail(header_line + 1, "the first grid point differs from field 'q0'");
   for (size_t i = 1; i < s.q.size(); ++i)
-    if (std::abs(s.q[i] - s.q[i - 1] - s.step) > 1e-9 * std::max(1.0, std::abs(s.q[i])))
-      fail(static_cast<int>(i) + 3, "grid points must be equally spaced by step");
+    if (!(s.q[i] > s.q[i - 1]) || std::abs(s.q[i] - s.q[i - 1] - s.step) > tol)
+      fail(header_line + 1 + static_cast<long>(i), "grid points must increase, equally spaced by field 'step'");
+  if (s.periodic && !s.revolute) fail(1, "a periodic table has a revolute coordinate (q_deg)");
   if (s.periodic && std::abs(s.step * static_cast<double>(s.q.size()) - 2 * kPi) > 1e-9)
-    fail(1, "a periodic table must cover exactly one turn");
+    fail(1, "a periodic table must cover exactly one turn (step × points = 360°)");
   return s;
+}
+
+Samples read_samples_csv(const std::string& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw TableError(path + ": cannot open reduced table: " + ec.message());
+  if (size > static_cast<std::uintmax_t>(kMaxTableBytes))
+    throw TableError(fmt::format("{}: the table has {} bytes, more than the limit of {} bytes", path, size,
+                                 kMaxTableBytes));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw TableError(path + ": cannot open reduced table");
+  std::string text(static_cast<size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (in.gcount() != static_cast<std::streamsize>(size)) throw TableError(path + ": cannot read reduced table");
+  return parse_samples_csv(text, path);
 }
 
 }  // namespace rdyn::reduced

@@ -12,6 +12,8 @@
 //   w_<b>, wx_<k>_<b>      body angular rate per unit q̇, per unit ẋ_k
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,6 +27,10 @@ class TableError : public std::runtime_error {
 
 struct Samples {
   std::string scene;         // scene name it was extracted from
+  // models::scene_hash of the scene it was extracted from; make_reduced_model refuses a
+  // scene with another hash. Empty only for samples assembled by hand.
+  std::optional<std::uint64_t> scene_hash;
+  std::string file;          // the file it was read from (for messages); empty when extracted
   std::string method;        // extraction method
   bool periodic = true;      // one period 2π of a revolute coordinate
   bool revolute = true;      // q in radians (q_deg column) or metres (q_m)
@@ -46,9 +52,25 @@ struct Samples {
   void add(const std::string& name, std::vector<double> values);
 };
 
-// CSV with a comment line of metadata, then q_deg (or q_m) and the named columns.
+// Limits on a table that is read (what `rdyn extract` can write, with margin): a grid of at
+// most 36 001 points (0.01° over a turn, the finest extraction grid), at most 4096 columns,
+// 2·10⁷ values and 256 MiB of text.
+inline constexpr long kMaxTableRows = 36001;
+inline constexpr long kMaxTableColumns = 4096;
+inline constexpr long kMaxTableValues = 20000000;
+inline constexpr long kMaxTableBytes = 256L << 20;
+
+// CSV: a first comment line
+//   # rdyn-table v1 scene=<16 hex digits> name=<scene> method=<m> periodic=<0|1> q0=<q> step=<h> grid_deg=<deg>
+// (q0 and step in rad or m, %.17g), optional "# singular:" and "# roots <column>:" lines, then
+// q_deg (or q_m) and the named columns. Requires samples.scene_hash.
 void write_samples_csv(const std::string& path, const Samples& s);
-// Throws TableError naming the file (and line) on malformed content.
+// Parses the text of a table; `name` is used in messages. Throws TableError naming the file,
+// line and field on malformed content: a missing or older header (re-extract), values that are
+// not finite, a grid that is not increasing and uniform, duplicate or unknown column names,
+// ragged rows, or a table over the limits above.
+Samples parse_samples_csv(const std::string& text, const std::string& name);
+// Reads a file (refusing one over kMaxTableBytes before reading it) and parses it.
 Samples read_samples_csv(const std::string& path);
 
 }  // namespace rdyn::reduced

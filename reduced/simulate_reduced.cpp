@@ -74,11 +74,18 @@ struct AdaptiveIntegrator::Impl {
   std::vector<char> pending;  // gates to flip before the next step
   bool flipped = false;   // a gate flipped since `end` was computed
   Point start{}, end{};
+  IntegratorLimits limits;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 
-  Impl(const ReducedModel& model, double tol, const std::string& method) : m(model), ws(model), ctx{&m, &ws} {
+  Impl(const ReducedModel& model, double tol, const std::string& method, IntegratorLimits lim)
+      : m(model), ws(model), ctx{&m, &ws}, limits(lim) {
     const gsl_odeiv2_step_type* type = step_type(method);
     if (!type) throw TableError("unknown reduced integrator '" + method + "' (rk8pd, rkf45, rkck, rk4-fixed)");
-    if (!(tol > 0)) throw TableError("reduced integrator tolerance must be positive");
+    if (!(tol >= kMinTolerance && tol <= kMaxTolerance))
+      throw TableError(fmt::format("reduced integrator tolerance {:g} is out of range [{:g}, {:g}]", tol, kMinTolerance,
+                                   kMaxTolerance));
+    if (!(limits.max_steps > 0) || !(limits.max_wall_s > 0))
+      throw TableError("reduced integrator step and wall-time budgets must be positive");
     gsl_set_error_handler_off();
     sys = {ode_rhs, nullptr, 3, &ctx};
     step.reset(gsl_odeiv2_step_alloc(type, 3));
@@ -175,8 +182,9 @@ struct AdaptiveIntegrator::Impl {
   }
 };
 
-AdaptiveIntegrator::AdaptiveIntegrator(const ReducedModel& m, double tolerance, const std::string& method)
-    : impl_(std::make_unique<Impl>(m, tolerance, method)) {}
+AdaptiveIntegrator::AdaptiveIntegrator(const ReducedModel& m, double tolerance, const std::string& method,
+                                       IntegratorLimits limits)
+    : impl_(std::make_unique<Impl>(m, tolerance, method, limits)) {}
 AdaptiveIntegrator::~AdaptiveIntegrator() = default;
 const ReducedWorkspace& AdaptiveIntegrator::state() const { return impl_->ws; }
 long AdaptiveIntegrator::steps() const { return impl_->steps; }
@@ -200,6 +208,20 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
 bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   auto& d = *impl_;
   const auto& m = d.m;
+  // Budgets: every run ends, in steps and in wall time (the clock is read every 64 steps).
+  const long attempted = d.steps + static_cast<long>(d.evolve->failed_steps);
+  if (attempted >= d.limits.max_steps)
+    throw models::NumericalError(fmt::format(
+        "reduced integration stopped at t = {:.6g} s: it used its budget of {} steps (the run needs more; "
+        "loosen the tolerance or shorten the duration)",
+        d.ws.t, d.limits.max_steps));
+  if (d.steps % 64 == 0) {
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.started).count();
+    if (wall > d.limits.max_wall_s)
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps",
+          d.ws.t, d.limits.max_wall_s, d.steps));
+  }
   if (std::find(d.pending.begin(), d.pending.end(), 1) != d.pending.end()) {
     for (size_t g = 0; g < d.pending.size(); ++g)
       if (d.pending[g]) d.ws.gate_on[g] = !d.ws.gate_on[g], d.pending[g] = 0;
@@ -223,7 +245,7 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
   const int st = gsl_odeiv2_evolve_apply(d.evolve.get(), d.control.get(), d.step.get(), &d.sys, &t, t_end, &d.h, d.y);
   if (st != GSL_SUCCESS)
-    throw TableError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
+    throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
   ++d.steps;
   d.end = d.point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)
   // What changed sign in this step: a gate's switching function (index ≥ 0) or q − q_stop (−2).
@@ -262,8 +284,8 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
     d.smallest = std::min(d.smallest, H);
   }
   d.ws.q = d.y[0], d.ws.qdot = d.y[1], d.ws.work = d.y[2], d.ws.t = t;
-  if (!std::isfinite(d.ws.q) || !std::isfinite(d.ws.qdot))
-    throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", t));
+  if (!std::isfinite(d.ws.q) || !std::isfinite(d.ws.qdot) || !std::isfinite(d.ws.work))
+    throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", t));
   if (!m.table.in_range(d.ws.q))
     throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
                                  t, d.ws.q));
@@ -283,6 +305,18 @@ void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, dou
             models::TimeSeries& ts, std::vector<double>& f) {
   double qdd, p;
   const double energy = calc_sample(m, ws, q, qdot, qdd, p, f.data());
+  // No NaN in an output: a sample that is not finite fails the run, naming what and when.
+  auto finite = [&](double v, const std::string& what) {
+    if (!std::isfinite(v))
+      throw models::NumericalError(
+          fmt::format("reduced model output {} is not finite ({}) at t = {:.6g} s", what, v, t));
+  };
+  finite(q, "q");
+  finite(qdot, "q̇");
+  finite(qdd, "q̈");
+  finite(energy, "energy");
+  finite(work, "work");
+  for (size_t k = 0; k < f.size(); ++k) finite(f[k], "constraint force '" + m.force_names[k] + "'");
   ts.t.push_back(t);
   ts.q.push_back(q);
   ts.qdot.push_back(qdot);
@@ -298,10 +332,42 @@ void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, dou
 
 }  // namespace
 
+void check_reduced_options(const ReducedOptions& opt) {
+  if (!(std::isfinite(opt.duration_s) && opt.duration_s > 0))
+    throw TableError(fmt::format("reduced simulation duration {:g} s must be finite and positive", opt.duration_s));
+  if (!(std::isfinite(opt.output_interval_s) && opt.output_interval_s > 0))
+    throw TableError(
+        fmt::format("reduced simulation output interval {:g} s must be finite and positive", opt.output_interval_s));
+  const double rows = std::floor(opt.duration_s / opt.output_interval_s) + 1;
+  if (!(rows <= static_cast<double>(kMaxOutputRows)))
+    throw TableError(fmt::format(
+        "reduced simulation: duration {:g} s / output interval {:g} s gives {:.3g} output rows, more than the limit of {}",
+        opt.duration_s, opt.output_interval_s, rows, kMaxOutputRows));
+  if (!(opt.max_steps > 0) || !(opt.max_wall_s > 0))
+    throw TableError("reduced simulation step and wall-time budgets must be positive");
+  if (opt.integrator == "rk4-fixed") {
+    if (!(opt.fixed_step_s >= kMinFixedStep_s && opt.fixed_step_s <= kMaxFixedStep_s))
+      throw TableError(fmt::format("reduced fixed step {:g} s is out of range [{:g}, {:g}] s", opt.fixed_step_s,
+                                   kMinFixedStep_s, kMaxFixedStep_s));
+    const double steps = std::ceil(opt.duration_s / opt.fixed_step_s);
+    if (!(steps <= static_cast<double>(opt.max_steps)))
+      throw TableError(fmt::format("reduced simulation: duration {:g} s at fixed step {:g} s needs {:.3g} steps, more "
+                                   "than the budget of {}",
+                                   opt.duration_s, opt.fixed_step_s, steps, opt.max_steps));
+  } else {
+    if (!step_type(opt.integrator))
+      throw TableError("unknown reduced integrator '" + opt.integrator + "' (rk8pd, rkf45, rkck, rk4-fixed)");
+    if (!(opt.tolerance >= kMinTolerance && opt.tolerance <= kMaxTolerance))
+      throw TableError(fmt::format("reduced integrator tolerance {:g} is out of range [{:g}, {:g}]", opt.tolerance,
+                                   kMinTolerance, kMaxTolerance));
+  }
+}
+
 models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdot0, const ReducedOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
-  if (!(opt.duration_s > 0) || !(opt.output_interval_s > 0))
-    throw TableError("duration and output interval must be positive");
+  check_reduced_options(opt);  // before any allocation
+  if (!std::isfinite(q0) || !std::isfinite(qdot0))
+    throw TableError(fmt::format("reduced simulation start (q, q̇) = ({}, {}) is not finite", q0, qdot0));
   models::TimeSeries ts;
   ts.force_names = m.force_names;
   ts.forces.resize(m.force_names.size());
@@ -314,7 +380,6 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
 
   if (opt.integrator == "rk4-fixed") {
     // Fixed steps regardless of the outputs; outputs by quintic Hermite inside each step.
-    if (!(opt.fixed_step_s > 0)) throw TableError("fixed step must be positive");
     ReducedWorkspace ws(m);
     ws.q = q0, ws.qdot = qdot0;
     init_gates(m, ws);
@@ -331,18 +396,29 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
     std::vector<char> before(ws.gate_on.size());
     while (i <= n) {
       std::copy(ws.gate_on.begin(), ws.gate_on.end(), before.begin());
+      // Budgets (the step count was checked against the duration; this also catches a time
+      // that stops advancing in floating point). The clock is read every 64 steps.
+      if (ts.stats.steps_taken >= opt.max_steps)
+        throw models::NumericalError(fmt::format(
+            "reduced integration stopped at t = {:.6g} s: it used its budget of {} fixed steps", ws.t, opt.max_steps));
+      if (ts.stats.steps_taken % 64 == 0 &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > opt.max_wall_s)
+        throw models::NumericalError(fmt::format(
+            "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps", ws.t,
+            opt.max_wall_s, ts.stats.steps_taken));
       const double t_switch = step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, opt.duration_s - ws.t));
       ++ts.stats.steps_taken;
       if (!std::isnan(t_switch)) ++ts.stats.events;
-      if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot))
-        throw TableError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
+      if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot) || !std::isfinite(ws.work))
+        throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
       const AdaptiveIntegrator::Point b = point(ws);
       const double E = calc_energy(m, b.q, b.qdot);  // divergence guard, as for the adaptive path
       E_scale = std::max(E_scale, std::abs(E));
       if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
-        throw TableError(fmt::format("reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J "
-                                     "— the table or the fixed step is too coarse for this run",
-                                     b.t, E - E0 - b.work));
+        throw models::NumericalError(fmt::format(
+            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J — the table or the fixed "
+            "step is too coarse for this run",
+            b.t, E - E0 - b.work));
       // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
       // interpolation there, with the gates that held at each sample's time (the fixed-step
       // path is the real-time one; accuracy is secondary).
@@ -361,7 +437,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
     ts.stats.steps_attempted = ts.stats.steps_taken;
     ts.stats.smallest_step_s = opt.fixed_step_s;
   } else {
-    AdaptiveIntegrator integ(m, opt.tolerance, opt.integrator);
+    AdaptiveIntegrator integ(m, opt.tolerance, opt.integrator, IntegratorLimits{opt.max_steps, opt.max_wall_s});
     integ.reset(0.0, q0, qdot0);
     ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
     record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
@@ -377,7 +453,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       const double E = calc_energy(m, b.q, b.qdot);
       E_scale = std::max(E_scale, std::abs(E));
       if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
-        throw TableError(fmt::format(
+        throw models::NumericalError(fmt::format(
             "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
             "initially {:.3g} J) — the table is too coarse for this run (refine the grid, or use "
             "--energy-consistent)",

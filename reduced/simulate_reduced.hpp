@@ -10,12 +10,35 @@
 
 namespace rdyn::reduced {
 
+// Valid ranges of the options, checked before any work (TableError, exit 2, naming the range).
+inline constexpr long kMaxOutputRows = 10000000;  // duration / output interval + 1
+inline constexpr double kMinTolerance = 1e-14;    // a few ulps of q ~ 2π: tighter cannot be met
+inline constexpr double kMaxTolerance = 1e-1;
+inline constexpr double kMinFixedStep_s = 1e-7;
+inline constexpr double kMaxFixedStep_s = 1.0;
+// Default run budgets: a run that needs more fails with NumericalError (exit 1) naming the
+// simulated time it reached. 10⁸ steps is ~2 min of the bicycle's rk8pd steps on one core.
+inline constexpr long kDefaultMaxSteps = 100000000;
+inline constexpr double kDefaultMaxWall_s = 600.0;
+
 struct ReducedOptions {
-  double duration_s = 5.0;
-  double output_interval_s = 0.01;
-  double tolerance = 1e-8;           // adaptive: relative and absolute error per step
+  double duration_s = 5.0;           // (0, ∞) [s], with duration / output interval ≤ kMaxOutputRows
+  double output_interval_s = 0.01;   // (0, ∞) [s]
+  double tolerance = 1e-8;           // adaptive: relative and absolute error per step, [1e-14, 1e-1]
   std::string integrator = "rk8pd";  // rk8pd | rkf45 | rkck (GSL odeiv2) | rk4-fixed
-  double fixed_step_s = 1e-3;        // rk4-fixed only
+  double fixed_step_s = 1e-3;        // rk4-fixed only, [1e-7, 1] s, duration / step ≤ max_steps
+  long max_steps = kDefaultMaxSteps;     // steps attempted (adaptive: accepted + rejected)
+  double max_wall_s = kDefaultMaxWall_s; // wall-clock budget of the run [s]
+};
+
+// Throws TableError (naming the option and its valid range) when an option is out of range;
+// simulate_reduced calls it first. Allocates nothing.
+void check_reduced_options(const ReducedOptions& opt);
+
+// Step and wall-time budget of one AdaptiveIntegrator (counted from its construction).
+struct IntegratorLimits {
+  long max_steps = kDefaultMaxSteps;
+  double max_wall_s = kDefaultMaxWall_s;
 };
 
 // Adaptive GSL odeiv2 integration of y = (q, q̇, W) with load switches located as events:
@@ -24,13 +47,16 @@ struct ReducedOptions {
 // the step is cut there and the gate flips before the next step.
 class AdaptiveIntegrator {
  public:
-  AdaptiveIntegrator(const ReducedModel& m, double tolerance, const std::string& method = "rk8pd");
+  // Throws TableError on an unknown method or a tolerance outside [kMinTolerance, kMaxTolerance].
+  AdaptiveIntegrator(const ReducedModel& m, double tolerance, const std::string& method = "rk8pd",
+                     IntegratorLimits limits = {});
   ~AdaptiveIntegrator();
   // Sets the state and the gates (from rest: as init_gates).
   void reset(double t, double q, double qdot, double work = 0.0);
   // Advances to t_end, or until q reaches q_stop (if finite), located like an event.
-  // Returns true when it stopped at q_stop. Throws TableError on a non-finite state or when
-  // q leaves a non-periodic table.
+  // Returns true when it stopped at q_stop. Throws NumericalError when GSL fails, on a
+  // non-finite state, or past the step or wall-time budget; TableError when q leaves a
+  // non-periodic table.
   bool advance(double t_end, double q_stop = NAN);
   // One accepted step toward t_end (cut at an event or at q_stop). Returns true when it
   // stopped at q_stop. After it, step_start()/state() bound the step and the gates are still
@@ -52,7 +78,9 @@ class AdaptiveIntegrator {
   std::unique_ptr<Impl> impl_;
 };
 
-// Integrates from (q0, q̇0) and samples every output interval.
+// Integrates from (q0, q̇0) and samples every output interval. Throws TableError on options out
+// of range (check_reduced_options) or a non-finite start; NumericalError when the run fails
+// (budget exceeded, divergence of the energy balance, a non-finite value in an output).
 models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdot0, const ReducedOptions& opt);
 
 }  // namespace rdyn::reduced

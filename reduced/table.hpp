@@ -41,9 +41,12 @@ struct Table {
   int column(const std::string& name) const;  // −1 when absent
 };
 
-// Builds the table. energy_consistent_m2 replaces m2 by ½ dm1/dq of the m1 interpolant
-// (Eksergian's identity) and Q_cons by −dV/dq of the V interpolant, so that ½ m1 q̇² + V is
-// conserved exactly by the reduced equation when no non-conservative load acts.
+// Builds the table. Throws TableError when the samples are inconsistent (fewer than 4 points,
+// a step that is not finite and positive, columns of another length than the grid).
+// energy_consistent_m2
+// replaces m2 by ½ dm1/dq of the m1 interpolant (Eksergian's identity) and Q_cons by −dV/dq of
+// the V interpolant, so that ½ m1 q̇² + V is conserved exactly by the reduced equation when no
+// non-conservative load acts.
 Table build_table(const Samples& samples, Interpolation interp, bool energy_consistent_m2 = false);
 
 }  // namespace rdyn::reduced

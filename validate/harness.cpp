@@ -241,7 +241,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
             ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
             walls.push_back(seconds_since(t0));
           }
-        } catch (const reduced::TableError& e) {
+        } catch (const std::runtime_error& e) {  // TableError or NumericalError: the run is recorded as stopped
           // A run that stops (divergence, validity domain) is recorded as failed, with its reason.
           r.failure = e.what();
           r.errors.signals.push_back({"qdot", 0.0, INFINITY, INFINITY});

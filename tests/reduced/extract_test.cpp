@@ -75,5 +75,83 @@ TEST(Extract, GridMustDivideATurn) {
   EXPECT_THROW(extract_samples(src, test::analytic_scene(), opt), TableError);
 }
 
+TEST(Extract, GridStepOutsideItsRangeIsRefusedBeforeAnyWork) {
+  // --grid-deg 1e-6 once asked for 3.6e8 points and exhausted memory: refused first, with the
+  // valid range in the message and not a single kinetostatic call.
+  for (double deg : std::initializer_list<double>{NAN, INFINITY, -INFINITY, -10.0, 0.0, 1e-6, 0.005, 91.0, 120.0, 360.0}) {
+    test::AnalyticSource src;
+    ExtractOptions opt;
+    opt.step_rad = deg * M_PI / 180;
+    try {
+      extract_samples(src, test::analytic_scene(), opt);
+      ADD_FAILURE() << deg << "° was accepted";
+    } catch (const TableError& e) {
+      EXPECT_NE(std::string(e.what()).find("valid grid steps are 0.01° to 90°"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(src.calls, 0) << deg;
+  }
+  EXPECT_EQ(check_grid_step(0.01 * M_PI / 180), 36000);  // the finest grid
+  EXPECT_EQ(check_grid_step(90 * M_PI / 180), 4);        // the coarsest
+  EXPECT_EQ(check_grid_step(10 * M_PI / 180), 36);
+  EXPECT_THROW(check_grid_step(7 * M_PI / 180), TableError);  // 51.43 points a turn
+}
+
+// The analytic source with one poisoned answer: its constraint-line force is NaN near 100°,
+// as a redundant loop's least-squares solve can return.
+class PoisonedSource : public test::AnalyticSource {
+ public:
+  ForcePoint inertial(double q, double qd, double qdd) override {
+    auto f = AnalyticSource::inertial(q, qd, qdd);
+    if (std::abs(q - 100 * M_PI / 180) < 1e-9 && qdd != 0) f.constraint_forces[0] = NAN;
+    return f;
+  }
+};
+
+TEST(Extract, NonFiniteSampleFailsNamingColumnAndAngle) {
+  PoisonedSource src;
+  ExtractOptions opt;
+  opt.step_rad = 10 * M_PI / 180;
+  try {
+    extract_samples(src, test::analytic_scene(), opt);
+    ADD_FAILURE() << "a NaN sample left extraction";
+  } catch (const models::NumericalError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("column 'me1_F'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("q = 100°"), std::string::npos) << msg;
+  }
+}
+
+TEST(Extract, SamplesRecordTheirScene) {
+  test::AnalyticSource src;
+  auto scene = test::analytic_scene();
+  ExtractOptions opt;
+  opt.step_rad = 30 * M_PI / 180;
+  const auto a = extract_samples(src, scene, opt);
+  scene.initial.q = 0.5;  // another grid anchor: another scene for a table
+  const auto b = extract_samples(src, scene, opt);
+  ASSERT_TRUE(a.scene_hash && b.scene_hash);
+  EXPECT_NE(*a.scene_hash, *b.scene_hash);
+}
+
+TEST(Extract, TablesOverTheReaderLimitsAreRefusedBeforeAnyWork) {
+  // 200 constraint forces on the analytic scene at 0.01°: 36 000 points × 1007 columns (q, then
+  // 4 + 3·200 + 2 + 200·2) is over the 2·10⁷ values a table may hold, so the reader could not
+  // read it back.
+  struct ManyForces : test::AnalyticSource {
+    int num_constraint_forces() const override { return 200; }
+  } src;
+  auto scene = test::analytic_scene();
+  scene.outputs.constraint_forces.assign(200, scene.outputs.constraint_forces[0]);
+  ExtractOptions opt;
+  opt.step_rad = 0.01 * M_PI / 180;
+  try {
+    extract_samples(src, scene, opt);
+    ADD_FAILURE() << "an oversized table was extracted";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("36000 points × 1007 columns"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(src.calls, 0);
+}
+
 }  // namespace
 }  // namespace rdyn::reduced

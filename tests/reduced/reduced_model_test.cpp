@@ -3,11 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <new>
 
 #include "analytic_source.hpp"
+#include "models/scene_hash.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/simulate_reduced.hpp"
 
@@ -148,6 +155,77 @@ TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
   // RK4 at 1 ms with switches located by linear interpolation: ~1e-6 relative.
   EXPECT_NEAR(ws.q, ts.q.back(), 1e-5 * std::abs(ts.q.back()));
   EXPECT_NEAR(ws.qdot, ts.qdot.back(), 5e-6 * std::abs(ts.qdot.back()));
+}
+
+TEST(ReducedModel, RefusesATableFromAnotherScene) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"drive", "lever", 2.0, models::RateGate{"lever", +1}});
+  const auto s = analytic_samples(0.0, scene);
+  ASSERT_TRUE(s.scene_hash);
+  EXPECT_EQ(*s.scene_hash, models::scene_hash(scene));
+  // Another mechanism (a heavier lever): refused, naming both fingerprints.
+  auto other = scene;
+  other.bodies[1].mass_kg *= 2;
+  try {
+    make_reduced_model(s, other, Interpolation::CubicSpline);
+    ADD_FAILURE() << "a table from another scene was accepted";
+  } catch (const TableError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("was extracted from a different scene (mechanism/loads differ: hash " +
+                       models::scene_hash_hex(*s.scene_hash) + " vs " + models::scene_hash_hex(models::scene_hash(other))),
+              std::string::npos)
+        << msg;
+  }
+  // The gate moved to another joint: the table's switch angles are not this scene's.
+  auto regated = scene;
+  regated.joint_torques[0].active_when->joint = "crank";
+  EXPECT_THROW(make_reduced_model(s, regated, Interpolation::CubicSpline), TableError);
+  // Load values are applied to the table, not stored in it (calibration scales the torque on
+  // one table): accepted, and the torque is the new one.
+  auto stronger = scene;
+  stronger.joint_torques[0].value = 5.0;
+  EXPECT_EQ(make_reduced_model(s, stronger, Interpolation::CubicSpline).torques[0].value, 5.0);
+  // Samples that record no scene are refused with advice to re-extract.
+  auto anonymous = s;
+  anonymous.scene_hash.reset();
+  try {
+    make_reduced_model(anonymous, scene, Interpolation::CubicSpline);
+    ADD_FAILURE() << "samples without a scene hash were accepted";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("re-extract"), std::string::npos) << e.what();
+  }
+}
+
+// The rdyn binary end to end (status and combined output).
+std::pair<int, std::string> run_rdyn(const std::string& args) {
+  const std::string cmd = std::string(RDYN_BINARY) + " " + args + " 2>&1";
+  std::string out;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+TEST(ReducedModel, CliRefusesAFourbarTableForTheBicycle) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_table_scene_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string table = (dir / "fourbar.csv").string();
+  const auto [st_extract, out_extract] = run_rdyn("extract fourbar --grid-deg 30 --out " + table);
+  ASSERT_EQ(st_extract, 0) << out_extract;
+  const auto out = dir / "bike";
+  const auto [st, msg] =
+      run_rdyn("simulate bicycle --model reduced --table " + table + " --duration 0.1 --out " + out.string());
+  EXPECT_EQ(st, 2) << msg;
+  EXPECT_NE(msg.find("table " + table + " was extracted from a different scene"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+  // The same table drives the fourbar it came from.
+  const auto [st_ok, msg_ok] =
+      run_rdyn("simulate fourbar --model reduced --table " + table + " --duration 0.1 --out " + (dir / "fb").string());
+  EXPECT_EQ(st_ok, 0) << msg_ok;
+  fs::remove_all(dir);
 }
 
 }  // namespace

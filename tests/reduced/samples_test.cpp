@@ -4,43 +4,173 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+
+#include <fmt/format.h>
 
 namespace rdyn::reduced {
 namespace {
 
-TEST(Samples, CsvRoundTripKeepsEveryBitAndTheRoots) {
+constexpr const char* kHash = "0123456789abcdef";
+
+// A valid periodic table text: 8 points of 45°, columns m1, m2, r_crank; `header` and `rows`
+// replace the column line and the data when given.
+std::string table_text(const std::string& meta_extra = "", const std::string& header = "q_deg,m1,m2,r_crank",
+                       const std::string& rows = "") {
+  std::string t = fmt::format("# rdyn-table v1 scene={} name=x method=kinetostatic periodic=1 q0=0 "
+                              "step=0.78539816339744828 grid_deg=45{}\n",
+                              kHash, meta_extra);
+  t += "# roots r_crank: 1.5 4.5\n" + header + "\n";
+  if (!rows.empty()) return t + rows;
+  for (int i = 0; i < 8; ++i) t += fmt::format("{},{},{},{}\n", 45 * i, 1 + 0.1 * i, 0.01 * i, std::cos(i * M_PI / 4));
+  return t;
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_samples_csv(text, "t.csv");
+  } catch (const TableError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Samples, CsvRoundTripKeepsEveryBitTheRootsAndTheSceneHash) {
   Samples s;
-  s.scene = "x";
+  s.scene = "x y";  // a name with a space is written as one token
+  s.scene_hash = 0xfedcba9876543210ull;
   s.method = "kinetostatic";
   s.step = 2 * M_PI / 8;
-  for (int i = 0; i < 8; ++i) s.q.push_back(i * s.step);
+  s.q0 = s.step;
+  for (int i = 0; i < 8; ++i) s.q.push_back((i + 1) * s.step);
   s.add("m1", {1, 2, 3, 4, 5, 6, 7, 8.123456789012345});
   s.add("m2", {0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7, -1e-300});
   s.roots.emplace_back("m2", std::vector<double>{0.1, 3.3});
+  s.singular_q = {2 * s.step};
   const std::string path = ::testing::TempDir() + "/samples_test.csv";
   write_samples_csv(path, s);
   const Samples r = read_samples_csv(path);
   EXPECT_EQ(r.names, s.names);
   EXPECT_EQ(r.columns, s.columns);
+  ASSERT_TRUE(r.scene_hash);
+  EXPECT_EQ(*r.scene_hash, *s.scene_hash);
+  EXPECT_EQ(r.scene, "x_y");
+  EXPECT_EQ(r.file, path);
+  EXPECT_EQ(r.q0, s.q0);
+  EXPECT_EQ(r.step, s.step);
+  EXPECT_EQ(r.singular_q, s.singular_q);
   ASSERT_NE(r.roots_of("m2"), nullptr);
   EXPECT_EQ(*r.roots_of("m2"), s.roots[0].second);
   for (size_t i = 0; i < s.q.size(); ++i) EXPECT_NEAR(r.q[i], s.q[i], 1e-15);
+  std::ifstream in(path);
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first.rfind("# rdyn-table v1 scene=fedcba9876543210 ", 0), 0u) << first;
   std::remove(path.c_str());
 }
 
-TEST(Samples, MalformedTablesNameFileAndLine) {
-  const std::string path = ::testing::TempDir() + "/bad_table.csv";
-  std::ofstream(path) << "# rdyn reduced table: scene=x method=k periodic=0 q0=0 step=1\nq_deg,m1\n0,1\n1,abc\n";
+TEST(Samples, SamplesWithoutASceneHashAreNotWritten) {
+  Samples s;
+  s.step = 1;
+  EXPECT_THROW(write_samples_csv(::testing::TempDir() + "/no_hash.csv", s), TableError);
+}
+
+TEST(Samples, TheValidFixtureParses) {
+  const Samples s = parse_samples_csv(table_text(), "t.csv");
+  EXPECT_EQ(s.q.size(), 8u);
+  EXPECT_EQ(*s.scene_hash, 0x0123456789abcdefull);
+  EXPECT_EQ(s.names, (std::vector<std::string>{"m1", "m2", "r_crank"}));
+  // Windows line ends are accepted too.
+  std::string crlf;
+  for (char c : table_text()) {
+    if (c == '\n') crlf += '\r';
+    crlf += c;
+  }
+  EXPECT_EQ(parse_samples_csv(crlf, "t.csv").columns, s.columns);
+}
+
+TEST(Samples, OlderTablesWithoutTheSceneHashAreRefusedWithAdviceToReExtract) {
+  const std::string e = error_of("# rdyn reduced table: scene=x method=k periodic=1 q0=0 step=1\nq_deg,m1\n0,1\n");
+  EXPECT_NE(e.find("t.csv:1:"), std::string::npos) << e;
+  EXPECT_NE(e.find("re-extract"), std::string::npos) << e;
+  const std::string missing = error_of("# rdyn-table v1 periodic=1 q0=0 step=0.78539816339744828\nq_deg,m1\n");
+  EXPECT_NE(missing.find("scene hash"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("re-extract"), std::string::npos) << missing;
+}
+
+TEST(Samples, MalformedTablesNameFileLineAndField) {
+  std::string ragged = table_text("", "q_deg,m1,m2,r_crank", "0,1,0,1\n45,1,0\n");
+  struct Case {
+    const char* what;
+    std::string text;
+    const char* expected;  // substring of the message
+  };
+  std::string uneven, decreasing, nan_value, inf_value, more_values;
+  for (int i = 0; i < 8; ++i) {
+    uneven += fmt::format("{},1,0,1\n", i == 5 ? 226 : 45 * i);
+    decreasing += fmt::format("{},1,0,1\n", i == 3 ? 90 : 45 * i);
+    nan_value += fmt::format("{},{},0,1\n", 45 * i, i == 2 ? "nan" : "1");
+    inf_value += fmt::format("{},1,{},1\n", 45 * i, i == 6 ? "-inf" : "0");
+    more_values += fmt::format("{},1,0,1{}\n", 45 * i, i == 1 ? ",7" : "");
+  }
+  const std::vector<Case> cases = {
+      {"empty", "", "t.csv:1: empty file"},
+      {"not a table", "t,q\n1,2\n", "t.csv:1: not an rdyn reduced table"},
+      {"bad hash", "# rdyn-table v1 scene=xyz periodic=1 q0=0 step=1\n", "t.csv:1: field 'scene'"},
+      {"unknown metadata", table_text(" colour=red"), "t.csv:1: unknown metadata field 'colour'"},
+      {"step not finite", "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=inf\n", "field 'step'"},
+      {"grid_deg disagrees", table_text(" grid_deg=40"), "field 'grid_deg' disagrees"},
+      {"no column header", "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n", "t.csv:2: missing"},
+      {"first column", table_text("", "t,m1,m2,r_crank"), "t.csv:3: first column must be q_deg or q_m"},
+      {"unknown column", table_text("", "q_deg,m1,m2,colour"), "t.csv:3: unknown column 'colour'"},
+      {"empty column name", table_text("", "q_deg,m1,m2,r_crank,"), "t.csv:3: unknown column ''"},
+      {"duplicate column", table_text("", "q_deg,m1,m1,r_crank"), "t.csv:3: duplicate column 'm1'"},
+      {"roots of an absent column", table_text("", "q_deg,m1,m2,r_other"), "roots are given for column 'r_crank'"},
+      {"ragged row", ragged, "t.csv:5: 3 values, the header has 4"},
+      {"more values", table_text("", "q_deg,m1,m2,r_crank", more_values), "t.csv:5: more values than the 4 columns"},
+      {"nan", table_text("", "q_deg,m1,m2,r_crank", nan_value), "t.csv:6: column 'm1': not a finite number: 'nan'"},
+      {"inf", table_text("", "q_deg,m1,m2,r_crank", inf_value), "t.csv:10: column 'm2': not a finite number: '-inf'"},
+      {"trailing garbage", table_text("", "q_deg,m1,m2,r_crank", "0,1x,0,1\n"), "not a finite number: '1x'"},
+      {"uneven grid", table_text("", "q_deg,m1,m2,r_crank", uneven), "t.csv:9: grid points must increase, equally"},
+      {"decreasing grid", table_text("", "q_deg,m1,m2,r_crank", decreasing), "t.csv:7: grid points must increase"},
+      {"too few points", table_text("", "q_deg,m1,m2,r_crank", "0,1,0,1\n45,1,0,1\n"), "at least 4 grid points"},
+      {"not a full turn", table_text("", "q_deg,m1,m2,r_crank", "0,1,0,1\n45,1,0,1\n90,1,0,1\n135,1,0,1\n"),
+       "exactly one turn"},
+      {"roots not increasing",
+       "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# roots r_a: 2 1\n", "t.csv:2: values must"},
+      {"root not finite",
+       "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# roots r_a: 1 nan\n", "t.csv:2: root"},
+  };
+  for (const auto& c : cases) {
+    const std::string e = error_of(c.text);
+    EXPECT_NE(e.find(c.expected), std::string::npos) << c.what << ": got '" << e << "'";
+  }
+}
+
+TEST(Samples, SizeLimitsAreCheckedWhileReading) {
+  // One row more than the finest extraction grid: refused at that row, not after reading it all.
+  std::string rows;
+  for (long i = 0; i <= kMaxTableRows; ++i) rows += fmt::format("{},1,1\n", i * 0.01);
+  const std::string e = error_of(table_text("", "q_deg,m1,r_crank", rows));
+  EXPECT_NE(e.find(fmt::format("t.csv:{}: more than {} grid points", kMaxTableRows + 4, kMaxTableRows)),
+            std::string::npos)
+      << e.substr(0, 200);
+  std::string header = "q_deg";
+  for (long c = 0; c <= kMaxTableColumns; ++c) header += fmt::format(",r_{}", c);
+  EXPECT_NE(error_of(table_text("", header)).find("more than 4096 columns"), std::string::npos);
+  // A file over the byte limit is refused from its size alone (a sparse file: nothing is read).
+  const std::string path = ::testing::TempDir() + "/huge_table.csv";
+  { std::ofstream(path) << "x"; }
+  std::filesystem::resize_file(path, static_cast<std::uintmax_t>(kMaxTableBytes) + 1);
   try {
     read_samples_csv(path);
-    FAIL();
-  } catch (const TableError& e) {
-    EXPECT_NE(std::string(e.what()).find("bad_table.csv:4"), std::string::npos) << e.what();
+    ADD_FAILURE() << "a table over the byte limit was read";
+  } catch (const TableError& err) {
+    EXPECT_NE(std::string(err.what()).find("more than the limit"), std::string::npos) << err.what();
   }
-  std::ofstream(path) << "t,q\n1,2\n";
-  EXPECT_THROW(read_samples_csv(path), TableError);
   std::remove(path.c_str());
+  EXPECT_THROW(read_samples_csv(::testing::TempDir() + "/no_such_table.csv"), TableError);
 }
 
 }  // namespace

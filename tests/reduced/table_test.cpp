@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 
 namespace rdyn::reduced {
@@ -83,6 +84,33 @@ TEST(Table, FusedEvaluationMatchesSingleColumns) {
   double out[3];
   t.eval_cols(1.2345, cols, 3, out);
   for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(out[k], t.eval(cols[k], 1.2345));
+}
+
+TEST(Table, InconsistentSamplesAreRefused) {
+  auto ragged = periodic_samples(8);
+  ragged.columns[1].pop_back();
+  EXPECT_THROW(build_table(ragged, Interpolation::CubicSpline), TableError);
+  auto no_step = periodic_samples(8);
+  no_step.step = NAN;
+  EXPECT_THROW(build_table(no_step, Interpolation::CubicSpline), TableError);
+  EXPECT_THROW(build_table(periodic_samples(3), Interpolation::CubicSpline), TableError);
+}
+
+TEST(Table, FourierOnAFineGridIsTheCubicTableOfItsSamples) {
+  // At ≤ 1° the trigonometric interpolant is resampled on the sample grid itself, where it
+  // equals the samples: the table is the cubic one, built without the N² DFT (36 000 points
+  // took minutes before), and still interpolates to spline accuracy.
+  const auto fine = periodic_samples(36000);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Table f = build_table(fine, Interpolation::Fourier);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  const Table c = build_table(fine, Interpolation::CubicSpline);
+  EXPECT_EQ(f.coef, c.coef);
+  EXPECT_LT(max_error(f, 2, f_exact), 1e-12);
+  // At 2° it still resamples (refine 2), so it differs from cubic between samples.
+  const auto coarse = periodic_samples(180);
+  EXPECT_NE(build_table(coarse, Interpolation::Fourier).coef.size(),
+            build_table(coarse, Interpolation::CubicSpline).coef.size());
 }
 
 }  // namespace

@@ -1,0 +1,102 @@
+#include "models/scene_hash.hpp"
+
+#include <cstdio>
+
+namespace rdyn::models {
+
+namespace {
+
+// Appends tagged fields to one canonical text: "tag=value;" with exact doubles and
+// length-prefixed strings, so no two different scenes serialize alike.
+class Canon {
+ public:
+  Canon& num(const char* tag, double v) {
+    if (v == 0.0) v = 0.0;  // −0 and +0 describe the same scene
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%a", v);
+    return put(tag, buf);
+  }
+  Canon& integer(const char* tag, long v) { return put(tag, std::to_string(v)); }
+  Canon& str(const char* tag, const std::string& s) { return put(tag, std::to_string(s.size()) + ":" + s); }
+  Canon& vec(const char* tag, const Vec2& v) {
+    const std::string t(tag);
+    num((t + ".x").c_str(), v.x);
+    return num((t + ".y").c_str(), v.y);
+  }
+  Canon& open(const char* section, size_t count) { return put(section, "[" + std::to_string(count)); }
+  const std::string& text() const { return text_; }
+
+ private:
+  Canon& put(const char* tag, const std::string& value) {
+    text_ += tag;
+    text_ += '=';
+    text_ += value;
+    text_ += ';';
+    return *this;
+  }
+  std::string text_;
+};
+
+}  // namespace
+
+std::string canonical_scene_text(const Scene& s) {
+  Canon c;
+  c.str("format", "rdyn-scene-hash v1");
+  c.open("bodies", s.bodies.size());
+  for (const auto& b : s.bodies) {
+    c.str("name", b.name).num("mass", b.mass_kg).vec("com", b.com_m).num("inertia", b.inertia_kgm2);
+    c.open("points", b.points.size());
+    for (const auto& [name, p] : b.points) c.str("point", name).vec("p", p);
+  }
+  c.open("ground_points", s.ground_points.size());
+  for (const auto& [name, p] : s.ground_points) c.str("point", name).vec("p", p);
+  c.open("joints", s.joints.size());
+  for (const auto& j : s.joints) {
+    c.str("name", j.name).integer("type", j.type == JointType::Revolute ? 0 : 1);
+    c.str("parent", j.parent).str("child", j.child).vec("parent_point", j.parent_point);
+    c.vec("child_point", j.child_point).vec("axis", j.axis).num("offset", j.offset_rad).num("guess", j.guess);
+  }
+  c.open("loops", s.loops.size());
+  for (const auto& l : s.loops)
+    c.str("name", l.name).str("a", l.body_a).vec("pa", l.point_a).str("b", l.body_b).vec("pb", l.point_b);
+  c.open("gears", s.gears.size());
+  for (const auto& g : s.gears)
+    c.str("name", g.name).str("driver", g.driver).str("driven", g.driven).num("ratio", g.ratio);
+  c.str("independent", s.independent);
+  c.integer("gravity", s.gravity.enabled ? 1 : 0).vec("g", s.gravity.g_m_s2);
+  c.open("constraint_forces", s.outputs.constraint_forces.size());
+  for (const auto& f : s.outputs.constraint_forces) c.str("name", f.name).str("joint", f.joint).vec("dir", f.direction);
+  c.num("initial_q", s.initial.q);
+  c.open("springs", s.springs.size());
+  for (const auto& sp : s.springs) {
+    c.str("a", sp.body_a).vec("pa", sp.point_a).str("b", sp.body_b).vec("pb", sp.point_b);
+    c.num("k", sp.stiffness_N_per_m).num("L0", sp.rest_length_m);
+  }
+  c.open("torques", s.joint_torques.size());
+  for (const auto& t : s.joint_torques) {
+    c.str("joint", t.joint).integer("gated", t.active_when ? 1 : 0);
+    if (t.active_when) c.str("gate_joint", t.active_when->joint).integer("gate_sign", t.active_when->sign);
+  }
+  c.open("motors", s.motors.size());
+  for (const auto& m : s.motors) c.str("joint", m.joint);
+  c.open("resistances", s.resistances.size());
+  for (const auto& r : s.resistances) c.str("body", r.body);
+  return c.text();
+}
+
+std::uint64_t scene_hash(const Scene& scene) {
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64-bit offset basis
+  for (const unsigned char ch : canonical_scene_text(scene)) {
+    h ^= ch;
+    h *= 1099511628211ull;  // FNV 64-bit prime
+  }
+  return h;
+}
+
+std::string scene_hash_hex(std::uint64_t hash) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(hash));
+  return buf;
+}
+
+}  // namespace rdyn::models
