@@ -1,7 +1,9 @@
 #include "reduced/samples.hpp"
 
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <fstream>
@@ -64,32 +66,39 @@ bool known_column(const std::string& n) {
 
 }  // namespace
 
-void write_samples_csv(const std::string& path, const Samples& s) {
-  if (!s.scene_hash) throw TableError(path + ": the samples record no scene hash; extract them from a scene");
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw TableError(path + ": cannot open for writing");
-  fmt::print(f, "{}scene={:016x} name={} method={} periodic={} q0={:.17g} step={:.17g} grid_deg={:.17g}\n", kHeader,
-             *s.scene_hash, token(s.scene), token(s.method), s.periodic ? 1 : 0, s.q0, s.step,
-             s.revolute ? s.step * 180.0 / kPi : s.step);
+std::string format_samples_csv(const Samples& s) {
+  if (!s.scene_hash) throw TableError("the samples record no scene hash; extract them from a scene");
+  std::string t = fmt::format("{}scene={:016x} name={} method={} periodic={} q0={:.17g} step={:.17g} grid_deg={:.17g}\n",
+                              kHeader, *s.scene_hash, token(s.scene), token(s.method), s.periodic ? 1 : 0, s.q0, s.step,
+                              s.revolute ? s.step * 180.0 / kPi : s.step);
   if (!s.singular_q.empty()) {
-    fmt::print(f, "# singular:");
-    for (double q : s.singular_q) fmt::print(f, " {:.17g}", q);
-    std::fputc('\n', f);
+    t += "# singular:";
+    for (double q : s.singular_q) t += fmt::format(" {:.17g}", q);
+    t += '\n';
   }
   for (const auto& [col, rs] : s.roots) {
-    fmt::print(f, "# roots {}:", col);
-    for (double r : rs) fmt::print(f, " {:.17g}", r);
-    std::fputc('\n', f);
+    t += fmt::format("# roots {}:", col);
+    for (double r : rs) t += fmt::format(" {:.17g}", r);
+    t += '\n';
   }
-  fmt::print(f, "{}", s.revolute ? "q_deg" : "q_m");
-  for (const auto& n : s.names) fmt::print(f, ",{}", n);
-  std::fputc('\n', f);
+  t += s.revolute ? "q_deg" : "q_m";
+  for (const auto& n : s.names) t += "," + n;
+  t += '\n';
   for (size_t i = 0; i < s.q.size(); ++i) {
-    fmt::print(f, "{:.17g}", s.revolute ? s.q[i] * 180.0 / kPi : s.q[i]);
-    for (const auto& c : s.columns) fmt::print(f, ",{:.17g}", c[i]);
-    std::fputc('\n', f);
+    t += fmt::format("{:.17g}", s.revolute ? s.q[i] * 180.0 / kPi : s.q[i]);
+    for (const auto& c : s.columns) t += fmt::format(",{:.17g}", c[i]);
+    t += '\n';
   }
-  if (std::fclose(f) != 0) throw TableError(path + ": write failed");
+  return t;
+}
+
+void write_samples_csv(const std::string& path, const Samples& s) {
+  const std::string text = format_samples_csv(s);
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw TableError(path + ": cannot open for writing: " + std::strerror(errno));
+  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  const int err = errno;
+  if (std::fclose(f) != 0 || !written) throw TableError(path + ": cannot write: " + std::strerror(written ? errno : err));
 }
 
 Samples parse_samples_csv(const std::string& text, const std::string& name) {

@@ -64,6 +64,8 @@ inline constexpr long kMaxTableBytes = 256L << 20;
 //   # rdyn-table v1 scene=<16 hex digits> name=<scene> method=<m> periodic=<0|1> q0=<q> step=<h> grid_deg=<deg>
 // (q0 and step in rad or m, %.17g), optional "# singular:" and "# roots <column>:" lines, then
 // q_deg (or q_m) and the named columns. Requires samples.scene_hash.
+// The table as text (header line with the scene hash, metadata comments, CSV).
+std::string format_samples_csv(const Samples& s);
 void write_samples_csv(const std::string& path, const Samples& s);
 // Parses the text of a table; `name` is used in messages. Throws TableError naming the file,
 // line and field on malformed content: a missing or older header (re-extract), values that are

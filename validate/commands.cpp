@@ -175,7 +175,7 @@ int run_extract(const ExtractArgs& a) {
   const auto method = reduced::parse_method(a.method);
   OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
   const auto e = extract_from_full(scene, a.grid_deg, method);
-  reduced::write_samples_csv(out.write_path(), e.samples);
+  write_text_file(out.write_path(), reduced::format_samples_csv(e.samples));
   out.commit();
   std::fprintf(stderr, "%s\n",
                fmt::format("rdyn: extracted {} ({}, {}° grid, {} points) in {:.3g} ms with {} kinetostatic calls; "
