@@ -17,8 +17,10 @@ struct ForwardOptions {
   std::string integrator = "rkmerson";  // rkmerson | rk3 | cpodes
   // Budgets, so that no run hangs (NumericalError naming the time reached and the step size).
   // Each internal step is counted, so one output interval of microscopic steps is bounded too.
-  // 5e6 steps: the shipped scenes take at most ~1e4 per simulated second at 1e-10 (measured,
-  // see forward_dynamics_test), so this is ~100 simulated seconds of the hardest of them.
+  // 5e6 steps: the shipped scenes take at most ~6e3 per simulated second at their tolerance
+  // (measured: motor-startup 24162 steps for 4 s, thousand-cycles 2.8e5 for 210 s), so this is
+  // ~800 simulated seconds of the hardest of them. A run whose recent mean step projects to
+  // more than 100 budgets stops at once (see simulate_full).
   long max_steps = 5'000'000;  // integrator steps attempted, > 0
   double max_wall_s = 600.0;   // wall-clock time of the integration [s], > 0
   // The run checks its own energy balance: max|E − E0 − W| must not exceed
