@@ -23,8 +23,9 @@ struct ForwardOptions {
   // more than 100 budgets stops at once (see simulate_full).
   long max_steps = 5'000'000;  // integrator steps attempted, > 0
   double max_wall_s = 600.0;   // wall-clock time of the integration [s], > 0
-  // The run checks its own energy balance: max|E − E0 − W| must not exceed
-  // energy_tolerance·max|E| + kEnergyFloor_J (models::energy_balance). 1 %: a correct run at
+  // The run checks its own energy balance: max|E − E0 − W| (models::energy_balance) must not
+  // exceed energy_tolerance·scale + kEnergyFloor_J, scale = the largest |E|, kinetic energy or
+  // |W| seen (|E| alone is ~0 when the potential's datum makes E ≡ 0). 1 %: a correct run at
   // the loosest tolerance the validation uses (CPodes at 1e-7 through the parallelogram's
   // singular positions) stays near 1e-4, a run that lost its energy is off by tens of percent.
   double energy_tolerance = 0.01;  // (0, ∞)
