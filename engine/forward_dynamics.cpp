@@ -101,7 +101,8 @@ void check_finite_row(const TimeSeries& ts) {
   check(ts.qddot.back(), "acceleration");
   check(ts.energy.back(), "energy");
   check(ts.work.back(), "work");
-  for (size_t k = 0; k < ts.forces.size(); ++k) check(ts.forces[k].back(), "constraint force '" + ts.force_names[k] + "'");
+  for (size_t k = 0; k < ts.forces.size(); ++k)
+    check(ts.forces[k].back(), "constraint force '" + ts.force_names[k] + "'");
 }
 
 }  // namespace
@@ -204,7 +205,8 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     }
     record(m, integ->getState(), ts);
     check_finite_row(ts);
-    motion_scale_J = std::max({motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
+    motion_scale_J = std::max(
+        {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
   }
   ts.stats.steps_taken = integ->getNumStepsTaken();
   ts.stats.steps_attempted = integ->getNumStepsAttempted();

@@ -71,7 +71,7 @@ MassProperties planar_mass(double m, models::Vec2 com, double Izz_c, double extr
 // constraint Jacobian. Exactly redundant rows (a repeated loop) come out at ~1e-16 relative
 // and rows made redundant by an assembled geometry (a parallelogram's third link) at the
 // assembly accuracy 1e-12; a loop near an aligned position has σ_min/σ_max ≈ 0.3·(distance
-// in rad) (measured on the parallelogram, see kinetostatic.hpp), so 1e-9 flags only
+// in rad) (measured on the parallelogram, see reduced_source.cpp), so 1e-9 flags only
 // configurations within ~3e-9 rad of a singular one, and those are re-checked nearby.
 constexpr double kRankTolerance = 1e-9;
 // Above this many constraint rows the row-by-row search for redundant ones (one SVD per row)
@@ -154,7 +154,8 @@ Mobility calc_mobility(const FullModel::Impl& m, const State& s) {
     }
     for (size_t k = 0; k < m.constraints.size(); ++k)
       if (count[k] > 0)
-        out.redundant.push_back(fmt::format("{} ({} row{})", m.constraints[k].first, count[k], count[k] > 1 ? "s" : ""));
+        out.redundant.push_back(
+            fmt::format("{} ({} row{})", m.constraints[k].first, count[k], count[k] > 1 ? "s" : ""));
   }
   return out;
 }

@@ -261,7 +261,8 @@ TEST(ForwardDynamicsChecks, KneeAlongAndAcrossAgreeBetweenRoutes) {
   for (int k = 0; k < 2; ++k) {
     const double peak = max_abs(r.forces[k]);
     EXPECT_GT(peak, 10.0) << k;
-    for (size_t i = 0; i < a.t.size(); ++i) EXPECT_NEAR(a.forces[k][i], r.forces[k][i], 1e-6 * peak) << k << " " << a.t[i];
+    for (size_t i = 0; i < a.t.size(); ++i)
+      EXPECT_NEAR(a.forces[k][i], r.forces[k][i], 1e-6 * peak) << k << " " << a.t[i];
   }
 }
 
