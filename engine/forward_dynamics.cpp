@@ -1,5 +1,6 @@
 #include "engine/forward_dynamics.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -64,13 +65,53 @@ void record(const FullModel::Impl& m, const State& s, TimeSeries& ts) {
   ts.stats.max_constraint_error = std::max(ts.stats.max_constraint_error, m.worst_loop_gap(s).first);
 }
 
+// Options in their documented ranges (EngineError: they are input, from the scene or the CLI).
+void check_options(const ForwardOptions& opt) {
+  auto bad = [](const std::string& what) { throw EngineError("forward dynamics: " + what); };
+  if (!(std::isfinite(opt.duration_s) && opt.duration_s > 0))
+    bad(fmt::format("duration {} s must be positive and finite", opt.duration_s));
+  if (!(std::isfinite(opt.output_interval_s) && opt.output_interval_s > 0))
+    bad(fmt::format("output interval {} s must be positive and finite", opt.output_interval_s));
+  if (opt.duration_s / opt.output_interval_s + 1 > static_cast<double>(kMaxOutputRows))
+    bad(fmt::format("output interval {:g} s over {:g} s gives {:.3g} rows, more than {:g}; use an interval of at "
+                    "least {:.3g} s",
+                    opt.output_interval_s, opt.duration_s, opt.duration_s / opt.output_interval_s + 1,
+                    static_cast<double>(kMaxOutputRows), opt.duration_s / (kMaxOutputRows - 1)));
+  if (!(opt.tolerance > 0 && opt.tolerance <= 1))
+    bad(fmt::format("tolerance {} must be in (0, 1]", opt.tolerance));
+  if (opt.integrator != "rkmerson" && opt.integrator != "rk3" && opt.integrator != "cpodes")
+    bad("unknown integrator '" + opt.integrator + "' (rkmerson, rk3, cpodes)");
+  if (!(opt.max_steps > 0)) bad(fmt::format("step budget {} must be positive", opt.max_steps));
+  if (!(std::isfinite(opt.max_wall_s) && opt.max_wall_s > 0))
+    bad(fmt::format("wall-time budget {} s must be positive and finite", opt.max_wall_s));
+  if (!(std::isfinite(opt.energy_tolerance) && opt.energy_tolerance > 0))
+    bad(fmt::format("energy tolerance {} must be positive and finite", opt.energy_tolerance));
+}
+
+// The last recorded row, every value finite (Simbody can return NaN/inf without throwing,
+// e.g. after an overflow of a runaway speed).
+void check_finite_row(const TimeSeries& ts) {
+  const double t = ts.t.back();
+  auto check = [t](double v, const std::string& what) {
+    if (!std::isfinite(v))
+      throw models::NumericalError(fmt::format("full model produced a non-finite {} at t = {:.6g} s", what, t));
+  };
+  check(ts.q.back(), "coordinate");
+  check(ts.qdot.back(), "speed");
+  check(ts.qddot.back(), "acceleration");
+  check(ts.energy.back(), "energy");
+  check(ts.work.back(), "work");
+  for (size_t k = 0; k < ts.forces.size(); ++k)
+    check(ts.forces[k].back(), "constraint force '" + ts.force_names[k] + "'");
+}
+
 }  // namespace
 
 TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   const auto& m = model.impl();
-  if (!(opt.duration_s > 0) || !(opt.output_interval_s > 0))
-    throw EngineError("duration and output interval must be positive");
+  check_options(opt);
   const auto start = std::chrono::steady_clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
   // Consistent initial state: a kinetostatic projection at (q0, q̇0), then the independent
   // coordinate is released.
@@ -87,17 +128,22 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   auto integ = make_integrator(m, opt.integrator);
   integ->setAccuracy(opt.tolerance);
   integ->setConstraintTolerance(std::min(1e-10, opt.tolerance));
-  integ->setReturnEveryInternalStep(true);  // to track the smallest step
+  // Return after every internal step: to track the smallest step, and so that the step and
+  // wall-time budgets are checked between steps, not only between outputs.
+  integ->setReturnEveryInternalStep(true);
   // Step freely and interpolate (then project) the states at output times, rather than
   // shortening steps to land on them: the full model's cheapest honest setting.
   integ->setAllowInterpolation(true);
   integ->setProjectInterpolatedStates(true);
   TimeStepper stepper(m.system, *integ);
-  stepper.setReportAllSignificantStates(false);
+  // TimeStepper::stepTo otherwise swallows the integrator's per-step returns and comes back
+  // only at the output time (Simbody 3.7 TimeStepperRep::stepTo loops until then), so a
+  // single output interval of microscopic steps would never reach the budget checks below.
+  stepper.setReportAllSignificantStates(true);
   try {
     stepper.initialize(s);
   } catch (const std::exception& e) {
-    throw EngineError(std::string("cannot start the full model: ") + e.what());
+    throw models::NumericalError(std::string("cannot start the full model: ") + e.what());
   }
 
   m.events_handled = 0;
@@ -106,7 +152,20 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   ts.forces.resize(ts.force_names.size());
   const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
   record(m, integ->getState(), ts);
+  check_finite_row(ts);
+  // Largest kinetic energy and |W| seen [J]: with max|E| the scale of the energy-balance test.
+  // max|E| alone fails where E ≡ 0 by the choice of datum (a pendulum released from the
+  // horizontal through its pivot's height): the residual is then rounding over ~0.
+  double motion_scale_J = m.system.calcKineticEnergy(integ->getState());
   double smallest = INFINITY;
+  long calls = 0;  // stepTo calls: bounded even if a call were to return without a step
+  // Hopeless runs fail early: every kWindow steps, the steps still needed at the window's
+  // mean step size; more than kHopeless budgets (a margin for start-up transients and event
+  // localization, which shrink steps for a while) will not finish, so stop now instead of
+  // after the wall-time budget (a c1 = 1e9 N·m·s resistance: 600 s → < 1 s, measured).
+  constexpr long kWindow = 1000;
+  constexpr double kHopeless = 100.0;
+  double window_t0 = 0.0;
   for (long i = 1; i <= n; ++i) {
     const double t = std::min(opt.duration_s, i * opt.output_interval_s);
     try {
@@ -114,19 +173,57 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
         stepper.stepTo(t);
         const double h = integ->getPreviousStepSizeTaken();
         if (h > 0) smallest = std::min(smallest, h);
+        const long steps = std::max<long>(++calls, integ->getNumStepsAttempted());
+        const double w = wall();
+        if (calls % kWindow == 0) {
+          const double now = integ->getTime(), mean_h = (now - window_t0) / kWindow;
+          const double needed = steps + (opt.duration_s - now) / std::max(mean_h, 1e-300);
+          window_t0 = now;
+          if (needed > kHopeless * static_cast<double>(opt.max_steps))
+            throw models::NumericalError(fmt::format(
+                "full model stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) "
+                "it would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or "
+                "too fast for '{}' at tolerance {:g}",
+                now, opt.duration_s, kWindow, mean_h, needed, kHopeless, opt.max_steps, opt.integrator,
+                opt.tolerance));
+        }
+        if (steps > opt.max_steps || w > opt.max_wall_s || !std::isfinite(integ->getTime()))
+          throw models::NumericalError(fmt::format(
+              "full model stopped at t = {:.6g} s of {:.6g} s: {} (last step {:.3g} s, smallest {:.3g} s): the "
+              "motion is too stiff or too fast for '{}' at tolerance {:g}",
+              integ->getTime(), opt.duration_s,
+              steps > opt.max_steps ? fmt::format("step budget of {} steps exhausted", opt.max_steps)
+                                    : fmt::format("wall-time budget of {:g} s exhausted", opt.max_wall_s),
+              h, std::isfinite(smallest) ? smallest : 0.0, opt.integrator, opt.tolerance));
       }
+    } catch (const models::NumericalError&) {
+      throw;
     } catch (const std::exception& e) {
-      throw EngineError(fmt::format("full model failed at t = {:.6g} s: {}", integ->getTime(), e.what()));
+      throw models::NumericalError(
+          fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}", integ->getTime(),
+                      integ->getPreviousStepSizeTaken(), e.what()));
     }
     record(m, integ->getState(), ts);
-    if (!std::isfinite(ts.qdot.back()))
-      throw EngineError(fmt::format("full model produced a non-finite speed at t = {:.6g} s", t));
+    check_finite_row(ts);
+    motion_scale_J = std::max(
+        {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
   }
   ts.stats.steps_taken = integ->getNumStepsTaken();
   ts.stats.steps_attempted = integ->getNumStepsAttempted();
   ts.stats.events = m.events_handled;
   ts.stats.smallest_step_s = std::isfinite(smallest) ? smallest : 0.0;
-  ts.stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ts.stats.wall_time_s = wall();
+
+  // The run checks itself: E(t) − E(0) = W(t) must hold to a fraction of the energy.
+  const auto eb = models::energy_balance(ts);
+  const double scale_J = std::max(eb.energy_scale_J, motion_scale_J);
+  if (!(eb.max_residual_J <= opt.energy_tolerance * scale_J + kEnergyFloor_J))
+    throw models::NumericalError(fmt::format(
+        "full model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
+        "energy scale {:.3g} J (largest |E|, kinetic energy or |W|; limit {:g} %): the integration lost or invented "
+        "energy ('{}' at tolerance {:g}; try a tighter tolerance or cpodes)",
+        eb.max_residual_J, eb.worst_time_s, 100 * eb.max_residual_J / std::max(scale_J, kEnergyFloor_J), scale_J,
+        100 * opt.energy_tolerance, opt.integrator, opt.tolerance));
   return ts;
 }
 

@@ -11,17 +11,39 @@
 namespace rdyn::engine {
 
 struct ForwardOptions {
-  double duration_s = 5.0;
-  double output_interval_s = 0.01;
-  double tolerance = 1e-9;  // integrator accuracy (relative); constraints held to ≤ this too
+  double duration_s = 5.0;          // (0, ∞), finite [s]
+  double output_interval_s = 0.01;  // > 0, at most kMaxOutputRows rows [s]
+  double tolerance = 1e-9;  // integrator accuracy (relative), (0, 1]; constraints held to ≤ this too
   std::string integrator = "rkmerson";  // rkmerson | rk3 | cpodes
+  // Budgets, so that no run hangs (NumericalError naming the time reached and the step size).
+  // Each internal step is counted, so one output interval of microscopic steps is bounded too.
+  // 5e6 steps: the shipped scenes take at most ~6e3 per simulated second at their tolerance
+  // (measured: motor-startup 24162 steps for 4 s, thousand-cycles 2.8e5 for 210 s), so this is
+  // ~800 simulated seconds of the hardest of them. A run whose recent mean step projects to
+  // more than 100 budgets stops at once (see simulate_full).
+  long max_steps = 5'000'000;  // integrator steps attempted, > 0
+  double max_wall_s = 600.0;   // wall-clock time of the integration [s], > 0
+  // The run checks its own energy balance: max|E − E0 − W| (models::energy_balance) must not
+  // exceed energy_tolerance·scale + kEnergyFloor_J, scale = the largest |E|, kinetic energy or
+  // |W| seen (|E| alone is ~0 when the potential's datum makes E ≡ 0). 1 %: a correct run at
+  // the loosest tolerance the validation uses (CPodes at 1e-7 through the parallelogram's
+  // singular positions) stays near 1e-4, a run that lost its energy is off by tens of percent.
+  double energy_tolerance = 0.01;  // (0, ∞)
 };
+
+// Output rows (duration / interval + 1) a run may produce: 1e7 rows of ~8 doubles is ~0.6 GB.
+inline constexpr long kMaxOutputRows = 10'000'000;
+// Absolute floor of the energy-balance test [J]: a motion whose energies are all ~0 (at rest,
+// no loads) has a residual of rounding size only.
+inline constexpr double kEnergyFloor_J = 1e-12;
 
 using models::RunStats;
 using models::TimeSeries;
 
 // Starts at the scene's initial q, q̇ (the rest of the state from the constraints).
-// Throws EngineError on failure.
+// Throws EngineError for options out of range or a scene the engine refuses, and
+// models::NumericalError when the integration fails on valid input: integrator error, step
+// or wall-time budget exhausted, a non-finite value, or an energy balance that does not close.
 TimeSeries simulate_full(const FullModel& model, const ForwardOptions& options);
 
 }  // namespace rdyn::engine

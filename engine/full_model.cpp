@@ -67,6 +67,162 @@ MassProperties planar_mass(double m, models::Vec2 com, double Izz_c, double extr
   return MassProperties(m, v3(com), about_origin);
 }
 
+// Singular values below this fraction of the largest count as zero when ranking the
+// constraint Jacobian. Exactly redundant rows (a repeated loop) come out at ~1e-16 relative
+// and rows made redundant by an assembled geometry (a parallelogram's third link) at the
+// assembly accuracy 1e-12; a loop near an aligned position has σ_min/σ_max ≈ 0.3·(distance
+// in rad) (measured on the parallelogram, see reduced_source.cpp), so 1e-9 flags only
+// configurations within ~3e-9 rad of a singular one, and those are re-checked nearby.
+constexpr double kRankTolerance = 1e-9;
+// Above this many constraint rows the row-by-row search for redundant ones (one SVD per row)
+// is skipped and only the counts are reported.
+constexpr int kMaxRowsToName = 400;
+
+int numerical_rank(const Matrix& A) {
+  if (A.nrow() == 0 || A.ncol() == 0) return 0;
+  FactorSVD svd(A);
+  Vector sv;
+  svd.getSingularValues(sv);
+  if (sv.size() == 0 || !std::isfinite(sv[0])) return 0;
+  int r = 0;
+  for (int i = 0; i < sv.size(); ++i) r += sv[i] > kRankTolerance * sv[0] ? 1 : 0;
+  return r;
+}
+
+// Constraint Jacobian ∂(loop and gear conditions)/∂u at a state realized to Position, one
+// block per constraint, restricted to the mobilities of the mechanism: the constraint
+// actuators' sliders are prescribed to x = 0 and are not degrees of freedom of the scene.
+struct Mobility {
+  int mobilities = 0;  // columns: joint coordinates of the mechanism
+  int rows = 0;        // loop and gear conditions
+  int rank = 0;        // of the whole Jacobian
+  bool independent_free = true;  // rank unchanged without the independent coordinate's column
+  std::vector<std::string> redundant;  // constraints owning a redundant row, "loop 'C' (1 row)"
+};
+
+Mobility calc_mobility(const FullModel::Impl& m, const State& s) {
+  m.system.realize(s, Stage::Position);
+  std::vector<bool> keep(s.getNU(), true);
+  for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
+  std::vector<int> cols;
+  for (int c = 0; c < s.getNU(); ++c)
+    if (keep[c]) cols.push_back(c);
+  std::vector<Matrix> rows;          // one 1×ncols row per constraint equation
+  std::vector<int> owner;            // its constraint
+  for (size_t k = 0; k < m.constraints.size(); ++k) {
+    const Matrix P = m.constraints[k].second.calcPositionConstraintMatrixP(s);  // mp × nu
+    for (int r = 0; r < P.nrow(); ++r) {
+      Matrix row(1, static_cast<int>(cols.size()));
+      for (size_t c = 0; c < cols.size(); ++c) row(0, static_cast<int>(c)) = P(r, cols[c]);
+      rows.push_back(row);
+      owner.push_back(static_cast<int>(k));
+    }
+  }
+  auto rank_of = [&](const std::vector<bool>& use, int drop_col) {
+    int n = 0;
+    for (bool u : use) n += u ? 1 : 0;
+    Matrix A(n, static_cast<int>(cols.size()) - (drop_col >= 0 ? 1 : 0));
+    for (size_t r = 0, i = 0; r < rows.size(); ++r) {
+      if (!use[r]) continue;
+      for (int c = 0, o = 0; c < static_cast<int>(cols.size()); ++c)
+        if (c != drop_col) A(static_cast<int>(i), o++) = rows[r](0, c);
+      ++i;
+    }
+    return numerical_rank(A);
+  };
+  Mobility out;
+  out.mobilities = static_cast<int>(cols.size());
+  out.rows = static_cast<int>(rows.size());
+  std::vector<bool> use(rows.size(), true);
+  out.rank = rank_of(use, -1);
+  int indep_col = -1;
+  const int indep_u = m.joint_mobod[m.independent].getFirstUIndex(s);
+  for (size_t c = 0; c < cols.size(); ++c)
+    if (cols[c] == indep_u) indep_col = static_cast<int>(c);
+  out.independent_free = rank_of(use, indep_col) == out.rank;
+  if (out.rank < out.rows && out.rows <= kMaxRowsToName) {
+    // Drop rows from the last declared constraint backwards; a row whose removal keeps the
+    // rank repeats what the rows kept impose (for two identical loops, the second one).
+    std::vector<int> count(m.constraints.size(), 0);
+    for (int r = out.rows - 1; r >= 0; --r) {
+      use[r] = false;
+      if (rank_of(use, -1) == out.rank) {
+        ++count[owner[r]];
+      } else {
+        use[r] = true;
+      }
+    }
+    for (size_t k = 0; k < m.constraints.size(); ++k)
+      if (count[k] > 0)
+        out.redundant.push_back(
+            fmt::format("{} ({} row{})", m.constraints[k].first, count[k], count[k] > 1 ? "s" : ""));
+  }
+  return out;
+}
+
+// A configuration next to `s` on the same branch: the independent coordinate moved by dq
+// and the rest projected onto the constraints. Empty when the projection fails.
+std::optional<State> nearby_configuration(const FullModel::Impl& m, const State& s, double dq) {
+  State near = s;
+  try {
+    m.set_law(near, 0, poly_law(m.scene.initial.q + dq, 0.0, 0.0));
+    m.system.realize(near, Stage::Time);
+    m.system.prescribeQ(near);
+    m.system.projectQ(near, 1e-12);
+    m.system.realize(near, Stage::Position);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return near;
+}
+
+bool one_dof(const Mobility& mob) {
+  return mob.mobilities - mob.rank == 1 && mob.rank == mob.rows && mob.independent_free;
+}
+
+// Degrees of freedom by rank (the counting check in models/ cannot see geometry): the
+// mechanism must have mobilities − rank(G) = 1, independent constraint rows (redundant
+// ones leave the constraint forces undetermined, Simbody would return one of infinitely
+// many splits) and an independent coordinate the constraints do not fix. At an isolated
+// singular configuration (aligned links) the rank drops only there, so a deficient
+// initial configuration is re-checked 0.01 rad (or 1 mm) to either side before refusing.
+void check_one_dof(const FullModel::Impl& m, const State& s) {
+  Mobility mob = calc_mobility(m, s);
+  if (one_dof(mob)) return;
+  const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
+  const double step = rev ? 0.01 : 1e-3;
+  for (double dq : {step, -step}) {
+    if (const auto near = nearby_configuration(m, s, dq)) {
+      const Mobility other = calc_mobility(m, *near);
+      if (one_dof(other)) return;
+      if (other.rank > mob.rank) mob = other;
+    }
+  }
+  const int dof = mob.mobilities - mob.rank;
+  std::string names;
+  for (const auto& r : mob.redundant) names += (names.empty() ? "" : ", ") + r;
+  const std::string where = fmt::format("{}: at {} = {:.6g} {}", m.scene.source_file, m.scene.independent,
+                                        m.scene.initial.q, rev ? "rad" : "m");
+  if (dof != 1) {
+    throw EngineError(fmt::format(
+        "{} the mechanism has {} degrees of freedom: {} joint coordinates, {} of them fixed by the {} loop and gear "
+        "conditions (rank of the constraint Jacobian); rdyn needs exactly 1{}",
+        where, dof, mob.mobilities, mob.rank, mob.rows,
+        names.empty() ? "" : "; redundant (their conditions repeat the others'): " + names));
+  }
+  if (mob.rank < mob.rows) {
+    throw EngineError(fmt::format(
+        "{} redundant constraints: {} repeat conditions the other loops and gears already impose (constraint "
+        "Jacobian rank {} of {} rows); the constraint forces would not be determined — remove the redundant "
+        "loop or link",
+        where, names.empty() ? "some rows" : names, mob.rank, mob.rows));
+  }
+  throw EngineError(fmt::format("{} the independent coordinate '{}' cannot move: the loops and gears fix it (the "
+                                "mechanism's one degree of freedom moves other joints only); choose another "
+                                "independent joint",
+                                where, m.scene.independent));
+}
+
 }  // namespace
 
 FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
@@ -77,6 +233,19 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   joint_fold.resize(nj);
   body_fold.resize(nb);
   independent = scene.joint_index(scene.independent);
+  if (independent < 0) throw EngineError(scene.source_file + ": unknown independent joint '" + scene.independent + "'");
+  // Requests the builder below can honour (check_scene refuses the others with a line number;
+  // this keeps a scene built in code from reaching Simbody with a dangling handle).
+  for (const auto& c : scene.outputs.constraint_forces) {
+    const int j = scene.joint_index(c.joint);
+    if (j < 0 || scene.joints[j].type != JointType::Revolute || j == independent ||
+        !(std::hypot(c.direction.x, c.direction.y) > 0))
+      throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint other than the independent "
+                                    "one and a non-zero direction",
+                                    scene.source_file, c.name));
+  }
+  actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
+                                                                          : 0);
 
   // 1. Which geared bodies can be folded onto their driver: a leaf turning about a fixed
   //    axis through its centre of mass, touched by nothing else, whose motion is not
@@ -123,28 +292,37 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
       const int b = scene.body_index(jt.child);
       const auto& bd = scene.bodies[b];
       const Body::Rigid info(planar_mass(bd.mass_kg, bd.com_m, bd.inertia_kgm2, extra_inertia[b]));
-      int request = -1;
+      std::vector<int> requests;  // constraint forces asked of this joint
       for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k)
-        if (scene.outputs.constraint_forces[k].joint == jt.name) request = static_cast<int>(k);
+        if (scene.outputs.constraint_forces[k].joint == jt.name) requests.push_back(static_cast<int>(k));
 
       if (jt.type == JointType::Prismatic) {
         const Rotation R(std::atan2(jt.axis.y, jt.axis.x), ZAxis);
         MobilizedBody::Slider mb(parent, Transform(R, v3(jt.parent_point)), info,
                                  Transform(R, v3(jt.child_point)));
         joint_mobod[j] = body_mobod[b] = mb;
-      } else if (request >= 0 && options.route == ConstraintForceRoute::Actuator) {
-        // Constraint actuator: pin to a massless frame turned so its x is the requested
-        // direction, then a slider along it carrying the child. R_PB = Rz(offset+a)Rz(q)Rz(−a).
-        const auto& d = scene.outputs.constraint_forces[request].direction;
-        const double a = std::atan2(d.y, d.x);
-        MobilizedBody::Pin pin(parent, Transform(Rotation(jt.offset_rad + a, ZAxis), v3(jt.parent_point)),
+      } else if (!requests.empty() && options.route == ConstraintForceRoute::Actuator) {
+        // Constraint actuators: a pin to a massless frame C turned like the child (rotation
+        // offset + q), then one slider per requested direction d_k (child frame), in series,
+        // the last carrying the child. Each slider's F and M frames are Rz(a_k) so it slides
+        // along d_k and leaves the orientation alone: R_PB = Rz(offset) Rz(q). In series every
+        // slider carries the whole joint force, so its multiplier is that force projected on
+        // its own d_k (virtual power: ẋ_k moves the child along d_k), whatever the other
+        // directions are — the Reaction route's quantity.
+        MobilizedBody::Pin pin(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)),
                                Body::Massless(), Transform());
-        MobilizedBody::Slider slider(pin, Transform(), info,
-                                     Transform(Rotation(a, ZAxis), v3(jt.child_point)));
+        MobilizedBody carrier = pin;
+        for (size_t i = 0; i < requests.size(); ++i) {
+          const auto& d = scene.outputs.constraint_forces[requests[i]].direction;
+          const Rotation R_d(std::atan2(d.y, d.x), ZAxis);
+          const bool last = i + 1 == requests.size();
+          MobilizedBody::Slider slider(carrier, Transform(R_d), last ? Body(info) : Body(Body::Massless()),
+                                       Transform(R_d, last ? v3(jt.child_point) : Vec3(0)));
+          actuator_slider[requests[i]] = slider;
+          carrier = slider;
+        }
         joint_mobod[j] = pin;
-        body_mobod[b] = slider;
-        if (static_cast<int>(actuator_slider.size()) <= request) actuator_slider.resize(request + 1);
-        actuator_slider[request] = slider;
+        body_mobod[b] = carrier;
       } else {
         MobilizedBody::Pin mb(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)), info,
                               Transform(v3(jt.child_point)));
@@ -154,6 +332,11 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
       ++done;
     }
   }
+  for (size_t j = 0; j < nj; ++j)
+    if (!built[j])
+      throw EngineError(fmt::format("{}: joint '{}' hangs from no body reachable from ground (the joints must "
+                                    "form a tree)",
+                                    scene.source_file, scene.joints[j].name));
 
   // 3. Loop closures: a point of body_b stays on the z line through a point of body_a:
   //    the two in-plane rows of a planar revolute, without Ball's redundant third row.
@@ -162,7 +345,8 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
                                                    : body_mobod[scene.body_index(l.body_a)];
     MobilizedBody b = l.body_b == models::kGround ? MobilizedBody(matter.updGround())
                                                    : body_mobod[scene.body_index(l.body_b)];
-    Constraint::PointOnLine(a, UnitVec3(ZAxis), v3(l.point_a), b, v3(l.point_b));
+    constraints.emplace_back("loop '" + l.name + "'",
+                             Constraint::PointOnLine(a, UnitVec3(ZAxis), v3(l.point_a), b, v3(l.point_b)));
   }
   // 4. Gears that were not folded: q_driven − r·q_driver − c = 0.
   for (size_t g = 0; g < scene.gears.size(); ++g) {
@@ -176,7 +360,8 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     std::vector<MobilizedBodyIndex> mbs{joint_mobod[jr].getMobilizedBodyIndex(),
                                         joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
-    Constraint::CoordinateCoupler(matter, new Function::Linear(coeff), mbs, qs);
+    constraints.emplace_back("gear '" + gear.name + "'",
+                             Constraint::CoordinateCoupler(matter, new Function::Linear(coeff), mbs, qs));
   }
 
   // 5. Prescribed laws: the independent coordinate (enabled for kinetostatic calls,
@@ -246,7 +431,7 @@ std::vector<double> FullModel::Impl::constraint_forces(const State& s) const {
   for (size_t k = 0; k < req.size(); ++k) {
     const auto& jt = scene.joints[scene.joint_index(req[k].joint)];
     const MobilizedBody& child = body_mobod[scene.body_index(jt.child)];
-    const Vec3 d_G = child.getBodyRotation(s) * v3(req[k].direction);
+    const Vec3 d_G = child.getBodyRotation(s) * UnitVec3(v3(req[k].direction));
     out[k] = dot(reactions[child.getMobilizedBodyIndex()][1], d_G);  // force on child at M, in G
   }
   return out;
@@ -302,6 +487,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
                                   "leaves a gap of {:.6g} m (check lengths and ground points)",
                                   m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
   }
+  check_one_dof(m, s);
 }
 
 FullWorkspace::~FullWorkspace() = default;

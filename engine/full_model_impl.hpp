@@ -4,6 +4,8 @@
 #include <Simbody.h>
 
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/full_model.hpp"
@@ -45,9 +47,13 @@ struct FullModel::Impl {
   std::vector<SimTK::MobilizedBody> body_mobod;   // per scene body
   std::vector<std::optional<Fold>> joint_fold;    // per scene joint
   std::vector<std::optional<Fold>> body_fold;     // per scene body
-  std::vector<SimTK::MobilizedBody> actuator_slider;  // per constraint force (Actuator)
+  // Per constraint force (Actuator route): the prescribed slider along its direction. Requests
+  // on one joint form a chain of sliders (massless frames between them) ending at the child.
+  std::vector<SimTK::MobilizedBody> actuator_slider;
   std::vector<SimTK::Motion::Custom> actuator_motion;
   SimTK::Motion::Custom independent_motion;
+  // Loop closures and unfolded gears, each with the name messages give it ("loop 'C'").
+  std::vector<std::pair<std::string, SimTK::Constraint>> constraints;
   int independent = -1;  // scene joint index
 
   // Indices allocated at realizeTopology (mutable: set by the const realize callbacks).

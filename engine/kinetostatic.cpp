@@ -1,5 +1,8 @@
 #include "engine/kinetostatic.hpp"
 
+#include <cmath>
+#include <initializer_list>
+
 #include <fmt/format.h>
 
 #include "engine/full_model_impl.hpp"
@@ -83,7 +86,26 @@ KinetostaticResult collect(const FullModel::Impl& m, const State& s) {
   r.kinetic_energy = m.system.calcKineticEnergy(s);
   // Folded bodies: ½ r² I u² is already in the driver's inertia.
   r.potential_energy = m.system.calcPotentialEnergy(s);
+  // Simbody does not throw on NaN or inf (e.g. a mass matrix made singular by a degenerate
+  // geometry): nothing non-finite leaves the engine.
+  bool finite = std::isfinite(r.driving_force) && std::isfinite(r.kinetic_energy) &&
+                std::isfinite(r.potential_energy);
+  for (double f : r.constraint_forces) finite &= std::isfinite(f);
+  for (size_t j = 0; j < nj; ++j) finite &= std::isfinite(r.joint_q[j]) && std::isfinite(r.joint_u[j]);
+  if (!finite)
+    throw models::NumericalError(fmt::format("{}: the full model returned a non-finite force, energy or joint "
+                                             "state at {} = {:.6g}",
+                                             m.scene.source_file, m.scene.independent,
+                                             m.joint_q(s, m.independent)));
   return r;
+}
+
+// Prescribed values must be finite before Simbody sees them (a NaN law would project to NaN).
+void check_finite_input(const FullModel::Impl& m, std::initializer_list<double> values) {
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw models::NumericalError(fmt::format("{}: non-finite value prescribed to the independent coordinate '{}'",
+                                               m.scene.source_file, m.scene.independent));
 }
 
 void ensure_kinetostatic_mode(const FullModel::Impl& m, State& s) {
@@ -98,6 +120,7 @@ void ensure_kinetostatic_mode(const FullModel::Impl& m, State& s) {
 KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, double q, double qdot,
                                      double qddot, Loads loads) {
   const auto& m = model.impl();
+  check_finite_input(m, {q, qdot, qddot});
   State& s = ws.impl().state;
   ensure_kinetostatic_mode(m, s);
   s.setTime(0.0);
@@ -110,6 +133,7 @@ KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, 
 
 void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
   const auto& m = model.impl();
+  check_finite_input(m, {q});
   State& s = ws.impl().state;
   ensure_kinetostatic_mode(m, s);
   s.setTime(0.0);
@@ -129,13 +153,19 @@ void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
 
 VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q, bool with_q, bool with_x) {
   const auto& m = model.impl();
+  check_finite_input(m, {q});
   State& s = ws.impl().state;
   ensure_kinetostatic_mode(m, s);
   s.setTime(0.0);
   const size_t nj = m.scene.joints.size(), nx = m.actuator_slider.size();
   auto rates = [&] {
     std::vector<double> u(nj);
-    for (size_t j = 0; j < nj; ++j) u[j] = m.joint_u(s, static_cast<int>(j));
+    for (size_t j = 0; j < nj; ++j) {
+      u[j] = m.joint_u(s, static_cast<int>(j));
+      if (!std::isfinite(u[j]))
+        throw models::NumericalError(fmt::format("{}: non-finite velocity ratio of joint '{}' at {} = {:.6g}",
+                                                 m.scene.source_file, m.scene.joints[j].name, m.scene.independent, q));
+    }
     return u;
   };
   VelocityRatios out;
@@ -184,6 +214,7 @@ double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
 KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws, const double c[5],
                                              double t, Loads loads) {
   const auto& m = model.impl();
+  check_finite_input(m, {c[0], c[1], c[2], c[3], c[4], t});
   State& s = ws.impl().state;
   ensure_kinetostatic_mode(m, s);
   m.set_law(s, 0, harmonic_law(c[0], c[1], c[2], c[3], c[4]));

@@ -15,6 +15,11 @@ namespace {
 // Continuation moves of at most 10° (with the secant predictor; retried in 2° and 0.2° moves
 // when a projection fails).
 constexpr double kMaxJump = 10.0 * 3.14159265358979323846 / 180.0;
+// Continuation moves one approach may take: a revolute coordinate never walks more than half a
+// turn (900 of the finest 0.2° moves); for a prismatic one the jumps are read in metres
+// (0.17 m, finest 3.5 mm), so 1e4 finest moves are 35 m of stroke. More means a runaway target
+// (a huge or non-finite request), refused rather than walked.
+constexpr double kMaxApproachMoves = 10000;
 }
 
 FullKinetostaticSource::FullKinetostaticSource(const FullModel& model)
@@ -59,7 +64,12 @@ void FullKinetostaticSource::approach(double q, double max_jump) {
   double target = q;
   const auto& jt = *model_.scene().find_joint(model_.scene().independent);
   if (jt.type == models::JointType::Revolute) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
-  const int steps = static_cast<int>(std::ceil(std::abs(target - q_now_) / max_jump - 1e-9));
+  const double moves = std::ceil(std::abs(target - q_now_) / max_jump - 1e-9);
+  if (!(moves <= kMaxApproachMoves))  // also NaN
+    throw models::NumericalError(fmt::format(
+        "{}: continuation from {} = {:.6g} to {:.6g} would need {:.3g} moves of {:.3g} (limit {:g})",
+        model_.scene().source_file, model_.scene().independent, q_now_, q, moves, max_jump, kMaxApproachMoves));
+  const int steps = static_cast<int>(moves);
   for (int i = 1; i < steps; ++i) {
     move_configuration(model_, ws_, q_now_ + (target - q_now_) * i / steps);
     ++calls_;
@@ -156,10 +166,15 @@ std::optional<reduced::DirectPoint> FullKinetostaticSource::direct_here(double q
   reduced::DirectPoint d;
   d.m1 = ~u * Mu;        // T = ½ m1 q̇²
   d.m2 = ~u * residual;  // uᵀ(M b + c)
+  bool finite = std::isfinite(d.m1) && std::isfinite(d.m2);
   for (int k = 0; k < nx; ++k) {
     d.me1.push_back(~ux[k] * Mu);
     d.me2.push_back(~ux[k] * residual);
+    finite &= std::isfinite(d.me1.back()) && std::isfinite(d.me2.back());
   }
+  if (!finite)
+    throw models::NumericalError(fmt::format("{}: non-finite reduced parameters at {} = {:.6g}",
+                                             model_.scene().source_file, model_.scene().independent, q));
   return d;
 }
 

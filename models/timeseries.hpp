@@ -2,6 +2,8 @@
 // reduced model (written as timeseries.csv). Plain data.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,5 +28,26 @@ struct TimeSeries {
   std::vector<std::uint32_t> gates;         // bit g set: rate-gated load g on at sample i
   RunStats stats;
 };
+
+// Energy balance of a simulated motion: E(t) − E(0) = W(t), the work of the non-conservative
+// loads integrated next to the motion, so the residual max|E − E0 − W| measures what the
+// integration lost or invented [J]; the largest |E| seen is its natural scale [J].
+struct EnergyBalance {
+  double max_residual_J = 0.0;
+  double energy_scale_J = 0.0;
+  double worst_time_s = 0.0;  // where the residual is largest [s]
+};
+inline EnergyBalance energy_balance(const TimeSeries& ts) {
+  EnergyBalance b;
+  for (size_t i = 0; i < ts.t.size(); ++i) {
+    const double r = std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]);
+    if (r > b.max_residual_J) {
+      b.max_residual_J = r;
+      b.worst_time_s = ts.t[i];
+    }
+    b.energy_scale_J = std::max(b.energy_scale_J, std::abs(ts.energy[i]));
+  }
+  return b;
+}
 
 }  // namespace rdyn::models

@@ -38,13 +38,4 @@ void write_timeseries_csv(const std::string& path, const engine::TimeSeries& ts)
   sink.close();
 }
 
-EnergyBalance energy_balance(const engine::TimeSeries& ts) {
-  EnergyBalance b;
-  for (size_t i = 0; i < ts.t.size(); ++i) {
-    b.max_residual_J = std::max(b.max_residual_J, std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]));
-    b.energy_scale_J = std::max(b.energy_scale_J, std::abs(ts.energy[i]));
-  }
-  return b;
-}
-
 }  // namespace rdyn::validate

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "models/scene_yaml.hpp"
 #include "test_scenes.hpp"
@@ -133,6 +134,23 @@ TEST(Kinetostatic, LoopThatCannotCloseIsNamedWithItsGap) {
     EXPECT_NE(m.find("loop 'C'"), std::string::npos) << m;
     EXPECT_NE(m.find("gap"), std::string::npos) << m;
   }
+}
+
+TEST(Kinetostatic, NonFinitePrescribedMotionIsANumericalError) {
+  // A NaN law would project to a NaN configuration and poison the workspace's next calls.
+  const auto scene = models::parse_scene(test::parallelogram_yaml(0.0, false), "p.yaml");
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  for (const auto& [q, qd, qdd] : {std::tuple{std::nan(""), 0.0, 0.0}, {0.7, INFINITY, 0.0}, {0.7, 0.0, -INFINITY}}) {
+    try {
+      calc_kinetostatic(model, ws, q, qd, qdd, Loads::Off);
+      ADD_FAILURE() << "accepted " << q << " " << qd << " " << qdd;
+    } catch (const models::NumericalError& e) {
+      EXPECT_NE(std::string(e.what()).find("independent coordinate 'crank'"), std::string::npos) << e.what();
+    }
+  }
+  // The workspace is untouched: the next finite call gives the closed-form m1 (q̈ = 1).
+  EXPECT_NEAR(calc_kinetostatic(model, ws, 0.7, 0.0, 1.0, Loads::Off).driving_force, test::parallelogram_m1(), 1e-10);
 }
 
 }  // namespace

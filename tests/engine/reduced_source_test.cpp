@@ -133,5 +133,32 @@ TEST(ReducedSource, SwitchAnglesAreZerosOfTheThighRate) {
   }
 }
 
+TEST(ReducedSource, RunawayContinuationTargetIsRefusedNotWalked) {
+  // A prismatic independent coordinate (a block on a slide): the continuation walks the
+  // configuration in moves of at most 0.17 m, so 1e9 m would be ~6e9 projections.
+  const auto scene = models::parse_scene(R"(
+name: slide
+ground_points: {O: [0, 0]}
+bodies:
+  - {name: block, mass_kg: 2.0, com_m: [0, 0], inertia_kgm2: 1.0e-2}
+joints:
+  - {name: slide, type: prismatic, parent: ground, parent_point: O, child: block, axis: [1, 0], guess_m: 0}
+independent: slide
+initial: {q: 0, qdot: 0}
+)",
+                                         "slide.yaml");
+  FullModel model(scene);
+  FullKinetostaticSource src(model);
+  EXPECT_NEAR(src.inertial(0.5, 0.0, 1.0).driving_force, 2.0, 1e-12);  // F = m q̈: the walk works
+  for (double q : {1e9, std::nan("")}) {
+    try {
+      src.inertial(q, 0.0, 1.0);
+      ADD_FAILURE() << q << " should be refused";
+    } catch (const models::NumericalError& e) {
+      EXPECT_NE(std::string(e.what()).find("continuation from slide = 0.5"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rdyn::engine

@@ -1,0 +1,213 @@
+// Building the full model: degrees of freedom by rank, redundant constraints named, several
+// constraint forces on one joint (actuator chain against Simbody's reactions).
+#include "engine/full_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "engine/kinetostatic.hpp"
+#include "models/scene_yaml.hpp"
+#include "test_scenes.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The message of the EngineError that building a workspace of `scene` throws ("" if none).
+std::string refusal(const models::Scene& scene) {
+  try {
+    FullModel model(scene);
+    FullWorkspace ws(model);
+  } catch (const EngineError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Parallelogram A-B-C-D (as test_scenes.hpp) with a third link E→E' parallel to the crank,
+// from ground E (0.15, 0) to the coupler's midpoint: on the parallelogram branch it moves with
+// the others, so one of its loop's two rows repeats what loop C imposes (Grübler counts 0 DOF
+// for the four bars, the mechanism has 1). Plus a free pendulum on ground: Grübler's count
+// 5 − 2·2 = 1 passes models::check_scene, the rank says 2.
+std::string third_link_and_pendulum_yaml() {
+  return R"(
+name: parallelogram3
+ground_points: {A: [0, 0], D: [0.3, 0], E: [0.15, 0], P: [0.6, 0]}
+bodies:
+  - {name: crank, mass_kg: 0.5, com_m: [0.05, 0], inertia_kgm2: 4.0e-4, points: {B: [0.1, 0]}}
+  - {name: coupler, mass_kg: 1.2, com_m: [0.15, 0], inertia_kgm2: 9.0e-3, points: {C: [0.3, 0], E: [0.15, 0]}}
+  - {name: rocker, mass_kg: 0.7, com_m: [0.05, 0], inertia_kgm2: 6.0e-4, points: {C: [0.1, 0]}}
+  - {name: link3, mass_kg: 0.3, com_m: [0.05, 0], inertia_kgm2: 3.0e-4, points: {E: [0.1, 0]}}
+  - {name: pendulum, mass_kg: 0.2, com_m: [0.05, 0], inertia_kgm2: 1.0e-4}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank, guess_deg: 40}
+  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler, guess_deg: -40}
+  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 40}
+  - {name: link3, type: revolute, parent: ground, parent_point: E, child: link3, guess_deg: 40}
+  - {name: pendulum, type: revolute, parent: ground, parent_point: P, child: pendulum, guess_deg: -90}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+  - {name: E, body_a: coupler, point_a: E, body_b: link3, point_b: E}
+independent: crank
+initial: {q_deg: 40, qdot: 1.0}
+)";
+}
+
+TEST(FullModelDof, TwoDegreesOfFreedomThatGrueblerCountsAsOneAreRefused) {
+  const auto scene = models::parse_scene(third_link_and_pendulum_yaml(), "p3.yaml");  // passes the count
+  const std::string m = refusal(scene);
+  EXPECT_TRUE(has(m, "p3.yaml")) << m;
+  EXPECT_TRUE(has(m, "2 degrees of freedom")) << m;
+  EXPECT_TRUE(has(m, "5 joint coordinates, 3 of them fixed by the 4")) << m;
+  // Rows are dropped from the last constraint backwards: loop E gives up its repeated row.
+  EXPECT_TRUE(has(m, "loop 'E' (1 row)")) << m;
+  EXPECT_FALSE(has(m, "loop 'C'")) << m;
+}
+
+TEST(FullModelDof, RedundantThirdLinkIsNamed) {
+  auto scene = models::parse_scene(third_link_and_pendulum_yaml(), "p3.yaml");
+  scene.joints.pop_back();  // without the pendulum: one DOF, but a redundant row
+  scene.bodies.pop_back();
+  const std::string m = refusal(scene);
+  EXPECT_TRUE(has(m, "redundant constraints: loop 'E' (1 row)")) << m;
+  EXPECT_TRUE(has(m, "rank 3 of 4 rows")) << m;
+}
+
+TEST(FullModelDof, RepeatedLoopClosureIsNamed) {
+  auto scene = models::parse_scene(test::parallelogram_yaml(0.0, false), "twice.yaml");
+  auto again = scene.loops.at(0);
+  again.name = "C_again";
+  scene.loops.push_back(again);  // both rows repeat loop C's
+  const std::string m = refusal(scene);
+  EXPECT_TRUE(has(m, "twice.yaml")) << m;
+  EXPECT_TRUE(has(m, "loop 'C_again' (2 rows)")) << m;
+  EXPECT_TRUE(has(m, "rank 2 of 4 rows")) << m;
+}
+
+TEST(FullModelDof, OpenChainIsRefusedWithItsDegreesOfFreedom) {
+  auto scene = models::parse_scene(test::parallelogram_yaml(0.0, false), "open.yaml");
+  scene.loops.clear();  // crank + coupler and rocker: three free joints
+  const std::string m = refusal(scene);
+  EXPECT_TRUE(has(m, "3 degrees of freedom")) << m;
+  EXPECT_FALSE(has(m, "redundant")) << m;
+}
+
+TEST(FullModelDof, IndependentCoordinateFixedByTheLoopsIsRefused) {
+  // A triangle O-B-D closed on ground (rigid) next to a free pendulum: one DOF (the
+  // pendulum), but the independent coordinate is the triangle's locked side.
+  const auto scene = models::parse_scene(R"(
+name: locked
+ground_points: {O: [0, 0], D: [0.1, 0], P: [0.5, 0]}
+bodies:
+  - {name: a, mass_kg: 0.3, com_m: [0.05, 0], inertia_kgm2: 3.0e-4, points: {B: [0.1, 0]}}
+  - {name: b, mass_kg: 0.3, com_m: [0.07, 0], inertia_kgm2: 5.0e-4, points: {E: [0.14142135623730950, 0]}}
+  - {name: pendulum, mass_kg: 0.2, com_m: [0.05, 0], inertia_kgm2: 1.0e-4}
+joints:
+  - {name: a, type: revolute, parent: ground, parent_point: O, child: a, guess_deg: 90}
+  - {name: b, type: revolute, parent: a, parent_point: B, child: b, guess_deg: -135}
+  - {name: pendulum, type: revolute, parent: ground, parent_point: P, child: pendulum, guess_deg: -90}
+loops:
+  - {name: T, body_a: b, point_a: E, body_b: ground, point_b: D}
+independent: a
+initial: {q_deg: 90, qdot: 0}
+)",
+                                         "locked.yaml");
+  const std::string m = refusal(scene);
+  EXPECT_TRUE(has(m, "independent coordinate 'a' cannot move")) << m;
+}
+
+TEST(FullModelDof, SingularInitialConfigurationIsNotMistakenForRedundancy) {
+  // At q = 0 the parallelogram is aligned: C's velocity from every joint is vertical and the
+  // loop Jacobian has rank 1 there only; 0.01 rad away it has rank 2.
+  std::string y = test::parallelogram_yaml(0.0, false);
+  y.replace(y.find("initial: {q_deg: 40"), 19, "initial: {q_deg: 0");
+  const auto scene = models::parse_scene(y, "aligned.yaml");
+  EXPECT_EQ(refusal(scene), "");
+}
+
+TEST(FullModelDof, EveryShippedSceneIsAccepted) {
+  int n = 0;
+  for (const char* dir : {RDYN_SCENES, RDYN_SCENES "/hard"})
+    for (const auto& f : std::filesystem::directory_iterator(dir)) {
+      if (f.path().extension() != ".yaml") continue;
+      const auto scene = models::load_scene(f.path().string());
+      FullModelOptions reaction;
+      reaction.route = ConstraintForceRoute::Reaction;
+      EXPECT_EQ(refusal(scene), "") << f.path();
+      try {
+        FullModel model(scene, reaction);
+        FullWorkspace ws(model);
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << f.path() << ": " << e.what();
+      }
+      ++n;
+    }
+  EXPECT_GE(n, 11);  // 3 scenes + 8 hard ones shipped
+}
+
+// The bicycle's right knee with three requests: along the shank (the shipped one), across it
+// (+90°) and at +45°.
+models::Scene bicycle_with_knee_components() {
+  auto scene = models::load_scene("bicycle");
+  const auto along = scene.outputs.constraint_forces.at(0);
+  auto across = along, diag = along;
+  across.name = "knee_across";
+  across.direction = {-along.direction.y, along.direction.x};
+  diag.name = "knee_diag";
+  diag.direction = {(along.direction.x - along.direction.y) / std::sqrt(2.0),
+                    (along.direction.y + along.direction.x) / std::sqrt(2.0)};
+  scene.outputs.constraint_forces.push_back(across);
+  scene.outputs.constraint_forces.push_back(diag);
+  return scene;
+}
+
+TEST(FullModelConstraintForces, SeveralDirectionsOnOneJointAgreeWithSimbodyReactions) {
+  const auto scene = bicycle_with_knee_components();
+  FullModelOptions reaction;
+  reaction.route = ConstraintForceRoute::Reaction;
+  FullModel act(scene), rea(scene, reaction);
+  FullWorkspace wa(act), wr(rea);
+  double peak = 0;
+  for (int deg = 0; deg < 360; deg += 30) {
+    const double q = deg * kPi / 180.0;
+    const auto fa = calc_kinetostatic(act, wa, q, 6.3, -2.0, Loads::All).constraint_forces;
+    const auto fr = calc_kinetostatic(rea, wr, q, 6.3, -2.0, Loads::All).constraint_forces;
+    ASSERT_EQ(fa.size(), 3u);
+    const double scale = std::max(1.0, std::hypot(fr[0], fr[1]));
+    // (i) the slider chain's multipliers against Simbody's mobilizer reaction, per direction.
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(fa[k], fr[k], 1e-9 * scale) << deg << " component " << k;
+    // (ii) geometry: projections on d, d⊥ and (d + d⊥)/√2 of one force.
+    EXPECT_NEAR(fa[2], (fa[0] + fa[1]) / std::sqrt(2.0), 1e-9 * scale) << deg;
+    // (iii) the resultant of along and across is the in-plane magnitude of Simbody's joint
+    //       reaction (the Reaction route projects that one vector on two orthonormal d).
+    EXPECT_NEAR(std::hypot(fa[0], fa[1]), std::hypot(fr[0], fr[1]), 1e-9 * scale) << deg;
+    peak = std::max(peak, std::abs(fa[1]));
+  }
+  EXPECT_GT(peak, 10.0);  // the across component is not zero: (ii) and (iii) test something
+}
+
+TEST(FullModelConstraintForces, RequestOnAPrismaticJointIsAnEngineErrorNotAnAbort) {
+  // check_scene refuses it with a line number; a scene built in code must not reach Simbody.
+  auto scene = models::load_scene("slider-crank");
+  for (const auto& j : scene.joints)
+    if (j.type == models::JointType::Prismatic)
+      scene.outputs.constraint_forces.push_back({"on_slider", j.name, {1.0, 0.0}});
+  const std::string m = [&] {
+    try {
+      FullModel model(scene);
+    } catch (const EngineError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_TRUE(has(m, "constraint force 'on_slider'")) << m;
+}
+
+}  // namespace
+}  // namespace rdyn::engine
