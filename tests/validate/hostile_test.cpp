@@ -466,8 +466,45 @@ void tables(std::vector<Case>& cs) {
                 }, "o"});
 }
 
+// Ground truth that would be silently wrong: a mechanism that is not one DOF although the
+// joint count says so, an integration that loses its energy, several forces on one joint.
+void ground_truth(std::vector<Case>& cs) {
+  const std::string fb = scene_text("fourbar");
+  // A free two-link pendulum (+2 coordinates) and the loop closure given twice (2 redundant
+  // rows): joints − 2·loops = 5 − 4 = 1 by count, but 3 degrees of freedom by rank.
+  std::string three_dof = edit(fb, "loops:\n", "loops:\n  - {name: C2, body_a: coupler, point_a: C, body_b: rocker, point_b: C}\n");
+  three_dof = edit(three_dof, "joints:\n",
+                   "joints:\n  - {name: p1, type: revolute, parent: ground, parent_point: A, child: p1, guess_deg: -90}\n"
+                   "  - {name: p2, type: revolute, parent: p1, parent_point: E, child: p2, guess_deg: 0}\n");
+  three_dof = edit(three_dof, "bodies:\n",
+                   "bodies:\n  - {name: p1, mass_kg: 0.1, com_m: [0.05, 0], inertia_kgm2: 1.0e-4, points: {E: [0.1, 0]}}\n"
+                   "  - {name: p2, mass_kg: 0.1, com_m: [0.05, 0], inertia_kgm2: 1.0e-4}\n");
+  for (const std::string cmd : {"simulate", "extract"}) {
+    std::vector<std::string> args{cmd, "s.yaml", "--out", cmd == "simulate" ? "o" : "t.csv"};
+    cs.push_back({cmd + "_not_one_dof_by_rank", args, 2, "degrees of freedom", {{"s.yaml", three_dof}}, nullptr,
+                  args.back()});
+  }
+  // Simbody's Runge–Kutta–Merson at 1e-6 loses the parallelogram's energy through its aligned
+  // positions (5.9 of 5.9 J): a numerical failure, not a time series.
+  const std::string pg = (fs::path(RDYN_SCENES) / "hard/parallelogram.yaml").string();
+  cs.push_back({"energy_lost_through_singular_positions", {"simulate", pg, "--tolerance", "1e-6", "--out", "o"}, 1,
+                "energy balance does not close", {}, nullptr, "o"});
+  // The knee along and across the shank: two constraint forces on one joint, both models.
+  const std::string two = edit(scene_text("bicycle"), "    - {name: knee, joint: knee_r, direction: ankle}\n",
+                               "    - {name: knee, joint: knee_r, direction: ankle}\n"
+                               "    - {name: knee_across, joint: knee_r, direction: [1, 0]}\n");
+  for (const std::string model : {"full", "reduced"})
+    cs.push_back({"two_forces_on_one_joint_" + model,
+                  {"simulate", "s.yaml", "--model", model, "--duration", "0.3", "--out", "o"}, 0, "",
+                  {{"s.yaml", two}}, nullptr, "", {}, [](const fs::path& d, const RdynRun&) {
+                    const std::string csv = slurp(d / "o/timeseries.csv");
+                    EXPECT_NE(csv.find(",F_knee,F_knee_across\n"), std::string::npos) << csv.substr(0, 200);
+                  }});
+}
+
 std::vector<Case> all_cases() {
   std::vector<Case> cs;
+  ground_truth(cs);
   bad_numbers(cs);
   outputs(cs);
   scenes(cs);
