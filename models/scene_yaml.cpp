@@ -529,7 +529,8 @@ Scene parse_scene(const std::string& text, const std::string& file,
     }
     if (top.has("validation")) {
       Fields f(top.raw("validation"), "validation", file,
-               {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance", "reference_integrator"});
+               {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance", "reference_integrator",
+                "compare"});
       s.validation.duration_s = f.num_or("duration_s", 0.0);
       s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
       if (!(s.validation.reference_tolerance > 0 && s.validation.reference_tolerance < 1e-3))
@@ -558,6 +559,15 @@ Scene parse_scene(const std::string& text, const std::string& file,
         if (!(s.validation.calibrate_cadence_Hz > 0) || !(s.validation.calibrate_power_W > 0))
           c.fail("cadence_Hz", "cadence and power must be positive");
       }
+      for_each_item(f, "compare", [&](const YAML::Node& n, const std::string& path) {
+        Fields c(n, path, file, {"quantity", "value", "unit", "source", "explanation"});
+        CompareValue cv{c.str("quantity"), c.num("value"), c.str_or("unit", ""), c.str_or("source", ""),
+                        c.str_or("explanation", "")};
+        if (std::find(kCompareQuantities.begin(), kCompareQuantities.end(), cv.quantity) == kCompareQuantities.end())
+          c.fail("quantity", "expected drive_torque_Nm, peak_force_N, speed_fluctuation or mean_power_W");
+        if (!f.has("calibrate")) c.fail("quantity", "compared values are calibration results: add validation.calibrate");
+        s.validation.compare.push_back(cv);
+      });
     }
   } catch (const YAML::Exception& e) {
     throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", e.msg);

@@ -20,6 +20,7 @@
 #include "validate/escape.hpp"
 #include "validate/harness.hpp"
 #include "validate/report.hpp"
+#include "validate/summary.hpp"
 #include "validate/sweep.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
@@ -236,23 +237,47 @@ namespace {
 nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
                             Progress& progress, bool& pass) {
   const ValidationResult v = run_validation(scene, opt, progress);
-  write_validation_report(v, dir);
+  const nlohmann::json full = summary_json(v);
+  render_report(full, dir);
   pass = v.pass;
   nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
                       {"note", v.note}};
-  const nlohmann::json full = summary_json(v);
   for (const char* k : {"speedup_at_matched_error", "extraction_ms", "thresholds", "reference", "steady_window",
-                        "headline", "matched_full", "matched_reduced"})
+                        "headline", "matched_full", "matched_reduced", "recommended_reduced", "verdicts", "baselines",
+                        "duration_s", "per_second_measured"})
     if (full.contains(k)) j[k] = full[k];
-  if (v.showcase_run >= 0) {
-    nlohmann::json sc = full["runs"][v.showcase_run];
-    j["reduced_10deg"] = sc;
-  }
+  j["headline"] = headline(full);
+  if (v.showcase_run >= 0) j["reduced_10deg"] = full["runs"][v.showcase_run];
   // Stability metrics of both models: the reference's and the default reduced run's energy
   // balance, drift per cycle, constraint violation, accepted/rejected steps, smallest step.
   j["stability"] = {{"full", full["reference"]["stability"]},
                     {"reduced", v.showcase_run >= 0 ? full["runs"][v.showcase_run] : nlohmann::json(nullptr)}};
   return j;
+}
+
+// One row of the suite index: the scene's verdicts in one cell each.
+std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
+  const std::string status = entry.value("status", std::string("error"));
+  std::string verdicts;
+  if (entry.contains("verdicts"))
+    for (const auto& v : entry["verdicts"]) {
+      const double e = v["judged_error"].is_number() ? v["judged_error"].get<double>() : NAN;
+      const double l = v["limit"].is_number() ? v["limit"].get<double>() : NAN;
+      const bool p = v.value("pass", false);
+      verdicts += fmt::format("<span class={}>{} {} ≤ {} {}</span><br>", p ? "pass" : "fail",
+                              html_escape(v.value("quantity", std::string())),
+                              std::isfinite(e) ? fmt::format("{:.3g} %", 100 * e) : "n/a", fmt::format("{:.3g} %", 100 * l),
+                              p ? "pass" : "FAIL");
+    }
+  std::string speed = "—";
+  if (entry.contains("baselines"))
+    for (const auto& b : entry["baselines"])
+      if (b.value("what", std::string()) == "matched-error full run" && b["speedup"].is_number())
+        speed = fmt::format("{:.3g}×", b["speedup"].get<double>());
+  const std::string what = entry.contains("error") ? entry.value("error", std::string()) : entry.value("note", std::string());
+  return fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td>"
+                     "<td>{3}</td><td class=l>{4}</td></tr>",
+                     html_escape(stem), html_escape(status), verdicts, html_escape(speed), html_escape(what));
 }
 
 }  // namespace
@@ -359,10 +384,7 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
       all_pass = false;
     }
     entry["report"] = stem + "/report.html";
-    const std::string status = entry["status"];
-    const std::string what = entry.contains("error") ? std::string(entry["error"]) : std::string(entry.value("note", ""));
-    rows += fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td></tr>",
-                        html_escape(stem), html_escape(status), html_escape(what));
+    rows += suite_row(stem, entry);
     scenes.push_back(entry);
   }
   write_json(out.file("summary.json"),
@@ -371,8 +393,9 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
                   "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:"
                   "sans-serif;max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{"
                   "border-collapse:collapse}.pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn "
-                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th><th>what "
-                  "it tests / error</th></tr>" + rows + "</table></body></html>\n");
+                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th>"
+                  "<th>verdicts (error, limit)</th><th>speed vs matched full run</th><th>what it tests / error</th></tr>" +
+                  rows + "</table></body></html>\n");
   out.commit();
   std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(),
                all_pass ? "all scenes pass" : "FAILURES", a.out.c_str());
@@ -392,9 +415,10 @@ int run_validate(const ValidateArgs& a) {
   ValidationOptions opt;
   opt.quick = a.quick;
   const ValidationResult v = run_validation(scene, opt, progress);
-  write_validation_report(v, out.file(""));
+  const nlohmann::json summary = summary_json(v);
+  render_report(summary, out.file(""));
   out.commit();
-  std::printf("%s\n\nReport: %s/report.html\n", headline(v).c_str(), a.out.c_str());
+  std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
   if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
   return v.pass ? 0 : 1;
 }

@@ -12,6 +12,9 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/pareto.hpp"
+#include "validate/thresholds.hpp"
+#include "validate/timing.hpp"
 
 namespace rdyn::validate {
 
@@ -24,12 +27,6 @@ using Clock = std::chrono::steady_clock;
 constexpr long kMinComparedSamples = 20;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 void fill_stats(RunRecord& r, const models::TimeSeries& ts) {
   r.cycles = std::abs(ts.q.back() - ts.q.front()) / (2 * M_PI);
@@ -80,13 +77,12 @@ std::string machine_description() {
                      os.empty() ? "" : ", " + os);
 }
 
-// Quantity whose error decides the match: the first constraint force (e.g. the knee).
-double error_of(const RunRecord& r, const std::string& q) {
-  const SignalError* s = r.errors.find(q);
-  return s ? s->max_rel : INFINITY;
-}
-
 }  // namespace
+
+double RunRecord::error_of(const std::string& q) const {
+  const SignalError* s = errors.find(q);
+  return s && std::isfinite(s->max_rel) ? s->max_rel : INFINITY;
+}
 
 std::string RunRecord::label() const {
   if (model == "full") return fmt::format("full {} tol {:.0e}", integrator, tolerance);
@@ -100,29 +96,34 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   v.scene = scene.name;
   v.scene_file = scene.source_file;
   v.note = scene.validation.note;
+  v.compare = scene.validation.compare;
   v.machine = machine_description();
   v.duration_s = scene.validation.duration_s > 0 ? scene.validation.duration_s : scene.simulation.duration_s;
   v.output_interval_s = scene.simulation.output_interval_s;
   v.headline_quantity = scene.outputs.constraint_forces.empty() ? "qdot" : scene.outputs.constraint_forces[0].name;
+  v.quantities = {"qdot"};
+  for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);
+  v.quantities.push_back("mean_qdot");
   const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
 
   // 1. Reference: full model at a tight tolerance, and the change when it is halved.
   v.reference_tolerance = scene.validation.reference_tolerance;
   engine::FullModel full(scene);
-  auto full_run = [&](double tol) {
+  auto full_run = [&](const std::string& integrator, double tol) {
     engine::ForwardOptions fo;
     fo.duration_s = v.duration_s;
     fo.output_interval_s = v.output_interval_s;
     fo.tolerance = tol;
-    fo.integrator = scene.validation.reference_integrator;
+    fo.integrator = integrator;
     return engine::simulate_full(full, fo);
   };
+  const std::string ref_integrator = scene.validation.reference_integrator;
   progress.count(scene.name + ": reference (full model)", 0, 2);
   const auto t_ref = Clock::now();
-  v.reference = full_run(v.reference_tolerance);
+  v.reference = full_run(ref_integrator, v.reference_tolerance);
   v.reference_wall_s = seconds_since(t_ref);
   v.reference_run.model = "full";
-  v.reference_run.integrator = scene.validation.reference_integrator;
+  v.reference_run.integrator = ref_integrator;
   v.reference_run.tolerance = v.reference_tolerance;
   v.reference_run.wall_s = v.reference_wall_s;
   v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
@@ -130,7 +131,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   fill_stats(v.reference_run, v.reference);
   v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
   progress.count(scene.name + ": reference (full model)", 1, 2);
-  const auto half = full_run(v.reference_tolerance / 2);
+  const auto half = full_run(ref_integrator, v.reference_tolerance / 2);
   progress.count(scene.name + ": reference (full model)", 2, 2);
   v.window = detect_steady_window(v.reference, rotating);
   v.reference_change = compare_series(v.reference, half, v.window.t_start);
@@ -139,6 +140,9 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
                        "lengthen validation.duration_s or shorten simulation.output_interval_s",
                        v.reference_change.samples, v.window.how, kMinComparedSamples));
+  // The scene's time scale sets the fixed steps of the ladder (issue #14).
+  v.time_scale = calc_time_scale(v.reference, rotating);
+  v.fixed_steps = calc_fixed_step_ladder(v.time_scale, opt.quick);
 
   // 2. Full-model tolerance ladder.
   // Simbody's Runge–Kutta–Merson over the whole ladder; RK3 and CPodes at loose tolerances,
@@ -151,28 +155,17 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     for (double t : {1e-4, 1e-6}) full_runs.push_back({"rk3", t});
     for (double t : {1e-4, 1e-6}) full_runs.push_back({"cpodes", t});
   }
-  const int full_repeats = opt.quick ? 1 : 3;
-  auto full_run_with = [&](const std::string& integrator, double tol) {
-    engine::ForwardOptions fo;
-    fo.duration_s = v.duration_s;
-    fo.output_interval_s = v.output_interval_s;
-    fo.tolerance = tol;
-    fo.integrator = integrator;
-    return engine::simulate_full(full, fo);
-  };
+  // Timings: median of repeats until a minimum wall time, so short runs are not timed once.
+  const RepeatPolicy full_repeats{opt.quick ? 1 : 3, 50, opt.quick ? 0.0 : 0.3};
+  const RepeatPolicy red_repeats{opt.quick ? 1 : 3, 200, opt.quick ? 0.02 : 0.1};
   for (size_t i = 0; i < full_runs.size(); ++i) {
     progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(i), static_cast<long>(full_runs.size()));
     RunRecord r;
     r.model = "full";
     r.integrator = full_runs[i].first;
     r.tolerance = full_runs[i].second;
-    std::vector<double> walls;
     models::TimeSeries ts;
-    for (int k = 0; k < full_repeats; ++k) {
-      const auto t0 = Clock::now();
-      ts = full_run_with(r.integrator, r.tolerance);
-      walls.push_back(seconds_since(t0));
-    }
+    const auto walls = time_repeats([&] { ts = full_run(r.integrator, r.tolerance); }, full_repeats);
     finish_run(r, walls, ts, v);
     v.runs.push_back(r);
   }
@@ -192,11 +185,21 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
                 : std::vector<Variant>{{"cubic", false}, {"akima", false},  {"linear", false},
                                        {"fourier", false}, {"cubic", true}, {"fourier", true}};
   const std::vector<double> red_tols = opt.quick ? std::vector<double>{1e-8} : std::vector<double>{1e-6, 1e-8, 1e-10};
-  const int red_repeats = opt.quick ? 3 : 5;
+  v.tightest_tolerance = red_tols.back();
   long done = 0;
-  const long total = static_cast<long>(grids.size() * variants.size() * (red_tols.size() + (opt.quick ? 1 : 6)));
+  const long total =
+      static_cast<long>(grids.size() * variants.size() * (red_tols.size() + (opt.quick ? 0 : 1) + v.fixed_steps.size()));
+  auto reduced_options = [&](const std::string& integrator, double tol, double h) {
+    reduced::ReducedOptions ro;
+    ro.duration_s = v.duration_s;
+    ro.output_interval_s = v.output_interval_s;
+    ro.tolerance = tol;
+    ro.integrator = integrator;
+    ro.fixed_step_s = h;
+    return ro;
+  };
   for (double grid : grids) {
-    // Extraction cost: median of three for the paper's 10° grid (amortised in the report).
+    // Extraction cost: median of three for the 10° grid (amortised in the report).
     Extraction e;
     std::vector<double> ms;
     for (int k = 0; k < (grid == 10 && !opt.quick ? 3 : 1); ++k) {
@@ -220,26 +223,16 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
         r.integrator = integrator;
         r.tolerance = tol;
         r.fixed_step_s = h;
-        reduced::ReducedOptions ro;
-        ro.duration_s = v.duration_s;
-        ro.output_interval_s = v.output_interval_s;
-        ro.tolerance = tol;
-        ro.integrator = integrator;
-        ro.fixed_step_s = h;
-        std::vector<double> walls;
+        const auto ro = reduced_options(integrator, tol, h);
         models::TimeSeries ts;
+        std::vector<double> walls;
         try {
-          for (int k = 0; k < red_repeats; ++k) {
-            const auto t0 = Clock::now();
-            ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
-            walls.push_back(seconds_since(t0));
-          }
+          walls = time_repeats([&] { ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro); },
+                               red_repeats);
         } catch (const reduced::TableError& e) {
           // A run that stops (divergence, validity domain) is recorded as failed, with its reason.
           r.failure = e.what();
-          r.errors.signals.push_back({"qdot", 0.0, INFINITY, INFINITY});
-          for (const auto& c : scene.outputs.constraint_forces) r.errors.signals.push_back({c.name, 0.0, INFINITY, INFINITY});
-          r.errors.signals.push_back({"mean_qdot", 0.0, INFINITY, INFINITY});
+          for (const auto& q : v.quantities) r.errors.signals.push_back({q, 0.0, INFINITY, INFINITY});
           r.repeats = 0;
           r.wall_s = r.per_simulated_s = INFINITY;
           v.runs.push_back(r);
@@ -247,7 +240,8 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
         }
         finish_run(r, walls, ts, v);
         v.runs.push_back(r);
-        if (grid == 10 && var.interp == "fourier" && !var.ec && integrator == "rk8pd" && tol == red_tols.back()) {
+        if (grid == 10 && var.interp == kDefaultInterpolation && !var.ec && integrator == "rk8pd" &&
+            tol == red_tols.back()) {
           v.showcase = ts;
           v.showcase_run = static_cast<int>(v.runs.size()) - 1;
         }
@@ -255,8 +249,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       for (double tol : red_tols) add_run("rk8pd", tol, 0.0);
       if (!opt.quick) add_run("rkck", 1e-8, 0.0);
       // Fixed-step RK4, the real-time stepper (outputs by dense interpolation).
-      for (double h : opt.quick ? std::vector<double>{5e-3} : std::vector<double>{1e-3, 5e-3, 1e-2, 2e-2, 4e-2})
-        add_run("rk4-fixed", 0.0, h);
+      for (double h : v.fixed_steps) add_run("rk4-fixed", 0.0, h);
     }
   }
   progress.count(scene.name + ": reduced ladder", total, total);
@@ -280,72 +273,56 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     }
   }
 
-  // 4. Pareto front (error of the headline quantity vs time) and the matched-error speedup:
-  //    the cheapest full run within the target, then the cheapest reduced run at equal or
-  //    better error.
-  for (auto& r : v.runs) {
-    r.pareto = true;
-    for (const auto& o : v.runs)
-      if (o.model == r.model && &o != &r && o.per_simulated_s <= r.per_simulated_s &&
-          error_of(o, v.headline_quantity) <= error_of(r, v.headline_quantity) &&
-          (o.per_simulated_s < r.per_simulated_s || error_of(o, v.headline_quantity) < error_of(r, v.headline_quantity)))
-        r.pareto = false;
-  }
-  for (size_t i = 0; i < v.runs.size(); ++i) {
-    const auto& r = v.runs[i];
-    if (r.model != "full" || error_of(r, v.headline_quantity) > v.matched_target) continue;
-    if (v.matched_full < 0 || r.per_simulated_s < v.runs[v.matched_full].per_simulated_s) v.matched_full = static_cast<int>(i);
-  }
-  if (v.matched_full >= 0) {
-    const double e_full = error_of(v.runs[v.matched_full], v.headline_quantity);
-    for (size_t i = 0; i < v.runs.size(); ++i) {
-      const auto& r = v.runs[i];
-      if (r.model != "reduced" || error_of(r, v.headline_quantity) > e_full) continue;
-      if (v.matched_reduced < 0 || r.per_simulated_s < v.runs[v.matched_reduced].per_simulated_s)
-        v.matched_reduced = static_cast<int>(i);
-    }
-    if (v.matched_reduced >= 0 && v.reference_change.samples >= kMinComparedSamples)
-      v.speedup_at_matched_error = v.runs[v.matched_full].per_simulated_s / v.runs[v.matched_reduced].per_simulated_s;
-  }
+  // 4. Pareto front, matched-error speedup, recommended setting (validate/pareto.hpp).
+  mark_pareto(v.runs, v.headline_quantity);
+  const auto matched = calc_matched_speedup(v.runs, v.headline_quantity, v.matched_target);
+  v.matched_full = matched.full;
+  v.matched_reduced = matched.reduced;
+  if (v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
+  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
+  const SignalError* ref_floor = v.reference_change.find(v.headline_quantity);
+  v.convergence_floor = 10 * std::max(1e-12, ref_floor ? ref_floor->max_rel : 0.0);
+  v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
 
   // 5. Calibration (scenes that declare an operating point).
   if (scene.validation.calibrate_cadence_Hz > 0) {
     v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
     v.calibration_options.power_w = scene.validation.calibrate_power_W;
-    progress.note(scene.name + ": calibrating the drive torque");
+    progress.note(scene.name + ": calibrating the drive load");
     v.calibration = calibrate(scene, v.calibration_options, progress);
   }
 
-  // 6. Acceptance thresholds: the reduced run at that grid and interpolation (default
-  //    fourier), rk8pd at the tightest tolerance.
+  // 6. Acceptance thresholds (validate/thresholds.hpp); a grid outside the ladder is run now.
   for (const auto& th : scene.validation.thresholds) {
-    ThresholdResult tr{th, INFINITY, false, "no matching run"};
-    const std::string interp = th.interpolation.empty() ? "fourier" : th.interpolation;
-    for (const auto& r : v.runs)
-      if (r.model == "reduced" && std::abs(r.grid_deg - th.grid_deg) < 1e-9 && r.interpolation == interp &&
-          !r.energy_consistent && r.integrator == "rk8pd" && r.tolerance == red_tols.back()) {
-        tr.error = error_of(r, th.quantity);
-        tr.run = r.label();
-      }
-    if (tr.run == "no matching run" && std::find(grids.begin(), grids.end(), th.grid_deg) == grids.end()) {
-      // A grid outside the ladder: run it now.
+    auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
+    if (!tr) {
+      const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
       const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic);
       const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
-      reduced::ReducedOptions ro;
-      ro.duration_s = v.duration_s;
-      ro.output_interval_s = v.output_interval_s;
-      ro.tolerance = red_tols.back();
-      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
       RunRecord r;
+      r.model = "reduced";
+      r.grid_deg = th.grid_deg;
+      r.interpolation = interp;
+      r.integrator = "rk8pd";
+      r.tolerance = v.tightest_tolerance;
+      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot,
+                                                reduced_options("rk8pd", v.tightest_tolerance, 0.0));
       r.errors = compare_series(v.reference, ts, v.window.t_start);
-      tr.error = error_of(r, th.quantity);
-      tr.run = fmt::format("reduced {:g}° {} rk8pd tol {:.0e}", th.grid_deg, interp, red_tols.back());
+      tr = judge_threshold_on(th, r);
     }
-    tr.pass = tr.error <= th.max_error;
-    if (!tr.pass)
-      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr.error,
-                         th.max_error, tr.run));
-    v.thresholds.push_back(tr);
+    if (!tr->pass)
+      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr->error,
+                         th.max_error, tr->run));
+    v.thresholds.push_back(*tr);
+  }
+
+  // 7. The first screen: verdicts, baselines and the error budget at the recommended setting.
+  const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
+  v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
+  if (rec) {
+    v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
+    v.budget = calc_error_budget(*rec, v.runs, ref_floor ? ref_floor->max_rel : NAN, v.headline_quantity,
+                                 v.tightest_tolerance);
   }
   return v;
 }
