@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "models/scene_yaml.hpp"
 #include "tests/validate/validation_fixture.hpp"
 
 namespace rdyn::validate {
@@ -54,6 +55,31 @@ TEST(Summary, CalibrationUnderNeutralNamesWithTheScenesComparison) {
   EXPECT_DOUBLE_EQ(cal["compare"][0]["value"].get<double>(), 69.7);
   EXPECT_DOUBLE_EQ(cal["compare"][0]["rdyn_value"].get<double>(), 60.0);
   EXPECT_FALSE(cal.contains("hip_torque_Nm"));
+}
+
+// The comparison lives in the scene (validation.compare), read with file, line and field.
+TEST(Summary, SceneDeclaresItsComparison) {
+  const auto bicycle = models::load_scene("bicycle");
+  ASSERT_EQ(bicycle.validation.compare.size(), 1u);
+  EXPECT_EQ(bicycle.validation.compare[0].quantity, "drive_torque_Nm");
+  EXPECT_DOUBLE_EQ(bicycle.validation.compare[0].value, 69.7);
+  EXPECT_FALSE(bicycle.validation.compare[0].explanation.empty());
+  EXPECT_TRUE(models::load_scene("fourbar").validation.compare.empty());
+  const std::string base = "name: x\nbicycle_leg: {}\nvalidation:\n";
+  try {
+    models::parse_scene(base + "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: torque, value: 1}]\n",
+                        "x.yaml");
+    FAIL() << "an unknown quantity was accepted";
+  } catch (const models::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("validation.compare[0].quantity"), std::string::npos) << e.what();
+  }
+  // Compared values are calibration results: without calibrate there is nothing to compare.
+  EXPECT_THROW(models::parse_scene(base + "  compare: [{quantity: drive_torque_Nm, value: 1}]\n", "x.yaml"),
+               models::SceneError);
+  EXPECT_THROW(models::parse_scene(base + "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: "
+                                          "drive_torque_Nm, value: .nan}]\n",
+                                   "x.yaml"),
+               models::SceneError);
 }
 
 }  // namespace
