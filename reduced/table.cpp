@@ -123,7 +123,10 @@ int Table::column(const std::string& name) const {
 Table build_table(const Samples& samples, Interpolation interp, bool energy_consistent_m2) {
   if (interp == Interpolation::Fourier) {
     if (!samples.periodic) throw TableError("fourier interpolation needs a periodic table");
-    const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 180.0) - 1e-9)));
+    // Resampled at ≤ 0.25°: the cubic table's own error (∝ h⁴) then sits ~1e-11 of a
+    // parameter's size, below the full-model reference's accuracy; at 1° it was a floor of
+    // ~1.5e-9 that every grid from 10° to 1° hit (issue #14, measured on exp(sin q)).
+    const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 720.0) - 1e-9)));
     return build_table(fourier_resample(samples, refine), Interpolation::CubicSpline, energy_consistent_m2);
   }
   const Samples& s = samples;
