@@ -264,6 +264,7 @@ std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
       const double e = v["judged_error"].is_number() ? v["judged_error"].get<double>() : NAN;
       const double l = v["limit"].is_number() ? v["limit"].get<double>() : NAN;
       const bool p = v.value("pass", false);
+      if (!v.value("decides", false)) continue;  // the scene's thresholds only (validate/verdicts.hpp)
       verdicts += fmt::format("<span class={}>{} {} ≤ {} {}</span><br>", p ? "pass" : "fail",
                               html_escape(v.value("quantity", std::string())),
                               std::isfinite(e) ? fmt::format("{:.3g} %", 100 * e) : "n/a", fmt::format("{:.3g} %", 100 * l),

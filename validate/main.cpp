@@ -99,10 +99,12 @@ int main(int argc, char** argv) {
   auto* validate = app.add_subcommand(
       "validate",
       "Validate the reduced model against full forward dynamics: a converged reference, a ladder of full-model "
-      "tolerances and of reduced models (grid × interpolation × integrator), errors over the steady cycles, median "
-      "timings, the matched-error speedup, calibration when the scene declares an operating point. Writes "
-      "DIR/summary.json, the CSVs and gnuplot scripts behind every figure, and DIR/report.html. With --suite, "
-      "every scene of a folder (exit status 1 if any fails its thresholds).");
+      "tolerances and of reduced models (grid × interpolation × integrator; fixed steps from the scene's time "
+      "scale), errors over the steady cycles (the whole run when it has none), median timings of repeats up to a "
+      "minimum wall time, the matched-error speedup, calibration when the scene declares an operating point. Writes "
+      "DIR/summary.json (every number and the data of every figure), the CSVs and gnuplot scripts behind every "
+      "figure, and DIR/report.html (rendered from summary.json; verdicts first). With --suite, every scene of a "
+      "folder and an index with their verdicts (exit status 1 if any fails its thresholds).");
   validate->add_option("scene", val.scene, "Scene name or YAML file");
   validate->add_option("--suite", val.suite, "Folder of scenes to validate (each may declare thresholds)");
   validate->add_option("--out", val.out, "Output folder (written atomically)")->required();

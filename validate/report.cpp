@@ -243,10 +243,13 @@ std::string verdict_table(const json& s) {
   h += "<table><tr><th>quantity</th><th>error at the recommended setting</th><th>limit</th><th>judged on</th>"
        "<th>error there</th><th></th></tr>";
   for (const auto& v : s["verdicts"]) {
-    const bool pass = v.value("pass", false);
-    h += fmt::format("<tr><td class=l>{}</td><td>{}</td><td>{}</td><td class=l>{}</td><td>{}</td><td class={}>{}</td></tr>",
-                     H(str(v, "quantity")), pct(d(v, "error")), pct(d(v, "limit")), H(str(v, "judged_on")),
-                     pct(d(v, "judged_error")), pass ? "pass" : "fail", pass ? "pass" : "FAIL");
+    const bool pass = v.value("pass", false), decides = v.value("decides", false);
+    // Only the scene's thresholds pass or fail; the target is shown for information.
+    const std::string mark = decides ? (pass ? "<td class=pass>pass</td>" : "<td class=fail>FAIL</td>")
+                                     : (pass ? "<td>within target</td>" : "<td>above target</td>");
+    h += fmt::format("<tr><td class=l>{}</td><td>{}</td><td>{}{}</td><td class=l>{}</td><td>{}</td>{}</tr>",
+                     H(str(v, "quantity")), pct(d(v, "error")), pct(d(v, "limit")), decides ? "" : " (target)",
+                     H(str(v, "judged_on")), pct(d(v, "judged_error")), mark);
   }
   h += "</table>";
   if (!s["baselines"].empty()) {

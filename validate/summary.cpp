@@ -156,7 +156,8 @@ nlohmann::json summary_json(const ValidationResult& v) {
   nlohmann::json verdicts = nlohmann::json::array();
   for (const auto& d : v.verdicts)
     verdicts.push_back({{"quantity", d.quantity}, {"error", num(d.error)}, {"limit", num(d.limit)},
-                        {"judged_on", d.judged_on}, {"judged_error", num(d.judged_error)}, {"pass", d.pass}});
+                        {"judged_on", d.judged_on}, {"judged_error", num(d.judged_error)}, {"pass", d.pass},
+                        {"decides", d.decides}});
   j["verdicts"] = verdicts;
   nlohmann::json baselines = nlohmann::json::array();
   for (const auto& b : v.baselines)

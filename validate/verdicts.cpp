@@ -20,6 +20,7 @@ std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, c
       v.judged_on = th->run;
       v.judged_error = th->error;
       v.pass = th->pass;
+      v.decides = true;
     } else {
       v.limit = target;
       v.judged_on = rec ? rec->label() : "no reduced run within the target";

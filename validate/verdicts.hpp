@@ -17,10 +17,12 @@ struct Verdict {
   std::string judged_on;    // the run the pass/fail is decided on
   double judged_error = 0.0;
   bool pass = false;
+  bool decides = false;     // a scene threshold: its failure fails the validation
 };
 
-// Thresholds decide for their quantity (the tightest when several); other quantities are held
-// to `target` at the recommended setting.
+// Thresholds decide for their quantity (the tightest when several); other quantities are
+// compared with `target` at the recommended setting for information (decides = false), so the
+// table never contradicts the validation's status.
 std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, const RunRecord* recommended,
                                    const std::vector<ThresholdResult>& thresholds, double target);
 

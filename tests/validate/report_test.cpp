@@ -52,6 +52,10 @@ TEST(Report, VerdictsFirstRunsFoldedSceneTextEscaped) {
   ASSERT_NE(verdict, std::string::npos);
   EXPECT_LT(verdict, figure);
   EXPECT_LT(html.find("matched-error full run"), figure);  // the speeds are on the first screen
+  // F has a threshold (pass); qdot and mean_qdot are only compared with the target.
+  EXPECT_LT(html.find("<td class=pass>pass</td>", verdict), figure);
+  EXPECT_LT(html.find("within target", verdict), figure);
+  EXPECT_EQ(html.find("FAIL"), std::string::npos);
   const size_t details = html.find("<details><summary>All 5 runs");
   ASSERT_NE(details, std::string::npos);
   EXPECT_LT(details, html.find("diverged at t = 0.5 s"));  // the run table is folded

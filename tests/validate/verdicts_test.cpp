@@ -21,12 +21,14 @@ TEST(Verdicts, ThresholdsDecideTheirQuantityTheTargetTheOthers) {
   EXPECT_DOUBLE_EQ(v[0].error, 2e-4);
   EXPECT_DOUBLE_EQ(v[0].limit, 1e-3);
   EXPECT_TRUE(v[0].pass);
+  EXPECT_FALSE(v[0].decides);  // no threshold: for information
   // F: the tightest threshold decides, on its own run.
   EXPECT_DOUBLE_EQ(v[1].error, 3e-3);
   EXPECT_DOUBLE_EQ(v[1].limit, 0.01);
   EXPECT_EQ(v[1].judged_on, "10° run");
   EXPECT_DOUBLE_EQ(v[1].judged_error, 0.02);
   EXPECT_FALSE(v[1].pass);
+  EXPECT_TRUE(v[1].decides);
   // Without a recommended setting nothing passes on the target.
   const auto none = calc_verdicts({"qdot"}, nullptr, {}, 1e-3);
   EXPECT_FALSE(none[0].pass);
