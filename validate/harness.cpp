@@ -12,6 +12,7 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/ladder_plan.hpp"
 #include "validate/pareto.hpp"
 #include "validate/thresholds.hpp"
 #include "validate/timing.hpp"
@@ -91,7 +92,30 @@ std::string RunRecord::label() const {
   return s + fmt::format(" {} tol {:.0e}", integrator, tolerance);
 }
 
-ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
+namespace {
+
+engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol) {
+  engine::ForwardOptions fo;
+  fo.duration_s = v.duration_s;
+  fo.output_interval_s = v.output_interval_s;
+  fo.tolerance = tol;
+  fo.integrator = integrator;
+  return fo;
+}
+
+reduced::ReducedOptions reduced_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                        double h) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = v.duration_s;
+  ro.output_interval_s = v.output_interval_s;
+  ro.tolerance = tol;
+  ro.integrator = integrator;
+  ro.fixed_step_s = h;
+  return ro;
+}
+
+// What is validated, from the scene alone.
+ValidationResult describe(const models::Scene& scene) {
   ValidationResult v;
   v.scene = scene.name;
   v.scene_file = scene.source_file;
@@ -104,105 +128,38 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   v.quantities = {"qdot"};
   for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);
   v.quantities.push_back("mean_qdot");
-  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
-
-  // 1. Reference: full model at a tight tolerance, and the change when it is halved.
   v.reference_tolerance = scene.validation.reference_tolerance;
-  engine::FullModel full(scene);
-  auto full_run = [&](const std::string& integrator, double tol) {
-    engine::ForwardOptions fo;
-    fo.duration_s = v.duration_s;
-    fo.output_interval_s = v.output_interval_s;
-    fo.tolerance = tol;
-    fo.integrator = integrator;
-    return engine::simulate_full(full, fo);
-  };
-  const std::string ref_integrator = scene.validation.reference_integrator;
-  progress.count(scene.name + ": reference (full model)", 0, 2);
-  const auto t_ref = Clock::now();
-  v.reference = full_run(ref_integrator, v.reference_tolerance);
-  v.reference_wall_s = seconds_since(t_ref);
-  v.reference_run.model = "full";
-  v.reference_run.integrator = ref_integrator;
-  v.reference_run.tolerance = v.reference_tolerance;
-  v.reference_run.wall_s = v.reference_wall_s;
-  v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
-  v.reference_run.repeats = 1;
-  fill_stats(v.reference_run, v.reference);
-  v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
-  progress.count(scene.name + ": reference (full model)", 1, 2);
-  const auto half = full_run(ref_integrator, v.reference_tolerance / 2);
-  progress.count(scene.name + ": reference (full model)", 2, 2);
-  v.window = detect_steady_window(v.reference, rotating);
-  v.reference_change = compare_series(v.reference, half, v.window.t_start);
-  // Errors and speedups are claimed only over enough samples (issue #9).
-  if (v.reference_change.samples < kMinComparedSamples)
-    v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
-                       "lengthen validation.duration_s or shorten simulation.output_interval_s",
-                       v.reference_change.samples, v.window.how, kMinComparedSamples));
-  // The scene's time scale sets the fixed steps of the ladder (issue #14).
-  v.time_scale = calc_time_scale(v.reference, rotating);
-  v.fixed_steps = calc_fixed_step_ladder(v.time_scale, opt.quick);
+  return v;
+}
 
-  // 2. Full-model tolerance ladder.
-  // Simbody's Runge–Kutta–Merson over the whole ladder; RK3 and CPodes at loose tolerances,
-  // so the full-model baseline is the cheapest Simbody offers at each accuracy.
-  std::vector<std::pair<std::string, double>> full_runs;
-  if (opt.quick) {
-    full_runs = {{"rkmerson", 1e-5}, {"rkmerson", 1e-7}};
-  } else {
-    for (double t : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) full_runs.push_back({"rkmerson", t});
-    for (double t : {1e-4, 1e-6}) full_runs.push_back({"rk3", t});
-    for (double t : {1e-4, 1e-6}) full_runs.push_back({"cpodes", t});
-  }
-  // Timings: median of repeats until a minimum wall time, so short runs are not timed once.
-  const RepeatPolicy full_repeats{opt.quick ? 1 : 3, 50, opt.quick ? 0.0 : 0.3};
-  const RepeatPolicy red_repeats{opt.quick ? 1 : 3, 200, opt.quick ? 0.02 : 0.1};
-  for (size_t i = 0; i < full_runs.size(); ++i) {
-    progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(i), static_cast<long>(full_runs.size()));
+// Stage 2: the full-model tolerance ladder, each run timed by repeats.
+void run_full_ladder(const std::string& name, engine::FullModel& full, const LadderPlan& plan, ValidationResult& v,
+                     Progress& progress) {
+  const long n = static_cast<long>(plan.full.size());
+  for (long i = 0; i < n; ++i) {
+    progress.count(name + ": full-model tolerance ladder", i, n);
     RunRecord r;
     r.model = "full";
-    r.integrator = full_runs[i].first;
-    r.tolerance = full_runs[i].second;
+    r.integrator = plan.full[i].first;
+    r.tolerance = plan.full[i].second;
     models::TimeSeries ts;
-    const auto walls = time_repeats([&] { ts = full_run(r.integrator, r.tolerance); }, full_repeats);
+    const auto fo = forward_options(v, r.integrator, r.tolerance);
+    const auto walls = time_repeats([&] { ts = engine::simulate_full(full, fo); }, plan.full_repeats);
     finish_run(r, walls, ts, v);
     v.runs.push_back(r);
   }
-  progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(full_runs.size()),
-                 static_cast<long>(full_runs.size()));
+  progress.count(name + ": full-model tolerance ladder", n, n);
+}
 
-  // 3. Reduced ladder: grid × interpolation (× energy-consistent m2) × integrator.
-  if (!rotating) throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
-  const std::vector<double> grids =
-      opt.quick ? std::vector<double>{30, 10, 5} : std::vector<double>{30, 20, 10, 5, 2, 1, 0.5};
-  struct Variant {
-    std::string interp;
-    bool ec;
-  };
-  const std::vector<Variant> variants =
-      opt.quick ? std::vector<Variant>{{"cubic", false}, {"fourier", false}}
-                : std::vector<Variant>{{"cubic", false}, {"akima", false},  {"linear", false},
-                                       {"fourier", false}, {"cubic", true}, {"fourier", true}};
-  const std::vector<double> red_tols = opt.quick ? std::vector<double>{1e-8} : std::vector<double>{1e-6, 1e-8, 1e-10};
-  v.tightest_tolerance = red_tols.back();
+// Stage 3: the reduced ladder, grid × interpolation (× energy-consistent m2) × integrator. A run
+// that stops (divergence, validity domain) is recorded with its reason.
+void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, ValidationResult& v, Progress& progress) {
   long done = 0;
-  const long total =
-      static_cast<long>(grids.size() * variants.size() * (red_tols.size() + (opt.quick ? 0 : 1) + v.fixed_steps.size()));
-  auto reduced_options = [&](const std::string& integrator, double tol, double h) {
-    reduced::ReducedOptions ro;
-    ro.duration_s = v.duration_s;
-    ro.output_interval_s = v.output_interval_s;
-    ro.tolerance = tol;
-    ro.integrator = integrator;
-    ro.fixed_step_s = h;
-    return ro;
-  };
-  for (double grid : grids) {
-    // Extraction cost: median of three for the 10° grid (amortised in the report).
+  const long total = plan.reduced_runs();
+  for (double grid : plan.grids_deg) {
     Extraction e;
     std::vector<double> ms;
-    for (int k = 0; k < (grid == 10 && !opt.quick ? 3 : 1); ++k) {
+    for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
       e = extract_from_full(scene, grid, reduced::Method::Kinetostatic);
       ms.push_back(e.extraction_ms);
     }
@@ -211,26 +168,26 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       v.extraction_ms = median(ms);
       v.samples10 = e.samples;
     }
-    for (const auto& var : variants) {
-      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interp), var.ec);
+    for (const auto& var : plan.variants) {
+      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interpolation),
+                                                     var.energy_consistent);
       auto add_run = [&](const std::string& integrator, double tol, double h) {
         progress.count(scene.name + ": reduced ladder", done++, total);
         RunRecord r;
         r.model = "reduced";
         r.grid_deg = grid;
-        r.interpolation = var.interp;
-        r.energy_consistent = var.ec;
+        r.interpolation = var.interpolation;
+        r.energy_consistent = var.energy_consistent;
         r.integrator = integrator;
         r.tolerance = tol;
         r.fixed_step_s = h;
-        const auto ro = reduced_options(integrator, tol, h);
+        const auto ro = reduced_options(v, integrator, tol, h);
         models::TimeSeries ts;
         std::vector<double> walls;
         try {
           walls = time_repeats([&] { ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro); },
-                               red_repeats);
+                               plan.reduced_repeats);
         } catch (const reduced::TableError& e) {
-          // A run that stops (divergence, validity domain) is recorded as failed, with its reason.
           r.failure = e.what();
           for (const auto& q : v.quantities) r.errors.signals.push_back({q, 0.0, INFINITY, INFINITY});
           r.repeats = 0;
@@ -240,59 +197,43 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
         }
         finish_run(r, walls, ts, v);
         v.runs.push_back(r);
-        if (grid == 10 && var.interp == kDefaultInterpolation && !var.ec && integrator == "rk8pd" &&
-            tol == red_tols.back()) {
+        if (grid == 10 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
+            tol == plan.tightest_tolerance()) {
           v.showcase = ts;
           v.showcase_run = static_cast<int>(v.runs.size()) - 1;
         }
       };
-      for (double tol : red_tols) add_run("rk8pd", tol, 0.0);
-      if (!opt.quick) add_run("rkck", 1e-8, 0.0);
+      for (double tol : plan.rk8pd_tolerances) add_run("rk8pd", tol, 0.0);
+      if (plan.rkck) add_run("rkck", 1e-8, 0.0);
       // Fixed-step RK4, the real-time stepper (outputs by dense interpolation).
-      for (double h : v.fixed_steps) add_run("rk4-fixed", 0.0, h);
+      for (double h : plan.fixed_steps_s) add_run("rk4-fixed", 0.0, h);
     }
   }
   progress.count(scene.name + ": reduced ladder", total, total);
+}
 
-  // Interpolants of the 10° table at 1° (figure 1).
-  if (!v.samples10.q.empty()) {
-    const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
-    std::vector<int> cols{m.c_m1, m.c_m2};
-    v.dense_names = {"q_deg", "m1", "m2"};
-    for (size_t k = 0; k < m.c_me1.size(); ++k) {
-      cols.push_back(m.c_me1[k]);
-      cols.push_back(m.c_me2[k]);
-      v.dense_names.push_back("me1_" + m.force_names[k]);
-      v.dense_names.push_back("me2_" + m.force_names[k]);
-    }
-    v.dense_params.assign(cols.size() + 1, {});
-    for (int d = 0; d <= 360; ++d) {
-      const double q = v.samples10.q0 + d * M_PI / 180;
-      v.dense_params[0].push_back(q * 180 / M_PI);
-      for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
-    }
+// The interpolant of the 10° table at 1° (figure 1).
+void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
+  if (v.samples10.q.empty()) return;
+  const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
+  std::vector<int> cols{m.c_m1, m.c_m2};
+  v.dense_names = {"q_deg", "m1", "m2"};
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    cols.push_back(m.c_me1[k]);
+    cols.push_back(m.c_me2[k]);
+    v.dense_names.push_back("me1_" + m.force_names[k]);
+    v.dense_names.push_back("me2_" + m.force_names[k]);
   }
-
-  // 4. Pareto front, matched-error speedup, recommended setting (validate/pareto.hpp).
-  mark_pareto(v.runs, v.headline_quantity);
-  const auto matched = calc_matched_speedup(v.runs, v.headline_quantity, v.matched_target);
-  v.matched_full = matched.full;
-  v.matched_reduced = matched.reduced;
-  if (v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
-  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
-  const SignalError* ref_floor = v.reference_change.find(v.headline_quantity);
-  v.convergence_floor = 10 * std::max(1e-12, ref_floor ? ref_floor->max_rel : 0.0);
-  v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
-
-  // 5. Calibration (scenes that declare an operating point).
-  if (scene.validation.calibrate_cadence_Hz > 0) {
-    v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
-    v.calibration_options.power_w = scene.validation.calibrate_power_W;
-    progress.note(scene.name + ": calibrating the drive load");
-    v.calibration = calibrate(scene, v.calibration_options, progress);
+  v.dense_params.assign(cols.size() + 1, {});
+  for (int d = 0; d <= 360; ++d) {
+    const double q = v.samples10.q0 + d * M_PI / 180;
+    v.dense_params[0].push_back(q * 180 / M_PI);
+    for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
   }
+}
 
-  // 6. Acceptance thresholds (validate/thresholds.hpp); a grid outside the ladder is run now.
+// Stage 6: the scene's thresholds; a grid outside the ladder is run now.
+void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
   for (const auto& th : scene.validation.thresholds) {
     auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
     if (!tr) {
@@ -306,7 +247,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
       r.integrator = "rk8pd";
       r.tolerance = v.tightest_tolerance;
       const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot,
-                                                reduced_options("rk8pd", v.tightest_tolerance, 0.0));
+                                                reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0));
       r.errors = compare_series(v.reference, ts, v.window.t_start);
       tr = judge_threshold_on(th, r);
     }
@@ -315,15 +256,89 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
                          th.max_error, tr->run));
     v.thresholds.push_back(*tr);
   }
+}
 
-  // 7. The first screen: verdicts, baselines and the error budget at the recommended setting.
+}  // namespace
+
+void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  const std::string integrator = scene.validation.reference_integrator;
+  progress.count(scene.name + ": reference (full model)", 0, 2);
+  const auto t_ref = Clock::now();
+  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance));
+  v.reference_wall_s = seconds_since(t_ref);
+  v.reference_run.model = "full";
+  v.reference_run.integrator = integrator;
+  v.reference_run.tolerance = v.reference_tolerance;
+  v.reference_run.wall_s = v.reference_wall_s;
+  v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
+  v.reference_run.repeats = 1;
+  fill_stats(v.reference_run, v.reference);
+  v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
+  progress.count(scene.name + ": reference (full model)", 1, 2);
+  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2));
+  progress.count(scene.name + ": reference (full model)", 2, 2);
+  v.window = detect_steady_window(v.reference, rotating);
+  v.reference_change = compare_series(v.reference, half, v.window.t_start);
+  // Errors and speedups are claimed only over enough samples (issue #9).
+  if (v.reference_change.samples < kMinComparedSamples)
+    v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
+                       "lengthen validation.duration_s or shorten simulation.output_interval_s",
+                       v.reference_change.samples, v.window.how, kMinComparedSamples));
+  v.time_scale = calc_time_scale(v.reference, rotating);
+}
+
+void analyse_runs(ValidationResult& v) {
+  mark_pareto(v.runs, v.headline_quantity);
+  const auto matched = calc_matched_speedup(v.runs, v.headline_quantity, v.matched_target);
+  v.matched_full = matched.full;
+  v.matched_reduced = matched.reduced;
+  v.speedup_at_matched_error.reset();
+  if (v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
+  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.convergence_floor = 10 * std::max(1e-12, ref ? ref->max_rel : 0.0);
+  v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
+}
+
+void calc_first_screen(ValidationResult& v) {
   const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
   v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
-  if (rec) {
-    v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
-    v.budget = calc_error_budget(*rec, v.runs, ref_floor ? ref_floor->max_rel : NAN, v.headline_quantity,
-                                 v.tightest_tolerance);
+  v.baselines.clear();
+  v.budget.reset();
+  if (!rec) return;
+  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
+}
+
+ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
+  ValidationResult v = describe(scene);
+  // 1. Reference: full model at a tight tolerance, and the change when it is halved; the
+  //    scene's time scale from it sets the fixed steps of the ladder.
+  engine::FullModel full(scene);
+  run_reference(scene, full, v, progress);
+  const LadderPlan plan = plan_ladders(v.time_scale, opt.quick);
+  v.fixed_steps = plan.fixed_steps_s;
+  v.tightest_tolerance = plan.tightest_tolerance();
+  // 2–3. The ladders.
+  run_full_ladder(scene.name, full, plan, v, progress);
+  if (scene.find_joint(scene.independent)->type != models::JointType::Revolute)
+    throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
+  run_reduced_ladder(scene, plan, v, progress);
+  calc_dense_params(scene, v);
+  // 4. Pareto front, matched-error speedup, recommended setting, convergence.
+  analyse_runs(v);
+  // 5. Calibration (scenes that declare an operating point).
+  if (scene.validation.calibrate_cadence_Hz > 0) {
+    v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
+    v.calibration_options.power_w = scene.validation.calibrate_power_W;
+    progress.note(scene.name + ": calibrating the drive load");
+    v.calibration = calibrate(scene, v.calibration_options, progress);
   }
+  // 6–7. Thresholds, then the first screen: verdicts, baselines, error budget.
+  judge_thresholds(scene, v);
+  calc_first_screen(v);
   return v;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/full_model.hpp"
 #include "models/scene.hpp"
 #include "models/timeseries.hpp"
 #include "reduced/samples.hpp"
@@ -68,7 +69,21 @@ struct ValidationResult {
   std::string failure_summary() const;
 };
 
-// Runs everything (engine + reduced) for one scene. Throws on scene/engine errors.
+// Runs everything (engine + reduced) for one scene. Throws on scene/engine errors. The
+// stages, in order: run_reference, plan_ladders (validate/ladder_plan.hpp), the full and reduced
+// ladders, analyse_runs, calibration, thresholds, calc_first_screen.
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress);
+
+// Stage 1: the reference (full model at the scene's reference tolerance), its change when the
+// tolerance is halved, the compared window and the scene's time scale, into `v` (whose
+// duration, output interval and reference tolerance are set).
+void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress);
+
+// Stage 4 (no simulation): Pareto front, matched-error speedup, recommended setting and
+// convergence series from v.runs.
+void analyse_runs(ValidationResult& v);
+
+// Stage 7 (no simulation): verdicts, baselines and error budget at the recommended setting.
+void calc_first_screen(ValidationResult& v);
 
 }  // namespace rdyn::validate

@@ -10,7 +10,9 @@ namespace {
 
 // Every number in the tree is finite (JSON has no NaN; unmeasured values are null).
 void expect_finite(const nlohmann::json& j, const std::string& path = "") {
-  if (j.is_number_float()) EXPECT_TRUE(std::isfinite(j.get<double>())) << path;
+  if (j.is_number_float()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>())) << path;
+  }
   if (j.is_structured())
     for (auto it = j.begin(); it != j.end(); ++it) expect_finite(*it, path + "/" + (j.is_object() ? it.key() : "[]"));
 }
