@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
       "calibrate",
       "Set the scene's resistance to dissipate P watts at cadence F, then find (GSL Brent) the constant drive "
       "torque that holds the mean steady cadence at F with the reduced model, confirmed with the full model. "
-      "Prints JSON on standard output (hip_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
-      "mean_power_w, peak_knee_force_N, speed_fluctuation, ...); progress goes to standard error.");
+      "Prints JSON on standard output (drive_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
+      "mean_power_w, force_name and its peak_force_N, speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
   calibrate->add_option("--cadence-hz", cal.cadence_hz, "Target cadence [Hz] (default 1)");
   calibrate->add_option("--power-w", cal.power_w, "Power the resistance dissipates at that cadence [W] (default 125)");
@@ -117,8 +117,8 @@ int main(int argc, char** argv) {
   auto* sweep = app.add_subcommand(
       "sweep",
       "Population sweep: calibrate the drive torque of many cases with the reduced model, in parallel threads. "
-      "One CSV row per case: the varied parameters, the calibrated hip torque, the peak of the first constraint "
-      "force (e.g. the knee) and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
+      "One CSV row per case: the varied parameters, the calibrated drive torque, the peak of the first constraint "
+      "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
       "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
   sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
   sweep->add_option("--vary", sw.vary, "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)")
