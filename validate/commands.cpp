@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <cctype>
 #include <map>
 #include <memory>
@@ -404,6 +405,39 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
 }
 
 }  // namespace
+
+// Largest summary.json `rdyn report` reads (the bicycle's full ladder writes ~0.7 MB).
+constexpr std::uintmax_t kMaxSummaryBytes = 64u << 20;
+
+int run_report(const ReportArgs& a) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(a.summary, ec))
+    throw ArgumentError(a.summary + ": not a readable file (give the summary.json of `rdyn validate`)");
+  const auto size = fs::file_size(a.summary, ec);
+  if (ec || size > kMaxSummaryBytes)
+    throw ArgumentError(fmt::format("{}: larger than {} MB, not a summary of `rdyn validate`", a.summary,
+                                    kMaxSummaryBytes >> 20));
+  std::ifstream in(a.summary, std::ios::binary);
+  nlohmann::json summary;
+  try {
+    summary = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ArgumentError(fmt::format("{}: not valid JSON ({})", a.summary, e.what()));
+  }
+  if (!summary.is_object() || !summary.contains("scene") || !summary.contains("runs"))
+    throw ArgumentError(a.summary + ": not a summary of `rdyn validate` (no 'scene' and 'runs')");
+  OutputDir out(a.out, a.force);
+  try {
+    render_report(summary, out.file(""));
+  } catch (const nlohmann::json::exception& e) {
+    // A hand-edited summary: a key missing or of the wrong type.
+    throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
+  }
+  out.commit();
+  std::fprintf(stderr, "rdyn: re-rendered %s into %s/report.html\n", a.summary.c_str(), a.out.c_str());
+  return 0;
+}
 
 int run_validate(const ValidateArgs& a) {
   if (!a.suite.empty() && !a.scene.empty()) throw ArgumentError("give a scene or --suite, not both");

@@ -113,6 +113,15 @@ int main(int argc, char** argv) {
   validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
   validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
 
+  ReportArgs rep;
+  auto* report = app.add_subcommand(
+      "report",
+      "Re-render a validation report from its summary.json alone (e.g. after editing a gnuplot style or moving "
+      "the folder): writes DIR/report.html, the figures' data, scripts and SVGs, and a copy of the summary.");
+  report->add_option("summary", rep.summary, "summary.json written by `rdyn validate`")->required();
+  report->add_option("--out", rep.out, "Output folder (written atomically)")->required();
+  report->add_flag("--force", rep.force, kForceHelpDir);
+
   SweepArgs sw;
   auto* sweep = app.add_subcommand(
       "sweep",
@@ -152,6 +161,7 @@ int main(int argc, char** argv) {
     if (*calibrate) return run_calibrate(cal);
     if (*validate) return run_validate(val);
     if (*sweep) return run_sweep_command(sw);
+    if (*report) return run_report(rep);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

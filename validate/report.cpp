@@ -26,8 +26,8 @@ std::string str(const json& j, const char* key) {
   return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>() : std::string();
 }
 double error_of(const json& run, const std::string& q) {
-  if (!run.is_object() || !run.contains("errors") || !run["errors"].contains(q)) return NAN;
-  return d(run["errors"][q], "max_rel");
+  if (!run.is_object() || !run.contains("errors") || !run.at("errors").contains(q)) return NAN;
+  return d(run.at("errors")[q], "max_rel");
 }
 
 // Scene-given text in HTML.
@@ -65,9 +65,9 @@ std::string read_text(const std::string& path) {
 // A {"names", "rows"} table of the summary as CSV.
 std::string table_csv(const json& t) {
   std::string s;
-  for (size_t c = 0; c < t["names"].size(); ++c) s += (c ? "," : "") + csv_field(t["names"][c].get<std::string>());
+  for (size_t c = 0; c < t.at("names").size(); ++c) s += (c ? "," : "") + csv_field(t.at("names")[c].get<std::string>());
   s += "\n";
-  for (const auto& row : t["rows"]) {
+  for (const auto& row : t.at("rows")) {
     for (size_t c = 0; c < row.size(); ++c)
       s += (c ? "," : "") + (row[c].is_number() ? fmt::format("{:.10g}", row[c].get<double>()) : std::string());
     s += "\n";
@@ -79,7 +79,7 @@ const char* kSvgHead = "set terminal svg size 960,{} dynamic enhanced font 'sans
 
 // Figure 1: reduced parameters — samples and interpolant.
 std::string params_gp(const json& fig) {
-  const auto& names = fig["params_samples"]["names"];
+  const auto& names = fig.at("params_samples").at("names");
   const size_t nf = names.size() > 3 ? (names.size() - 3) / 2 : 0;
   std::string gp = "# Reduced parameters vs the independent coordinate. Restyle freely; data: params.csv (table\n"
                    "# samples), params_dense.csv (the interpolant at 1°).\n";
@@ -101,7 +101,7 @@ std::string params_gp(const json& fig) {
 
 // Figure 2: the speed and the first constraint force, full and reduced, over the last periods.
 std::string timeseries_gp(const json& ts) {
-  const bool has_f = ts["names"].size() >= 5;
+  const bool has_f = ts.at("names").size() >= 5;
   std::string gp = "# Full model and reduced model over the last periods of the scene's time scale. Data: compare.csv.\n";
   gp += fmt::format(fmt::runtime(kSvgHead), 640);
   gp += "set output 'timeseries.svg'\nset datafile separator ','\nset grid\nset xlabel 't [s]'\n"
@@ -126,7 +126,7 @@ void write_pareto(const json& s, const std::string& dir) {
   const std::string Q = str(s, "headline_quantity");
   std::string red = "wall_s,error,label\n", front = red, full = red;
   std::vector<std::pair<double, std::string>> fr;
-  for (const auto& r : s["runs"]) {
+  for (const auto& r : s.at("runs")) {
     const double w = d(r, "wall_s"), e = error_of(r, Q);
     if (!std::isfinite(w) || !std::isfinite(e)) continue;  // stopped runs have no error to plot
     const std::string line = fmt::format("{:.6g},{:.6g},{}\n", w, std::max(e, 1e-12), csv_field(str(r, "label")));
@@ -160,18 +160,18 @@ void write_pareto(const json& s, const std::string& dir) {
 
 // Figure 4 data and script: error against grid step per interpolation.
 void write_convergence(const json& s, const std::string& dir) {
-  const auto& conv = s["convergence"];
+  const auto& conv = s.at("convergence");
   std::vector<double> grids;
-  for (const auto& e : s["extractions"]) grids.push_back(d(e, "grid_deg"));
+  for (const auto& e : s.at("extractions")) grids.push_back(d(e, "grid_deg"));
   std::string csv = "grid_deg";
-  for (const auto& ser : conv["series"]) csv += "," + csv_field(str(ser, "interpolation"));
+  for (const auto& ser : conv.at("series")) csv += "," + csv_field(str(ser, "interpolation"));
   csv += "\n";
   for (double g : grids) {
     csv += fmt::format("{:g}", g);
-    for (const auto& ser : conv["series"]) {
+    for (const auto& ser : conv.at("series")) {
       std::string cell;
-      for (const auto& p : ser["points"])
-        if (p[0].is_number() && std::abs(p[0].get<double>() - g) < 1e-9 && p[1].is_number())
+      for (const auto& p : ser.at("points"))
+        if (p.is_array() && p.size() == 2 && p[0].is_number() && std::abs(p[0].get<double>() - g) < 1e-9 && p[1].is_number())
           cell = fmt::format("{:.6g}", std::max(p[1].get<double>(), 1e-12));
       csv += "," + cell;
     }
@@ -188,8 +188,8 @@ void write_convergence(const json& s, const std::string& dir) {
                    "order, fitted above 10× the reference floor)'\n";
   const char* colors[] = {"#1f77b4", "#2ca02c", "#9467bd", "#d62728", "#ff7f0e", "#8c564b"};
   std::string plot;
-  for (size_t k = 0; k < conv["series"].size(); ++k) {
-    const auto& ser = conv["series"][k];
+  for (size_t k = 0; k < conv.at("series").size(); ++k) {
+    const auto& ser = conv.at("series")[k];
     const double o = d(ser, "order");
     plot += fmt::format("{}'convergence.csv' skip 1 using 1:{} with linespoints pt 7 lw 2 lc rgb '{}' title {}",
                         k ? ", " : "", k + 2, colors[k % 6],
@@ -203,19 +203,20 @@ void write_convergence(const json& s, const std::string& dir) {
 void write_runs_csv(const json& s, const std::string& dir) {
   std::string csv = "model,label,grid_deg,interpolation,energy_consistent,integrator,tolerance,fixed_step_s,wall_s,"
                     "repeats,steps,energy_residual_rel,pareto,excluded_samples,failure";
-  for (const auto& q : s["quantities"]) csv += ",max_rel_" + q.get<std::string>() + ",rms_rel_" + q.get<std::string>();
+  for (const auto& q : s.at("quantities"))
+    csv += "," + csv_field("max_rel_" + q.get<std::string>()) + "," + csv_field("rms_rel_" + q.get<std::string>());
   csv += "\n";
   auto cell = [](double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string(); };
-  for (const auto& r : s["runs"]) {
-    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", str(r, "model"), csv_field(str(r, "label")),
-                       cell(d(r, "grid_deg")), str(r, "interpolation"), r.value("energy_consistent_m2", false) ? 1 : 0,
-                       str(r, "integrator"), cell(d(r, "tolerance")), cell(d(r, "fixed_step_s")), cell(d(r, "wall_s")),
+  for (const auto& r : s.at("runs")) {
+    csv += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", csv_field(str(r, "model")), csv_field(str(r, "label")),
+                       cell(d(r, "grid_deg")), csv_field(str(r, "interpolation")), r.value("energy_consistent_m2", false) ? 1 : 0,
+                       csv_field(str(r, "integrator")), cell(d(r, "tolerance")), cell(d(r, "fixed_step_s")), cell(d(r, "wall_s")),
                        r.value("repeats", 0), r.value("steps", 0L), cell(d(r, "energy_balance_residual_rel")),
                        r.value("pareto", false) ? 1 : 0, r.value("excluded_between_switches", 0L),
                        csv_field(str(r, "failure")));
-    for (const auto& q : s["quantities"]) {
+    for (const auto& q : s.at("quantities")) {
       const std::string name = q.get<std::string>();
-      const json e = r.contains("errors") && r["errors"].contains(name) ? r["errors"][name] : json::object();
+      const json e = r.contains("errors") && r.at("errors").contains(name) ? r.at("errors")[name] : json::object();
       csv += "," + cell(d(e, "max_rel")) + "," + cell(d(e, "rms_rel"));
     }
     csv += "\n";
@@ -233,7 +234,7 @@ std::string svg_or_note(const std::map<std::string, std::string>& figures, const
 
 // The first screen: one row per quantity.
 std::string verdict_table(const json& s) {
-  const json& rec = s["recommended_reduced"];
+  const json& rec = s.at("recommended_reduced");
   std::string h = "<h2>Verdict</h2>";
   if (rec.is_object())
     h += "<p>Recommended reduced setting: <b>" + H(str(rec, "label")) + "</b>, " + H(cost(s, d(rec, "wall_s"))) + ".</p>";
@@ -242,7 +243,7 @@ std::string verdict_table(const json& s) {
                      pct(d(s, "matched_error_target")), H(str(s, "headline_quantity")));
   h += "<table><tr><th>quantity</th><th>error at the recommended setting</th><th>limit</th><th>judged on</th>"
        "<th>error there</th><th></th></tr>";
-  for (const auto& v : s["verdicts"]) {
+  for (const auto& v : s.at("verdicts")) {
     const bool pass = v.value("pass", false), decides = v.value("decides", false);
     // Only the scene's thresholds pass or fail; the target is shown for information.
     const std::string mark = decides ? (pass ? "<td class=pass>pass</td>" : "<td class=fail>FAIL</td>")
@@ -252,15 +253,15 @@ std::string verdict_table(const json& s) {
                      H(str(v, "judged_on")), pct(d(v, "judged_error")), mark);
   }
   h += "</table>";
-  if (!s["baselines"].empty()) {
+  if (!s.at("baselines").empty()) {
     h += "<table><tr><th>baseline (full model)</th><th>run</th><th>its cost</th><th>recommended setting is</th></tr>";
-    for (const auto& b : s["baselines"])
+    for (const auto& b : s.at("baselines"))
       h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{:.3g}× faster</td></tr>",
                        H(str(b, "what")), H(str(b, "label")), H(cost(s, d(b, "wall_s"))), d(b, "speedup"));
     h += "</table>";
   }
   if (s.contains("error_budget")) {
-    const auto& b = s["error_budget"];
+    const auto& b = s.at("error_budget");
     h += fmt::format(
         "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak): reference {} (its change when its "
         "tolerance is halved), table {} ({}: grid and interpolation, integrated at the tightest tolerance), "
@@ -274,7 +275,7 @@ std::string verdict_table(const json& s) {
 
 // Published values the scene compares with (validation.compare), beside rdyn's calibration.
 std::string calibration_section(const json& s) {
-  const auto& c = s["calibration"];
+  const auto& c = s.at("calibration");
   std::string h = "<h2>Calibration</h2>";
   h += fmt::format(
       "<p>With the resistance dissipating {:g} W at {:g} Hz, the drive load that holds a mean steady rate of {:g} "
@@ -307,15 +308,15 @@ std::string headline(const json& s) {
   std::string out;
   const std::string Q = str(s, "headline_quantity");
   const std::string qw = quantity_words(Q);
-  const json& mf = s["matched_full"];
-  const json& mr = s["matched_reduced"];
-  if (s["speedup_at_matched_error"].is_number() && mf.is_object() && mr.is_object()) {
+  const json& mf = s.at("matched_full");
+  const json& mr = s.at("matched_reduced");
+  if (s.at("speedup_at_matched_error").is_number() && mf.is_object() && mr.is_object()) {
     out += fmt::format(
         "On this machine ({}), the reduced model of '{}' ({}) takes {} against {} for Simbody forward dynamics ({}), at "
         "equal or better error of the {} ({} vs {} of its peak): {:.3g}× faster. ",
         str(s, "machine"), str(s, "scene"), str(mr, "label"), cost(s, d(mr, "wall_s")), secs(d(mf, "wall_s")),
         str(mf, "label"), qw, pct(error_of(mr, Q)), pct(error_of(mf, Q)), d(s, "speedup_at_matched_error"));
-    for (const auto& e : s["extractions"])
+    for (const auto& e : s.at("extractions"))
       if (std::abs(d(e, "grid_deg") - d(mr, "grid_deg")) < 1e-9) {
         out += fmt::format("Its {:g}° table costs {:.3g} ms to extract once", d(e, "grid_deg"), d(e, "ms"));
         if (s.value("per_second_measured", false))
@@ -328,27 +329,27 @@ std::string headline(const json& s) {
                        "or no reduced run matched it: no matched-error speedup is claimed. ",
                        str(s, "scene"), pct(d(s, "matched_error_target")), qw);
   }
-  const json& sc = s["showcase_reduced"];
+  const json& sc = s.at("showcase_reduced");
   if (sc.is_object()) {
     out += fmt::format("At the 10° grid ({}), the errors are {} for the speed", str(sc, "label"), pct(error_of(sc, "qdot")));
-    for (const auto& q : s["quantities"])
+    for (const auto& q : s.at("quantities"))
       if (q != "qdot" && q != "mean_qdot") out += fmt::format(" and {} for {}", pct(error_of(sc, q)), q.get<std::string>());
     out += ". ";
   }
-  const auto& ref = s["reference"];
+  const auto& ref = s.at("reference");
   out += fmt::format("Reference: the full model (Simbody, {}) at tolerance {:.0e}; halving that tolerance changed",
                      str(ref, "integrator") == "rkmerson" ? "Runge–Kutta–Merson" : str(ref, "integrator"),
                      d(ref, "tolerance"));
-  const auto& ch = ref["change_when_tolerance_halved"]["errors"];
+  const auto& ch = ref.at("change_when_tolerance_halved").at("errors");
   bool first = true;
-  for (const auto& q : s["quantities"]) {
+  for (const auto& q : s.at("quantities")) {
     const std::string name = q.get<std::string>();
     if (name == "mean_qdot" || !ch.contains(name)) continue;
     out += fmt::format("{} {} by {}", first ? "" : " and", name == "qdot" ? "the speed" : name, pct(d(ch[name], "max_rel")));
     first = false;
   }
   out += " of their peaks. ";
-  out += s["steady_window"].value("whole_run", false) ? "The run has no steady cycles: errors are maxima over the whole run."
+  out += s.at("steady_window").value("whole_run", false) ? "The run has no steady cycles: errors are maxima over the whole run."
                                                       : "Errors are maxima over the steady cycles.";
   return out;
 }
@@ -365,20 +366,20 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
        "font-weight:bold}</style></head><body>";
   const bool pass = str(s, "status") == "pass";
   h += "<h1>rdyn validation: " + H(str(s, "scene")) + " — <span class=" + (pass ? "pass>pass" : "fail>FAIL") + "</span></h1>";
-  if (!s["failures"].empty()) {
+  if (!s.at("failures").empty()) {
     h += "<ul>";
-    for (const auto& f : s["failures"]) h += "<li class=warn>" + H(f.get<std::string>()) + "</li>";
+    for (const auto& f : s.at("failures")) h += "<li class=warn>" + H(f.get<std::string>()) + "</li>";
     h += "</ul>";
   }
   h += verdict_table(s);
   h += "<p class=lead>" + H(headline(s)) + "</p>";
   if (!str(s, "note").empty()) h += "<p><b>What this scene tests:</b> " + H(str(s, "note")) + "</p>";
-  const auto& w = s["steady_window"];
+  const auto& w = s.at("steady_window");
   h += fmt::format("<p>Scene file: <code>{}</code>. Simulated {:g} s, output every {:g} s. Time scale: {}. Compared "
                    "window: {}. Samples lying between the two models' instants of a load switch (where the force "
                    "jumps) are excluded from the error maxima and counted in <code>runs.csv</code>.</p>",
                    H(str(s, "scene_file")), d(s, "duration_s"), d(s, "output_interval_s"),
-                   H(str(s["time_scale"], "how")), H(str(w, "how")));
+                   H(str(s.at("time_scale"), "how")), H(str(w, "how")));
   h += s.value("per_second_measured", false)
            ? "<p>Costs are given for the run as simulated and per simulated second (the run lasted at least a second).</p>"
            : "<p>Costs are given for the run as simulated only: it lasted less than a second, so a per-second figure "
@@ -386,22 +387,22 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   h += "<h2>1. Reduced parameters</h2><p>m1, m2 of Eksergian's equation <code>m1 q̈ + m2 q̇² = F*</code> and me1, me2 of "
        "each constraint line <code>me1 q̈ + me2 q̇² = F_E + Q_x</code>, from kinetostatic calls of the full model at 10°."
        "</p>" +
-       (s.contains("figures") && s["figures"].contains("params_samples") ? svg_or_note(figures, "params")
+       (s.contains("figures") && s.at("figures").contains("params_samples") ? svg_or_note(figures, "params")
                                                                         : "<p>No table in this summary.</p>");
   h += "<h2>2. Full and reduced model over the last periods</h2>" + svg_or_note(figures, "timeseries");
   h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto");
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");
-  h += "<p>Observed orders (fitted above 10× the reference's own change, " + pct(d(s["convergence"], "floor")) + "):";
-  for (const auto& ser : s["convergence"]["series"]) {
+  h += "<p>Observed orders (fitted above 10× the reference's own change, " + pct(d(s.at("convergence"), "floor")) + "):";
+  for (const auto& ser : s.at("convergence").at("series")) {
     const double o = d(ser, "order");
     h += fmt::format(" {} {};", H(str(ser, "interpolation")), std::isfinite(o) ? fmt::format("{:.2f}", o) : "n/a");
   }
   h += " Below that floor an error measures the reference, not the table.</p>";
   if (s.contains("calibration")) h += calibration_section(s);
-  if (!s["thresholds"].empty()) {
+  if (!s.at("thresholds").empty()) {
     h += "<h2>Acceptance thresholds</h2><table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</th><th>run</th>"
          "<th></th></tr>";
-    for (const auto& t : s["thresholds"]) {
+    for (const auto& t : s.at("thresholds")) {
       const bool p = t.value("pass", false);
       h += fmt::format("<tr><td class=l>{}</td><td>{:g}°</td><td>{}</td><td>{}</td><td class=l>{}</td><td class={}>{}</td>"
                        "</tr>",
@@ -414,24 +415,24 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
                    "wall time) for the run as simulated; errors are maxima over the compared window relative to the "
                    "reference's peak (RMS in <code>runs.csv</code>). ★: on the Pareto front of its model.</p>"
                    "<table><tr><th>run</th><th>wall time</th><th>repeats</th><th>steps</th><th>energy residual</th>",
-                   s["runs"].size());
-  for (const auto& q : s["quantities"]) h += "<th>" + H(q.get<std::string>()) + "</th>";
+                   s.at("runs").size());
+  for (const auto& q : s.at("quantities")) h += "<th>" + H(q.get<std::string>()) + "</th>";
   h += "</tr>";
-  for (const auto& r : s["runs"]) {
+  for (const auto& r : s.at("runs")) {
     if (!str(r, "failure").empty()) {
       h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>", H(str(r, "label")),
-                       4 + s["quantities"].size(), H(str(r, "failure")));
+                       4 + s.at("quantities").size(), H(str(r, "failure")));
       continue;
     }
     h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.1e}</td>",
                      r.value("pareto", false) ? "★ " : "", H(str(r, "label")), secs(d(r, "wall_s")), r.value("repeats", 0),
                      r.value("steps", 0L), d(r, "energy_balance_residual_rel"));
-    for (const auto& q : s["quantities"]) h += fmt::format("<td>{:.2e}</td>", error_of(r, q.get<std::string>()));
+    for (const auto& q : s.at("quantities")) h += fmt::format("<td>{:.2e}</td>", error_of(r, q.get<std::string>()));
     h += "</tr>";
   }
   h += "</table></details><h2>Extraction cost</h2><table><tr><th>grid</th><th>points</th><th>kinetostatic calls</th>"
        "<th>time</th></tr>";
-  for (const auto& e : s["extractions"])
+  for (const auto& e : s.at("extractions"))
     h += fmt::format("<tr><td>{:g}°</td><td>{}</td><td>{}</td><td>{:.3g} ms</td></tr>", d(e, "grid_deg"),
                      e.value("points", 0), e.value("kinetostatic_calls", 0L), d(e, "ms"));
   h += "</table>";
@@ -448,14 +449,14 @@ void render_report(const json& s, const std::string& dir) {
   std::vector<std::string> names;
   const json& fig = s.value("figures", json::object());
   if (fig.contains("params_samples")) {
-    write_text_file(dir + "/params.csv", table_csv(fig["params_samples"]));
-    write_text_file(dir + "/params_dense.csv", table_csv(fig["params_dense"]));
+    write_text_file(dir + "/params.csv", table_csv(fig.at("params_samples")));
+    write_text_file(dir + "/params_dense.csv", table_csv(fig.at("params_dense")));
     write_text_file(dir + "/params.gp", params_gp(fig));
     names.push_back("params");
   }
   if (fig.contains("timeseries")) {
-    write_text_file(dir + "/compare.csv", table_csv(fig["timeseries"]));
-    write_text_file(dir + "/timeseries.gp", timeseries_gp(fig["timeseries"]));
+    write_text_file(dir + "/compare.csv", table_csv(fig.at("timeseries")));
+    write_text_file(dir + "/timeseries.gp", timeseries_gp(fig.at("timeseries")));
     names.push_back("timeseries");
   }
   write_pareto(s, dir);

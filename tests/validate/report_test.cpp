@@ -100,5 +100,35 @@ TEST(Report, ShortRunsAreNotExtrapolatedPerSecond) {
   EXPECT_NE(headline(summary_json(v)).find("per simulated second"), std::string::npos);
 }
 
+// `rdyn report SUMMARY --out DIR`: the same report from the saved summary; a file that is not
+// a summary is bad input (exit 2, the file named, nothing written), never an internal error.
+TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_report_cmd_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "a");
+  render_report(summary_json(test::synthetic_validation()), (dir / "a").string());
+  auto r = test::run_rdyn({"report", "a/summary.json", "--out", "b"}, dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(test::slurp(dir / "a" / "report.html"), test::slurp(dir / "b" / "report.html"));
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"not_json.json", "{\"scene\": "},
+      {"array.json", "[1, 2]"},
+      {"runs_not_a_list.json", "{\"scene\": \"x\", \"runs\": 5}"},
+      {"missing_keys.json", "{\"scene\": \"x\", \"runs\": []}"},
+      {"wrong_types.json", "{\"scene\": 1, \"runs\": [{\"label\": 2}], \"quantities\": [3]}"}};
+  for (const auto& [name, text] : bad) {
+    std::ofstream(dir / name) << text;
+    r = test::run_rdyn({"report", name, "--out", "c"}, dir);
+    EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "c")) << name;
+  }
+  r = test::run_rdyn({"report", "missing.json", "--out", "c"}, dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
