@@ -124,6 +124,21 @@ TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
     EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "c")) << name;
   }
+  // Numbers removed by hand (null: "not measured") print as n/a, never as nan.
+  auto holes = summary_json(test::synthetic_validation());
+  for (const char* k : {"duration_s", "output_interval_s", "speedup_at_matched_error"}) holes[k] = nullptr;
+  holes["runs"][0]["energy_balance_residual_rel"] = nullptr;
+  holes["runs"][0]["errors"]["qdot"]["max_rel"] = nullptr;
+  holes["extractions"][0]["ms"] = nullptr;
+  holes["baselines"][0]["speedup"] = nullptr;
+  std::ofstream(dir / "holes.json") << holes.dump();
+  r = test::run_rdyn({"report", "holes.json", "--out", "h"}, dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  std::string html = test::slurp(dir / "h" / "report.html");
+  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg")) html.erase(at, html.find("</svg>", at) + 6 - at);
+  EXPECT_EQ(html.find("nan"), std::string::npos);
+  EXPECT_EQ(html.find("inf"), std::string::npos);
+  EXPECT_NE(html.find("n/a"), std::string::npos);
   r = test::run_rdyn({"report", "missing.json", "--out", "c"}, dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
