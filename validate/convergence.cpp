@@ -18,13 +18,17 @@ double calc_observed_order(const std::vector<std::pair<double, double>>& pts, do
   return (n * sxy - sx * sy) / den;
 }
 
-std::vector<ConvergenceSeries> calc_convergence(const std::vector<RunRecord>& runs, const std::string& q,
-                                                double tolerance, double floor) {
+std::vector<ConvergenceSeries> calc_convergence(const std::vector<RunRecord>& runs,
+                                                const std::string& q, double tolerance,
+                                                double floor) {
   std::vector<ConvergenceSeries> out;
   for (const auto& r : runs) {
-    if (r.model != "reduced" || r.energy_consistent || r.integrator != "rk8pd" || r.tolerance != tolerance) continue;
+    if (r.model != "reduced" || r.energy_consistent || r.integrator != "rk8pd" ||
+        r.tolerance != tolerance)
+      continue;
     if (!r.failure.empty() || !std::isfinite(r.error_of(q))) continue;
-    auto it = std::find_if(out.begin(), out.end(), [&](const auto& s) { return s.interpolation == r.interpolation; });
+    auto it = std::find_if(out.begin(), out.end(),
+                           [&](const auto& s) { return s.interpolation == r.interpolation; });
     if (it == out.end()) it = out.insert(out.end(), ConvergenceSeries{r.interpolation, {}, NAN});
     it->points.push_back({r.grid_deg, r.error_of(q)});
   }

@@ -21,7 +21,8 @@ double calc_observed_order(const std::vector<std::pair<double, double>>& points,
 
 // For each interpolation (plain m2, rk8pd at `tolerance`): the errors of `quantity` at each
 // grid of the ladder and their observed order.
-std::vector<ConvergenceSeries> calc_convergence(const std::vector<RunRecord>& runs, const std::string& quantity,
-                                                double tolerance, double floor);
+std::vector<ConvergenceSeries> calc_convergence(const std::vector<RunRecord>& runs,
+                                                const std::string& quantity, double tolerance,
+                                                double floor);
 
 }  // namespace rdyn::validate

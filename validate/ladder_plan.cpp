@@ -21,7 +21,7 @@ LadderPlan plan_ladders(const TimeScale& scale, bool quick) {
     for (double t : {1e-4, 1e-6}) p.full.push_back({"rk3", t});
     for (double t : {1e-4, 1e-6}) p.full.push_back({"cpodes", t});
     p.grids_deg = {30, 20, 10, 5, 2, 1, 0.5};
-    p.variants = {{"cubic", false},  {"akima", false}, {"linear", false},
+    p.variants = {{"cubic", false},   {"akima", false}, {"linear", false},
                   {"fourier", false}, {"cubic", true},  {"fourier", true}};
     p.rk8pd_tolerances = {1e-6, 1e-8, 1e-10};
     p.rkck = true;

@@ -21,13 +21,13 @@ struct LadderPlan {
   std::vector<std::pair<std::string, double>> full;  // (integrator, tolerance)
   std::vector<double> grids_deg;                     // coarse to fine
   std::vector<ReducedVariant> variants;
-  std::vector<double> rk8pd_tolerances;              // ascending accuracy; the last is the tightest
-  bool rkck = false;                                 // one rkck run at 1e-8 per variant
-  std::vector<double> fixed_steps_s;                 // rk4-fixed, from the time scale
+  std::vector<double> rk8pd_tolerances;  // ascending accuracy; the last is the tightest
+  bool rkck = false;                     // one rkck run at 1e-8 per variant
+  std::vector<double> fixed_steps_s;     // rk4-fixed, from the time scale
   RepeatPolicy full_repeats, reduced_repeats;
-  int extraction_repeats_10deg = 1;                  // median of this many for the 10° table
+  int extraction_repeats_10deg = 1;  // median of this many for the 10° table
   double tightest_tolerance() const { return rk8pd_tolerances.back(); }
-  long reduced_runs() const;                         // runs of the reduced ladder
+  long reduced_runs() const;  // runs of the reduced ladder
 };
 
 // `quick`: short ladders and single repeats (suites, smoke runs).

@@ -20,7 +20,8 @@ void mark_pareto(std::vector<RunRecord>& runs, const std::string& q) {
   }
 }
 
-MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& q, double target) {
+MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& q,
+                                    double target) {
   MatchedSpeedup m;
   for (size_t i = 0; i < runs.size(); ++i) {
     const auto& r = runs[i];
@@ -34,11 +35,13 @@ MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const st
     if (r.model != "reduced" || !r.failure.empty() || !(r.error_of(q) <= e_full)) continue;
     if (m.reduced < 0 || r.wall_s < runs[m.reduced].wall_s) m.reduced = static_cast<int>(i);
   }
-  if (m.reduced >= 0 && runs[m.reduced].wall_s > 0) m.speedup = runs[m.full].wall_s / runs[m.reduced].wall_s;
+  if (m.reduced >= 0 && runs[m.reduced].wall_s > 0)
+    m.speedup = runs[m.full].wall_s / runs[m.reduced].wall_s;
   return m;
 }
 
-int pick_recommended(const std::vector<RunRecord>& runs, const std::vector<std::string>& quantities, double target) {
+int pick_recommended(const std::vector<RunRecord>& runs, const std::vector<std::string>& quantities,
+                     double target) {
   int best = -1;
   for (size_t i = 0; i < runs.size(); ++i) {
     const auto& r = runs[i];

@@ -22,9 +22,11 @@ struct MatchedSpeedup {
 
 // The cheapest full run within `target` on `quantity`, then the cheapest reduced run at equal
 // or better error; the speedup is their cost ratio.
-MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& quantity, double target);
+MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& quantity,
+                                    double target);
 
 // The cheapest completed reduced run within `target` on every one of `quantities`; −1 if none.
-int pick_recommended(const std::vector<RunRecord>& runs, const std::vector<std::string>& quantities, double target);
+int pick_recommended(const std::vector<RunRecord>& runs, const std::vector<std::string>& quantities,
+                     double target);
 
 }  // namespace rdyn::validate

@@ -4,9 +4,8 @@
 #pragma once
 
 #include <map>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rdyn::validate {
 
@@ -17,7 +16,8 @@ void render_report(const nlohmann::json& summary, const std::string& dir);
 
 // report.html from the summary and the SVG text of each figure (name → SVG; a missing one
 // is reported as not rendered).
-std::string render_html(const nlohmann::json& summary, const std::map<std::string, std::string>& figures);
+std::string render_html(const nlohmann::json& summary,
+                        const std::map<std::string, std::string>& figures);
 
 // One-paragraph plain-words headline (also printed by the CLI).
 std::string headline(const nlohmann::json& summary);

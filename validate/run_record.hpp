@@ -13,20 +13,20 @@ struct RunRecord {
   std::string model;  // "full" or "reduced"
   double tolerance = 0.0;
   std::string integrator;
-  double grid_deg = 0.0;        // reduced
-  std::string interpolation;    // reduced
+  double grid_deg = 0.0;      // reduced
+  std::string interpolation;  // reduced
   bool energy_consistent = false;
-  double fixed_step_s = 0.0;    // rk4-fixed
-  double wall_s = 0.0;          // median over repeats, the run as simulated [s]
-  double per_simulated_s = 0.0; // wall_s / duration [s per simulated s]
+  double fixed_step_s = 0.0;     // rk4-fixed
+  double wall_s = 0.0;           // median over repeats, the run as simulated [s]
+  double per_simulated_s = 0.0;  // wall_s / duration [s per simulated s]
   int repeats = 0;
   long steps = 0;
-  long rejected = 0;                 // rejected steps (error control)
+  long rejected = 0;  // rejected steps (error control)
   double smallest_step_s = 0.0;
-  double constraint_violation_m = 0.0;  // full model: largest loop gap seen
-  long events = 0;                   // load switches
-  double energy_residual_rel = 0.0;  // max|E − E0 − W| / max|E|
-  double cycles = 0.0;                // revolutions of the independent coordinate in the run
+  double constraint_violation_m = 0.0;    // full model: largest loop gap seen
+  long events = 0;                        // load switches
+  double energy_residual_rel = 0.0;       // max|E − E0 − W| / max|E|
+  double cycles = 0.0;                    // revolutions of the independent coordinate in the run
   double energy_drift_per_cycle_J = 0.0;  // |E − E0 − W| at the end / cycles
   Comparison errors;
   bool pareto = false;

@@ -9,16 +9,20 @@ namespace rdyn::validate {
 namespace {
 
 // JSON has no NaN or infinity: they are written as null ("not measured").
-nlohmann::json num(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+nlohmann::json num(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
 
 nlohmann::json comparison_json(const Comparison& c) {
   nlohmann::json j = nlohmann::json::object();
-  for (const auto& s : c.signals) j[s.name] = {{"max_rel", num(s.max_rel)}, {"rms_rel", num(s.rms_rel)}, {"peak", num(s.peak)}};
+  for (const auto& s : c.signals)
+    j[s.name] = {{"max_rel", num(s.max_rel)}, {"rms_rel", num(s.rms_rel)}, {"peak", num(s.peak)}};
   return {{"errors", j}, {"samples", c.samples}, {"excluded_between_switches", c.excluded}};
 }
 
 // Column-wise table: {"names": [...], "rows": [[...], ...]}.
-nlohmann::json table_json(const std::vector<std::string>& names, const std::vector<std::vector<double>>& cols) {
+nlohmann::json table_json(const std::vector<std::string>& names,
+                          const std::vector<std::vector<double>>& cols) {
   nlohmann::json rows = nlohmann::json::array();
   const size_t n = cols.empty() ? 0 : cols[0].size();
   for (size_t i = 0; i < n; ++i) {
@@ -39,7 +43,8 @@ nlohmann::json figures_json(const ValidationResult& v) {
     for (size_t i = 0; i <= sm.q.size(); ++i) {  // the first point again at +360°
       const size_t k = i % sm.q.size();
       cols[0].push_back((sm.q[k] + (i == sm.q.size() ? 2 * M_PI : 0)) * 180 / M_PI);
-      for (size_t c = 1; c < v.dense_names.size(); ++c) cols[c].push_back(sm.columns[sm.column(v.dense_names[c])][k]);
+      for (size_t c = 1; c < v.dense_names.size(); ++c)
+        cols[c].push_back(sm.columns[sm.column(v.dense_names[c])][k]);
     }
     f["params_samples"] = table_json(v.dense_names, cols);
     f["params_dense"] = table_json(v.dense_names, v.dense_params);
@@ -82,8 +87,12 @@ nlohmann::json calibration_json(const ValidationResult& v) {
                       {"drive_work_per_rev_per_Nm", num(c.drive_work_per_rev_per_Nm)}};
   nlohmann::json cmp = nlohmann::json::array();
   for (const auto& cv : v.compare)
-    cmp.push_back({{"quantity", cv.quantity}, {"value", cv.value}, {"unit", cv.unit}, {"source", cv.source},
-                   {"explanation", cv.explanation}, {"rdyn_value", j.value(cv.quantity, nlohmann::json(nullptr))}});
+    cmp.push_back({{"quantity", cv.quantity},
+                   {"value", cv.value},
+                   {"unit", cv.unit},
+                   {"source", cv.source},
+                   {"explanation", cv.explanation},
+                   {"rdyn_value", j.value(cv.quantity, nlohmann::json(nullptr))}});
   j["compare"] = cmp;
   return j;
 }
@@ -142,38 +151,55 @@ nlohmann::json summary_json(const ValidationResult& v) {
   j["extraction_ms"] = v.extraction_ms;
   nlohmann::json ex = nlohmann::json::array();
   for (const auto& e : v.extractions)
-    ex.push_back({{"grid_deg", e.grid_deg}, {"ms", e.ms}, {"kinetostatic_calls", e.calls}, {"points", e.points}});
+    ex.push_back({{"grid_deg", e.grid_deg},
+                  {"ms", e.ms},
+                  {"kinetostatic_calls", e.calls},
+                  {"points", e.points}});
   j["extractions"] = ex;
   j["headline_quantity"] = v.headline_quantity;
   j["quantities"] = v.quantities;
   j["matched_error_target"] = v.matched_target;
-  j["speedup_at_matched_error"] = v.speedup_at_matched_error ? num(*v.speedup_at_matched_error) : nullptr;
-  j["matched_full"] = v.matched_full >= 0 ? run_json(v.runs[v.matched_full]) : nlohmann::json(nullptr);
-  j["matched_reduced"] = v.matched_reduced >= 0 ? run_json(v.runs[v.matched_reduced]) : nlohmann::json(nullptr);
+  j["speedup_at_matched_error"] =
+      v.speedup_at_matched_error ? num(*v.speedup_at_matched_error) : nullptr;
+  j["matched_full"] =
+      v.matched_full >= 0 ? run_json(v.runs[v.matched_full]) : nlohmann::json(nullptr);
+  j["matched_reduced"] =
+      v.matched_reduced >= 0 ? run_json(v.runs[v.matched_reduced]) : nlohmann::json(nullptr);
   // The settings to use for this scene, chosen from the measurements (validate/pareto.hpp).
-  j["recommended_reduced"] = v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
-  j["showcase_reduced"] = v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
+  j["recommended_reduced"] =
+      v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
+  j["showcase_reduced"] =
+      v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
   nlohmann::json verdicts = nlohmann::json::array();
   for (const auto& d : v.verdicts)
-    verdicts.push_back({{"quantity", d.quantity}, {"error", num(d.error)}, {"limit", num(d.limit)},
-                        {"judged_on", d.judged_on}, {"judged_error", num(d.judged_error)}, {"pass", d.pass},
+    verdicts.push_back({{"quantity", d.quantity},
+                        {"error", num(d.error)},
+                        {"limit", num(d.limit)},
+                        {"judged_on", d.judged_on},
+                        {"judged_error", num(d.judged_error)},
+                        {"pass", d.pass},
                         {"decides", d.decides}});
   j["verdicts"] = verdicts;
   nlohmann::json baselines = nlohmann::json::array();
   for (const auto& b : v.baselines)
-    baselines.push_back({{"what", b.what}, {"label", b.label}, {"wall_s", num(b.wall_s)}, {"speedup", num(b.speedup)}});
+    baselines.push_back({{"what", b.what},
+                         {"label", b.label},
+                         {"wall_s", num(b.wall_s)},
+                         {"speedup", num(b.speedup)}});
   j["baselines"] = baselines;
   if (v.budget)
-    j["error_budget"] = {{"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
-                         {"table", num(v.budget->table)},       {"integration", num(v.budget->integration)},
-                         {"total", num(v.budget->total)},       {"table_run", v.budget->table_run}};
+    j["error_budget"] = {
+        {"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
+        {"table", num(v.budget->table)},   {"integration", num(v.budget->integration)},
+        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run}};
   nlohmann::json conv = nlohmann::json::array();
   for (const auto& s : v.convergence) {
     nlohmann::json pts = nlohmann::json::array();
     for (const auto& [g, e] : s.points) pts.push_back({g, num(e)});
     conv.push_back({{"interpolation", s.interpolation}, {"points", pts}, {"order", num(s.order)}});
   }
-  j["convergence"] = {{"quantity", v.headline_quantity}, {"floor", num(v.convergence_floor)}, {"series", conv}};
+  j["convergence"] = {
+      {"quantity", v.headline_quantity}, {"floor", num(v.convergence_floor)}, {"series", conv}};
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& r : v.runs) runs.push_back(run_json(r));
   j["runs"] = runs;

@@ -13,7 +13,8 @@ constexpr const char* kDefaultInterpolation = "fourier";
 
 // The reduced run a threshold is judged on: its grid and interpolation, plain m2, rk8pd at
 // `tolerance` (the ladder's tightest). Empty when the ladder has no such run.
-std::optional<ThresholdResult> judge_threshold(const models::Threshold& th, const std::vector<RunRecord>& runs,
+std::optional<ThresholdResult> judge_threshold(const models::Threshold& th,
+                                               const std::vector<RunRecord>& runs,
                                                double tolerance);
 
 // The result for a run made outside the ladder for this threshold.

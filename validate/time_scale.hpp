@@ -32,6 +32,8 @@ TimeScale calc_time_scale(const models::TimeSeries& reference, bool rotating);
 std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick);
 
 // Whether a cost per simulated second is a measurement (the run lasted at least that long).
-inline bool per_second_is_measured(double duration_s) { return duration_s >= kMinDurationPerSecond_s; }
+inline bool per_second_is_measured(double duration_s) {
+  return duration_s >= kMinDurationPerSecond_s;
+}
 
 }  // namespace rdyn::validate

@@ -9,8 +9,8 @@ namespace rdyn::validate {
 
 struct RepeatPolicy {
   int min_repeats = 3;
-  int max_repeats = 200;        // bound: a run that is fast but noisy still stops
-  double min_total_s = 0.2;     // repeat until this much wall time has been spent
+  int max_repeats = 200;     // bound: a run that is fast but noisy still stops
+  double min_total_s = 0.2;  // repeat until this much wall time has been spent
 };
 
 // Calls `run` until both min_repeats and min_total_s are reached (or max_repeats); returns

@@ -14,7 +14,8 @@ std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, c
     v.error = rec ? rec->error_of(q) : INFINITY;
     const ThresholdResult* th = nullptr;
     for (const auto& t : thresholds)
-      if (t.threshold.quantity == q && (!th || t.threshold.max_error < th->threshold.max_error)) th = &t;
+      if (t.threshold.quantity == q && (!th || t.threshold.max_error < th->threshold.max_error))
+        th = &t;
     if (th) {
       v.limit = th->threshold.max_error;
       v.judged_on = th->run;
@@ -32,23 +33,25 @@ std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, c
   return out;
 }
 
-std::vector<Baseline> calc_baselines(const RunRecord& rec, const RunRecord& reference, const std::vector<RunRecord>& runs,
-                                     int matched_full) {
+std::vector<Baseline> calc_baselines(const RunRecord& rec, const RunRecord& reference,
+                                     const std::vector<RunRecord>& runs, int matched_full) {
   std::vector<Baseline> out;
   auto add = [&](const char* what, const RunRecord& f) {
-    if (rec.wall_s > 0 && std::isfinite(f.wall_s)) out.push_back({what, f.label(), f.wall_s, f.wall_s / rec.wall_s});
+    if (rec.wall_s > 0 && std::isfinite(f.wall_s))
+      out.push_back({what, f.label(), f.wall_s, f.wall_s / rec.wall_s});
   };
   add("reference", reference);
   if (matched_full >= 0) add("matched-error full run", runs[matched_full]);
   const RunRecord* cheapest = nullptr;
   for (const auto& r : runs)
-    if (r.model == "full" && r.failure.empty() && (!cheapest || r.wall_s < cheapest->wall_s)) cheapest = &r;
+    if (r.model == "full" && r.failure.empty() && (!cheapest || r.wall_s < cheapest->wall_s))
+      cheapest = &r;
   if (cheapest) add("cheapest full run", *cheapest);
   return out;
 }
 
-ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs, double reference_change,
-                              const std::string& q, double tol) {
+ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs,
+                              double reference_change, const std::string& q, double tol) {
   ErrorBudget b;
   b.reference = reference_change;
   b.total = run.error_of(q);

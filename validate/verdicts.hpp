@@ -12,18 +12,19 @@ namespace rdyn::validate {
 
 struct Verdict {
   std::string quantity;
-  double error = 0.0;       // at the recommended setting (+∞ without one)
-  double limit = 0.0;       // the scene's threshold for the quantity, else the matched-error target
-  std::string judged_on;    // the run the pass/fail is decided on
+  double error = 0.0;     // at the recommended setting (+∞ without one)
+  double limit = 0.0;     // the scene's threshold for the quantity, else the matched-error target
+  std::string judged_on;  // the run the pass/fail is decided on
   double judged_error = 0.0;
   bool pass = false;
-  bool decides = false;     // a scene threshold: its failure fails the validation
+  bool decides = false;  // a scene threshold: its failure fails the validation
 };
 
 // Thresholds decide for their quantity (the tightest when several); other quantities are
 // compared with `target` at the recommended setting for information (decides = false), so the
 // table never contradicts the validation's status.
-std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, const RunRecord* recommended,
+std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities,
+                                   const RunRecord* recommended,
                                    const std::vector<ThresholdResult>& thresholds, double target);
 
 struct Baseline {
@@ -46,7 +47,8 @@ struct ErrorBudget {
   double reference = 0.0, table = 0.0, integration = 0.0, total = 0.0;
   std::string table_run;  // empty when the ladder has no tight run at that grid
 };
-ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs, double reference_change,
-                              const std::string& quantity, double tightest_tolerance);
+ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs,
+                              double reference_change, const std::string& quantity,
+                              double tightest_tolerance);
 
 }  // namespace rdyn::validate

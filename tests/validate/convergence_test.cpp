@@ -17,16 +17,20 @@ TEST(Convergence, ObservedOrderOfAPowerLaw) {
   for (double h : {30.0, 20.0, 10.0, 5.0}) pts.push_back({h, 3e-8 * std::pow(h, 4)});
   for (double h : {1.0, 0.5}) pts.push_back({h, 1e-9});
   EXPECT_NEAR(calc_observed_order(pts, 1e-8), 4.0, 1e-12);
-  EXPECT_GT(std::abs(calc_observed_order(pts, 0.0) - 4.0), 0.3);  // kept, the floor points bend the fit
+  EXPECT_GT(std::abs(calc_observed_order(pts, 0.0) - 4.0),
+            0.3);  // kept, the floor points bend the fit
   EXPECT_TRUE(std::isnan(calc_observed_order({{10, 1e-3}}, 0.0)));
-  EXPECT_TRUE(std::isnan(calc_observed_order({{10, 1e-3}, {10, 2e-3}}, 0.0)));  // one grid: no slope
+  EXPECT_TRUE(
+      std::isnan(calc_observed_order({{10, 1e-3}, {10, 2e-3}}, 0.0)));  // one grid: no slope
 }
 
 TEST(Convergence, SeriesPerInterpolationAtTheTightTolerance) {
   std::vector<RunRecord> runs;
   for (double h : {30.0, 10.0, 5.0})
     for (const char* interp : {"cubic", "fourier"}) {
-      auto r = record("reduced", 1e-3, {{"F", std::string(interp) == "cubic" ? 1e-6 * std::pow(h, 4) : 1e-3 * std::pow(h, 2)}});
+      auto r = record(
+          "reduced", 1e-3,
+          {{"F", std::string(interp) == "cubic" ? 1e-6 * std::pow(h, 4) : 1e-3 * std::pow(h, 2)}});
       r.grid_deg = h;
       r.interpolation = interp;
       r.tolerance = 1e-10;

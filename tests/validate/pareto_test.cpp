@@ -13,10 +13,11 @@ using test::record;
 
 std::vector<RunRecord> ladder() {
   return {
-      record("full", 1.0, {{"qdot", 1e-6}, {"F", 1e-6}}),     // 0: accurate, slow
-      record("full", 0.2, {{"qdot", 5e-4}, {"F", 8e-4}}),     // 1: within 1e-3, cheapest such
-      record("full", 0.1, {{"qdot", 1e-2}, {"F", 2e-2}}),     // 2: cheap, outside the target
-      record("reduced", 0.002, {{"qdot", 1e-4}, {"F", 9e-4}}),  // 3: cheap, F worse than run 1's 8e-4
+      record("full", 1.0, {{"qdot", 1e-6}, {"F", 1e-6}}),  // 0: accurate, slow
+      record("full", 0.2, {{"qdot", 5e-4}, {"F", 8e-4}}),  // 1: within 1e-3, cheapest such
+      record("full", 0.1, {{"qdot", 1e-2}, {"F", 2e-2}}),  // 2: cheap, outside the target
+      record("reduced", 0.002,
+             {{"qdot", 1e-4}, {"F", 9e-4}}),  // 3: cheap, F worse than run 1's 8e-4
       record("reduced", 0.004, {{"qdot", 1e-5}, {"F", 7e-4}}),  // 4: matches run 1
       record("reduced", 0.005, {{"qdot", 1e-5}, {"F", 7e-4}}),  // 5: dominated by 4
       record("reduced", 0.001, {{"qdot", 2e-3}, {"F", 3e-3}}),  // 6: cheapest, outside the target
@@ -51,7 +52,8 @@ TEST(Pareto, RecommendedIsTheCheapestWithinTheTargetOnEveryQuantity) {
   EXPECT_EQ(pick_recommended(runs, {"qdot", "F"}, 1e-3), 3);
   EXPECT_EQ(pick_recommended(runs, {"qdot", "F"}, 8e-4), 4);
   EXPECT_EQ(pick_recommended(runs, {"qdot", "F"}, 1e-8), -1);
-  EXPECT_EQ(pick_recommended(runs, {"qdot", "missing"}, 1.0), -1);  // an unmeasured quantity never passes
+  EXPECT_EQ(pick_recommended(runs, {"qdot", "missing"}, 1.0),
+            -1);  // an unmeasured quantity never passes
 }
 
 }  // namespace

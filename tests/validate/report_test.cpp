@@ -26,13 +26,15 @@ TEST(Report, ReRenderedFromASavedSummaryIsTheSame) {
   // Only the saved summary goes into the second rendering.
   const auto saved = nlohmann::json::parse(test::slurp(dir / "a" / "summary.json"));
   render_report(saved, (dir / "b").string());
-  for (const char* f : {"report.html", "runs.csv", "compare.csv", "params.csv", "params_dense.csv", "pareto.gp",
-                        "convergence.csv", "summary.json"})
+  for (const char* f : {"report.html", "runs.csv", "compare.csv", "params.csv", "params_dense.csv",
+                        "pareto.gp", "convergence.csv", "summary.json"})
     EXPECT_EQ(test::slurp(dir / "a" / f), test::slurp(dir / "b" / f)) << f;
   const std::string html = test::slurp(dir / "b" / "report.html");
-  EXPECT_EQ(html.find("could not be rendered"), std::string::npos) << test::slurp(dir / "b" / "gnuplot.log");
+  EXPECT_EQ(html.find("could not be rendered"), std::string::npos)
+      << test::slurp(dir / "b" / "gnuplot.log");
   size_t svgs = 0;
-  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++svgs;
+  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1))
+    ++svgs;
   EXPECT_EQ(svgs, 4u);
   // params.csv: the 12 samples and the first again at 360°.
   const std::string params = test::slurp(dir / "b" / "params.csv");
@@ -103,7 +105,8 @@ TEST(Report, ShortRunsAreNotExtrapolatedPerSecond) {
 // `rdyn report SUMMARY --out DIR`: the same report from the saved summary; a file that is not
 // a summary is bad input (exit 2, the file named, nothing written), never an internal error.
 TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
-  const fs::path dir = fs::temp_directory_path() / ("rdyn_report_cmd_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("rdyn_report_cmd_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "a");
   render_report(summary_json(test::synthetic_validation()), (dir / "a").string());
@@ -126,7 +129,8 @@ TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
   }
   // Numbers removed by hand (null: "not measured") print as n/a, never as nan.
   auto holes = summary_json(test::synthetic_validation());
-  for (const char* k : {"duration_s", "output_interval_s", "speedup_at_matched_error"}) holes[k] = nullptr;
+  for (const char* k : {"duration_s", "output_interval_s", "speedup_at_matched_error"})
+    holes[k] = nullptr;
   holes["runs"][0]["energy_balance_residual_rel"] = nullptr;
   holes["runs"][0]["errors"]["qdot"]["max_rel"] = nullptr;
   holes["extractions"][0]["ms"] = nullptr;
@@ -135,7 +139,8 @@ TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
   r = test::run_rdyn({"report", "holes.json", "--out", "h"}, dir);
   EXPECT_EQ(r.status, 0) << r.err;
   std::string html = test::slurp(dir / "h" / "report.html");
-  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg")) html.erase(at, html.find("</svg>", at) + 6 - at);
+  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg"))
+    html.erase(at, html.find("</svg>", at) + 6 - at);
   EXPECT_EQ(html.find("nan"), std::string::npos);
   EXPECT_EQ(html.find("inf"), std::string::npos);
   EXPECT_NE(html.find("n/a"), std::string::npos);

@@ -14,7 +14,8 @@ void expect_finite(const nlohmann::json& j, const std::string& path = "") {
     EXPECT_TRUE(std::isfinite(j.get<double>())) << path;
   }
   if (j.is_structured())
-    for (auto it = j.begin(); it != j.end(); ++it) expect_finite(*it, path + "/" + (j.is_object() ? it.key() : "[]"));
+    for (auto it = j.begin(); it != j.end(); ++it)
+      expect_finite(*it, path + "/" + (j.is_object() ? it.key() : "[]"));
 }
 
 TEST(Summary, HoldsTheVerdictsBaselinesAndFigureData) {
@@ -26,7 +27,7 @@ TEST(Summary, HoldsTheVerdictsBaselinesAndFigureData) {
   EXPECT_EQ(s["verdicts"][1]["quantity"], "F");
   EXPECT_EQ(s["verdicts"][1]["pass"], true);
   EXPECT_DOUBLE_EQ(s["baselines"][0]["speedup"].get<double>(), 1000.0);  // reference 3 s / 3 ms
-  EXPECT_TRUE(s["runs"][4]["wall_s"].is_null());                        // the stopped run
+  EXPECT_TRUE(s["runs"][4]["wall_s"].is_null());                         // the stopped run
   EXPECT_EQ(s["runs"][4]["failure"], "diverged at t = 0.5 s");
   EXPECT_EQ(s["steady_window"]["whole_run"], true);
   EXPECT_EQ(s["per_second_measured"], true);  // 2 s simulated
@@ -69,18 +70,23 @@ TEST(Summary, SceneDeclaresItsComparison) {
   EXPECT_TRUE(models::load_scene("fourbar").validation.compare.empty());
   const std::string base = "name: x\nbicycle_leg: {}\nvalidation:\n";
   try {
-    models::parse_scene(base + "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: torque, value: 1}]\n",
+    models::parse_scene(base +
+                            "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: "
+                            "torque, value: 1}]\n",
                         "x.yaml");
     FAIL() << "an unknown quantity was accepted";
   } catch (const models::SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("validation.compare[0].quantity"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("validation.compare[0].quantity"), std::string::npos)
+        << e.what();
   }
   // Compared values are calibration results: without calibrate there is nothing to compare.
-  EXPECT_THROW(models::parse_scene(base + "  compare: [{quantity: drive_torque_Nm, value: 1}]\n", "x.yaml"),
-               models::SceneError);
-  EXPECT_THROW(models::parse_scene(base + "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: "
-                                          "drive_torque_Nm, value: .nan}]\n",
-                                   "x.yaml"),
+  EXPECT_THROW(
+      models::parse_scene(base + "  compare: [{quantity: drive_torque_Nm, value: 1}]\n", "x.yaml"),
+      models::SceneError);
+  EXPECT_THROW(models::parse_scene(
+                   base + "  calibrate: {cadence_Hz: 1, power_W: 100}\n  compare: [{quantity: "
+                          "drive_torque_Nm, value: .nan}]\n",
+                   "x.yaml"),
                models::SceneError);
 }
 

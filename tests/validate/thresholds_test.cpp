@@ -10,10 +10,11 @@ namespace {
 using test::record;
 
 TEST(Thresholds, JudgedOnTheMatchingTightRun) {
-  std::vector<RunRecord> runs{record("reduced", 1e-3, {{"qdot", 4e-3}}), record("reduced", 1e-3, {{"qdot", 6e-3}}),
+  std::vector<RunRecord> runs{record("reduced", 1e-3, {{"qdot", 4e-3}}),
+                              record("reduced", 1e-3, {{"qdot", 6e-3}}),
                               record("reduced", 1e-3, {{"qdot", 1e-4}})};
-  runs[0].tolerance = 1e-10;                  // the tight fourier run at 10°: the one judged
-  runs[1].tolerance = 1e-8;                   // same grid, looser: not judged
+  runs[0].tolerance = 1e-10;  // the tight fourier run at 10°: the one judged
+  runs[1].tolerance = 1e-8;   // same grid, looser: not judged
   runs[2].tolerance = 1e-10, runs[2].interpolation = "cubic";  // other interpolation
   const models::Threshold th{"qdot", 10.0, "", 5e-3};
   auto t = judge_threshold(th, runs, 1e-10);

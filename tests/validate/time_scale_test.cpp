@@ -56,7 +56,8 @@ TEST(TimeScale, WithoutARevolutionTheDurationSetsTheScale) {
   s = calc_time_scale(spinning(2 * M_PI, 5.0), false);  // prismatic coordinate
   EXPECT_NEAR(s.period_s, 5.0, 1e-12);
   // The steps are capped at duration / kMinFixedSteps, so even the coarsest one resolves the run.
-  for (double step : calc_fixed_step_ladder(s, false)) EXPECT_LE(step, 5.0 / kMinFixedSteps * (1 + 1e-12));
+  for (double step : calc_fixed_step_ladder(s, false))
+    EXPECT_LE(step, 5.0 / kMinFixedSteps * (1 + 1e-12));
 }
 
 }  // namespace

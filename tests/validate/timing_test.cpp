@@ -31,7 +31,12 @@ TEST(Timing, MinAndMaxRepeatsBound) {
   time_repeats([&] { ++calls; }, {5, 1000, 0.0});
   EXPECT_EQ(calls, 5);  // fast runs: the minimum count
   calls = 0;
-  time_repeats([&] { std::this_thread::sleep_for(std::chrono::milliseconds(1)); ++calls; }, {1, 4, 10.0});
+  time_repeats(
+      [&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ++calls;
+      },
+      {1, 4, 10.0});
   EXPECT_EQ(calls, 4);  // the bound holds even when the minimum time is far away
 }
 

@@ -39,11 +39,12 @@ inline validate::ValidationResult synthetic_validation() {
   v.reference_change.signals = {{"qdot", 7.0, 1e-9, 1e-10}, {"F", 10.0, 2e-9, 1e-10}};
   v.reference_change.samples = 200;
   v.window = {0.0, 1, true, "compared over the whole run"};
-  v.runs = {record("full", 1.0, {{"qdot", 1e-6}, {"F", 1e-6}, {"mean_qdot", 1e-7}}),
-            record("full", 0.3, {{"qdot", 5e-4}, {"F", 6e-4}, {"mean_qdot", 1e-5}}),
-            record("reduced", 0.003, {{"qdot", 2e-4}, {"F", 4e-4}, {"mean_qdot", 1e-6}}),
-            record("reduced", 0.001, {{"qdot", 2e-2}, {"F", 4e-2}, {"mean_qdot", 1e-3}}),
-            record("reduced", INFINITY, {{"qdot", INFINITY}, {"F", INFINITY}, {"mean_qdot", INFINITY}})};
+  v.runs = {
+      record("full", 1.0, {{"qdot", 1e-6}, {"F", 1e-6}, {"mean_qdot", 1e-7}}),
+      record("full", 0.3, {{"qdot", 5e-4}, {"F", 6e-4}, {"mean_qdot", 1e-5}}),
+      record("reduced", 0.003, {{"qdot", 2e-4}, {"F", 4e-4}, {"mean_qdot", 1e-6}}),
+      record("reduced", 0.001, {{"qdot", 2e-2}, {"F", 4e-2}, {"mean_qdot", 1e-3}}),
+      record("reduced", INFINITY, {{"qdot", INFINITY}, {"F", INFINITY}, {"mean_qdot", INFINITY}})};
   v.runs[3].grid_deg = 30;
   v.runs[4].failure = "diverged at t = 0.5 s";
   v.extractions = {{10.0, 12.0, 37, 36}, {30.0, 4.0, 13, 12}};
@@ -56,8 +57,10 @@ inline validate::ValidationResult synthetic_validation() {
   v.matched_full = m.full, v.matched_reduced = m.reduced, v.speedup_at_matched_error = m.speedup;
   v.recommended = validate::pick_recommended(v.runs, {"qdot", "F"}, v.matched_target);
   v.thresholds = {{{"F", 10.0, "", 1e-3}, 4e-4, true, v.runs[2].label()}};
-  v.verdicts = validate::calc_verdicts(v.quantities, &v.runs[v.recommended], v.thresholds, v.matched_target);
-  v.baselines = validate::calc_baselines(v.runs[v.recommended], v.reference_run, v.runs, v.matched_full);
+  v.verdicts =
+      validate::calc_verdicts(v.quantities, &v.runs[v.recommended], v.thresholds, v.matched_target);
+  v.baselines =
+      validate::calc_baselines(v.runs[v.recommended], v.reference_run, v.runs, v.matched_full);
   v.convergence = validate::calc_convergence(v.runs, "F", 1e-8, 1e-8);
   v.reference = sine_series(1.0);
   v.showcase = sine_series(1.001);

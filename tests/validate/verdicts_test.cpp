@@ -38,8 +38,8 @@ TEST(Verdicts, ThresholdsDecideTheirQuantityTheTargetTheOthers) {
 TEST(Verdicts, BaselinesAreCostRatios) {
   const RunRecord rec = record("reduced", 0.01, {{"qdot", 1e-4}});
   const RunRecord ref = record("full", 4.0, {{"qdot", 0.0}});
-  std::vector<RunRecord> runs{record("full", 2.0, {{"qdot", 1e-5}}), record("full", 0.5, {{"qdot", 1e-3}}),
-                              rec};
+  std::vector<RunRecord> runs{record("full", 2.0, {{"qdot", 1e-5}}),
+                              record("full", 0.5, {{"qdot", 1e-3}}), rec};
   runs.push_back(record("full", 0.1, {}));
   runs.back().failure = "stopped";  // not a baseline
   const auto b = calc_baselines(rec, ref, runs, 0);
