@@ -219,6 +219,17 @@ struct Threshold {
   double max_error = 0.005;
 };
 
+// A published value the validation report sets beside rdyn's own (validation.compare).
+// `quantity` names a calibration result (kCompareQuantities); the report prints both values,
+// the source and the explanation of the difference as the scene gives them.
+struct CompareValue {
+  std::string quantity;
+  double value = 0.0;
+  std::string unit, source, explanation;
+};
+inline const std::vector<std::string> kCompareQuantities{"drive_torque_Nm", "peak_force_N", "speed_fluctuation",
+                                                          "mean_power_W"};
+
 struct Validation {
   double duration_s = 0.0;  // 0: simulation.duration_s
   double reference_tolerance = 1e-10;  // full-model reference accuracy (halved to show convergence)
@@ -228,6 +239,7 @@ struct Validation {
   double calibrate_cadence_Hz = 0.0;
   double calibrate_power_W = 0.0;
   std::string note;  // why the scene is hard / what it shows (reports quote it)
+  std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };
 
 struct Scene {

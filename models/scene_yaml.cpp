@@ -716,7 +716,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   if (top.has("validation")) {
     Fields f(top.raw("validation"), "validation", ctx,
              {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
-              "reference_integrator"});
+              "reference_integrator", "compare"});
     s.validation.duration_s = f.num_or("duration_s", 0.0);
     s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
     s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
@@ -739,6 +739,20 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
       if (!(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
     }
+    // Published values the report sets beside the calibration's (e.g. the original authors'
+    // hip torque): plain text, HTML-escaped by the report.
+    for_each_item(f, "compare", [&](const YAML::Node& n, const std::string& path) {
+      Fields c(n, path, ctx, {"quantity", "value", "unit", "source", "explanation"});
+      CompareValue cv{c.str("quantity"), c.num("value"), c.str_or("unit", ""), c.str_or("source", ""),
+                      c.str_or("explanation", "")};
+      if (std::find(kCompareQuantities.begin(), kCompareQuantities.end(), cv.quantity) ==
+          kCompareQuantities.end())
+        c.fail("quantity", "expected drive_torque_Nm, peak_force_N, speed_fluctuation or mean_power_W");
+      if (!std::isfinite(cv.value)) c.fail("value", "must be a finite number");
+      if (!f.has("calibrate"))
+        c.fail("quantity", "compared values are calibration results: add validation.calibrate");
+      s.validation.compare.push_back(cv);
+    });
   }
 }
 

@@ -135,8 +135,11 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
                                    samples.columns[c].size(), npts));
   if (interp == Interpolation::Fourier) {
     if (!samples.periodic) throw TableError("fourier interpolation needs a periodic table");
-    const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 180.0) - 1e-9)));
-    // At 1° or finer the resampling grid is the sample grid, where the trigonometric
+    // Resampled at ≤ 0.25°: the cubic table's own error (∝ h⁴) then sits ~1e-11 of a
+    // parameter's size, below the full-model reference's accuracy; at 1° it was a floor of
+    // ~1.5e-9 that every grid from 10° to 1° hit (issue #14, measured on exp(sin q)).
+    const int refine = std::max(1, static_cast<int>(std::ceil(samples.step / (M_PI / 720.0) - 1e-9)));
+    // At 0.25° or finer the resampling grid is the sample grid, where the trigonometric
     // interpolant equals the samples: skip its direct DFT, which costs N² per column (36 000
     // points: minutes), and build the cubic table from the samples themselves.
     if (refine == 1) return build_table(samples, Interpolation::CubicSpline, energy_consistent_m2);

@@ -1,6 +1,6 @@
 // Calibration: the resistance dissipates P watts at cadence F; find the constant drive
-// (hip) torque that holds the mean steady cadence at F — with the reduced model, confirmed
-// with the full model. The original authors iterated by hand.
+// torque that holds the mean steady cadence at F — with the reduced model, confirmed with the
+// full model (GSL Brent instead of iterating by hand).
 #pragma once
 
 #include <string>
@@ -33,7 +33,7 @@ struct CalibrationResult {
   double peak_force_full_N = 0.0;
   double speed_fluctuation = 0.0;       // (max − min)/mean of q̇ over the steady cycle (reduced)
   double speed_fluctuation_full = 0.0;
-  double drive_work_per_rev_per_Nm = 0.0;  // Σ ∫ r_j·gate dq: e.g. the thighs' descending swing [rad]
+  double drive_work_per_rev_per_Nm = 0.0;  // Σ ∫ r_j·gate dq: the gated joints' swing [rad]
   double steady_q = 0.0, steady_qdot = 0.0;  // a point of the steady cycle (initial conditions)
   int evaluations = 0;                  // steady cycles computed
   double wall_time_s = 0.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <cctype>
 #include <map>
 #include <memory>
@@ -20,6 +21,7 @@
 #include "validate/escape.hpp"
 #include "validate/harness.hpp"
 #include "validate/report.hpp"
+#include "validate/summary.hpp"
 #include "validate/sweep.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
@@ -204,13 +206,13 @@ int run_calibrate(const CalibrateArgs& a) {
       {"scene", scene.name},
       {"target_cadence_hz", a.cadence_hz},
       {"target_power_w", a.power_w},
-      {"hip_torque_Nm", r.torque_Nm},
+      {"drive_torque_Nm", r.torque_Nm},
       {"initial_guess_Nm", r.initial_guess_Nm},
       {"resistance_coefficient", r.resistance_coefficient},
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
       {"mean_cadence_hz_full", r.mean_cadence_hz_full},
       {"mean_power_w", r.mean_power_w},
-      {"peak_knee_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
+      {"peak_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
       {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_full_N)},
       {"force_name", r.force_name},
       {"speed_fluctuation", r.speed_fluctuation},
@@ -236,23 +238,48 @@ namespace {
 nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
                             Progress& progress, bool& pass) {
   const ValidationResult v = run_validation(scene, opt, progress);
-  write_validation_report(v, dir);
+  const nlohmann::json full = summary_json(v);
+  render_report(full, dir);
   pass = v.pass;
   nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
                       {"note", v.note}};
-  const nlohmann::json full = summary_json(v);
   for (const char* k : {"speedup_at_matched_error", "extraction_ms", "thresholds", "reference", "steady_window",
-                        "headline", "matched_full", "matched_reduced"})
+                        "headline", "matched_full", "matched_reduced", "recommended_reduced", "verdicts", "baselines",
+                        "duration_s", "per_second_measured"})
     if (full.contains(k)) j[k] = full[k];
-  if (v.showcase_run >= 0) {
-    nlohmann::json sc = full["runs"][v.showcase_run];
-    j["reduced_10deg"] = sc;
-  }
+  j["headline"] = headline(full);
+  if (v.showcase_run >= 0) j["reduced_10deg"] = full["runs"][v.showcase_run];
   // Stability metrics of both models: the reference's and the default reduced run's energy
   // balance, drift per cycle, constraint violation, accepted/rejected steps, smallest step.
   j["stability"] = {{"full", full["reference"]["stability"]},
                     {"reduced", v.showcase_run >= 0 ? full["runs"][v.showcase_run] : nlohmann::json(nullptr)}};
   return j;
+}
+
+// One row of the suite index: the scene's verdicts in one cell each.
+std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
+  const std::string status = entry.value("status", std::string("error"));
+  std::string verdicts;
+  if (entry.contains("verdicts"))
+    for (const auto& v : entry["verdicts"]) {
+      const double e = v["judged_error"].is_number() ? v["judged_error"].get<double>() : NAN;
+      const double l = v["limit"].is_number() ? v["limit"].get<double>() : NAN;
+      const bool p = v.value("pass", false);
+      if (!v.value("decides", false)) continue;  // the scene's thresholds only (validate/verdicts.hpp)
+      verdicts += fmt::format("<span class={}>{} {} ≤ {} {}</span><br>", p ? "pass" : "fail",
+                              html_escape(v.value("quantity", std::string())),
+                              std::isfinite(e) ? fmt::format("{:.3g} %", 100 * e) : "n/a", fmt::format("{:.3g} %", 100 * l),
+                              p ? "pass" : "FAIL");
+    }
+  std::string speed = "—";
+  if (entry.contains("baselines"))
+    for (const auto& b : entry["baselines"])
+      if (b.value("what", std::string()) == "matched-error full run" && b["speedup"].is_number())
+        speed = fmt::format("{:.3g}×", b["speedup"].get<double>());
+  const std::string what = entry.contains("error") ? entry.value("error", std::string()) : entry.value("note", std::string());
+  return fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td>"
+                     "<td>{3}</td><td class=l>{4}</td></tr>",
+                     html_escape(stem), html_escape(status), verdicts, html_escape(speed), html_escape(what));
 }
 
 }  // namespace
@@ -359,10 +386,7 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
       all_pass = false;
     }
     entry["report"] = stem + "/report.html";
-    const std::string status = entry["status"];
-    const std::string what = entry.contains("error") ? std::string(entry["error"]) : std::string(entry.value("note", ""));
-    rows += fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td></tr>",
-                        html_escape(stem), html_escape(status), html_escape(what));
+    rows += suite_row(stem, entry);
     scenes.push_back(entry);
   }
   write_json(out.file("summary.json"),
@@ -371,8 +395,9 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
                   "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:"
                   "sans-serif;max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{"
                   "border-collapse:collapse}.pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn "
-                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th><th>what "
-                  "it tests / error</th></tr>" + rows + "</table></body></html>\n");
+                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th>"
+                  "<th>verdicts (error, limit)</th><th>speed vs matched full run</th><th>what it tests / error</th></tr>" +
+                  rows + "</table></body></html>\n");
   out.commit();
   std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(),
                all_pass ? "all scenes pass" : "FAILURES", a.out.c_str());
@@ -380,6 +405,39 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
 }
 
 }  // namespace
+
+// Largest summary.json `rdyn report` reads (the bicycle's full ladder writes ~0.7 MB).
+constexpr std::uintmax_t kMaxSummaryBytes = 64u << 20;
+
+int run_report(const ReportArgs& a) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(a.summary, ec))
+    throw ArgumentError(a.summary + ": not a readable file (give the summary.json of `rdyn validate`)");
+  const auto size = fs::file_size(a.summary, ec);
+  if (ec || size > kMaxSummaryBytes)
+    throw ArgumentError(fmt::format("{}: larger than {} MB, not a summary of `rdyn validate`", a.summary,
+                                    kMaxSummaryBytes >> 20));
+  std::ifstream in(a.summary, std::ios::binary);
+  nlohmann::json summary;
+  try {
+    summary = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ArgumentError(fmt::format("{}: not valid JSON ({})", a.summary, e.what()));
+  }
+  if (!summary.is_object() || !summary.contains("scene") || !summary.contains("runs"))
+    throw ArgumentError(a.summary + ": not a summary of `rdyn validate` (no 'scene' and 'runs')");
+  OutputDir out(a.out, a.force);
+  try {
+    render_report(summary, out.file(""));
+  } catch (const nlohmann::json::exception& e) {
+    // A hand-edited summary: a key missing or of the wrong type.
+    throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
+  }
+  out.commit();
+  std::fprintf(stderr, "rdyn: re-rendered %s into %s/report.html\n", a.summary.c_str(), a.out.c_str());
+  return 0;
+}
 
 int run_validate(const ValidateArgs& a) {
   if (!a.suite.empty() && !a.scene.empty()) throw ArgumentError("give a scene or --suite, not both");
@@ -392,9 +450,10 @@ int run_validate(const ValidateArgs& a) {
   ValidationOptions opt;
   opt.quick = a.quick;
   const ValidationResult v = run_validation(scene, opt, progress);
-  write_validation_report(v, out.file(""));
+  const nlohmann::json summary = summary_json(v);
+  render_report(summary, out.file(""));
   out.commit();
-  std::printf("%s\n\nReport: %s/report.html\n", headline(v).c_str(), a.out.c_str());
+  std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
   if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
   return v.pass ? 0 : 1;
 }

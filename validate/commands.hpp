@@ -72,6 +72,14 @@ struct ValidateArgs {
 };
 int run_validate(const ValidateArgs& args);
 
+// Re-renders a report from a summary.json written by `rdyn validate`.
+struct ReportArgs {
+  std::string summary;  // path of summary.json
+  std::string out;      // output folder
+  bool force = false;
+};
+int run_report(const ReportArgs& args);
+
 struct SweepArgs {
   std::string scene;
   std::vector<std::string> vary;

@@ -30,9 +30,11 @@ SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, 
     }
   }
   if (crossings.size() < 3) {
-    w.t_start = 0.2 * T;
-    w.revolutions = 0;
-    w.how = fmt::format("fewer than three full revolutions: the first 20 % ({:.3g} s) is skipped", w.t_start);
+    w.t_start = 0.0;
+    w.revolutions = static_cast<int>(crossings.size());
+    w.whole_run = true;
+    w.how = fmt::format("fewer than three full revolutions in {:.3g} s, so no steady cycles: compared over the whole run",
+                        T);
     return w;
   }
   // Mean speed of revolution k (from crossing k−1 to k; the first one starts at t = 0).

@@ -12,6 +12,7 @@ namespace rdyn::validate {
 struct SteadyWindow {
   double t_start = 0.0;
   int revolutions = 0;  // whole revolutions after t_start
+  bool whole_run = false;  // no steady cycles: compared from t = 0
   std::string how;      // plain-words description for the report
 };
 
@@ -19,8 +20,8 @@ struct SteadyWindow {
 // revolution from which every revolution's mean speed differs from the previous one's by
 // less than `tolerance` (quasi-steady: a heavy flywheel's slow drift toward its final cadence,
 // ~0.3 % per revolution for the bicycle, is not a start-up transient); at least the first
-// revolution is skipped. Without three revolutions (a rocking or stalling mechanism) the
-// first 20 % of the run is skipped instead.
+// revolution is skipped. Without three revolutions (a transient, a rocking or stalling
+// mechanism) there are no steady cycles: the whole run is compared, and `how` says so.
 SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, double tolerance = 1e-2);
 
 struct SignalError {

@@ -12,6 +12,10 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/ladder_plan.hpp"
+#include "validate/pareto.hpp"
+#include "validate/thresholds.hpp"
+#include "validate/timing.hpp"
 
 namespace rdyn::validate {
 
@@ -27,12 +31,6 @@ constexpr long kMinComparedSamples = 20;
 constexpr int kMinSteadyRevolutions = 2;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 void fill_stats(RunRecord& r, const models::TimeSeries& ts) {
   r.cycles = std::abs(ts.q.back() - ts.q.front()) / (2 * M_PI);
@@ -58,13 +56,20 @@ void finish_run(RunRecord& r, const std::vector<double>& walls, const models::Ti
   r.errors = compare_series(v.reference, ts, v.window.t_start);
 }
 
+// |E − E0 − W| relative to the energy scale (models::energy_balance: one implementation).
 double energy_residual_rel(const models::TimeSeries& ts) {
-  double r = 0, e = 0;
-  for (size_t i = 0; i < ts.t.size(); ++i) {
-    r = std::max(r, std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]));
-    e = std::max(e, std::abs(ts.energy[i]));
-  }
-  return e > 0 ? r / e : r;
+  const auto b = models::energy_balance(ts);
+  return b.energy_scale_J > 0 ? b.max_residual_J / b.energy_scale_J : b.max_residual_J;
+}
+
+// A ladder run that stopped (a budget, an energy balance that does not close, divergence,
+// the validity domain) is recorded with its reason instead of ending the validation.
+void record_stopped(RunRecord& r, const std::string& why, ValidationResult& v) {
+  r.failure = why;
+  for (const auto& q : v.quantities) r.errors.signals.push_back({q, 0.0, INFINITY, INFINITY});
+  r.repeats = 0;
+  r.wall_s = r.per_simulated_s = INFINITY;
+  v.runs.push_back(r);
 }
 
 std::string machine_description() {
@@ -83,13 +88,12 @@ std::string machine_description() {
                      os.empty() ? "" : ", " + os);
 }
 
-// Quantity whose error decides the match: the first constraint force (e.g. the knee).
-double error_of(const RunRecord& r, const std::string& q) {
-  const SignalError* s = r.errors.find(q);
-  return s ? s->max_rel : INFINITY;
-}
-
 }  // namespace
+
+double RunRecord::error_of(const std::string& q) const {
+  const SignalError* s = errors.find(q);
+  return s && std::isfinite(s->max_rel) ? s->max_rel : INFINITY;
+}
 
 std::string RunRecord::label() const {
   if (model == "full") return fmt::format("full {} tol {:.0e}", integrator, tolerance);
@@ -98,34 +102,185 @@ std::string RunRecord::label() const {
   return s + fmt::format(" {} tol {:.0e}", integrator, tolerance);
 }
 
-ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
+namespace {
+
+engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol) {
+  engine::ForwardOptions fo;
+  fo.duration_s = v.duration_s;
+  fo.output_interval_s = v.output_interval_s;
+  fo.tolerance = tol;
+  fo.integrator = integrator;
+  return fo;
+}
+
+reduced::ReducedOptions reduced_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                        double h) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = v.duration_s;
+  ro.output_interval_s = v.output_interval_s;
+  ro.tolerance = tol;
+  ro.integrator = integrator;
+  ro.fixed_step_s = h;
+  return ro;
+}
+
+// What is validated, from the scene alone.
+ValidationResult describe(const models::Scene& scene) {
   ValidationResult v;
   v.scene = scene.name;
   v.scene_file = scene.source_file;
   v.note = scene.validation.note;
+  v.compare = scene.validation.compare;
   v.machine = machine_description();
   v.duration_s = scene.validation.duration_s > 0 ? scene.validation.duration_s : scene.simulation.duration_s;
   v.output_interval_s = scene.simulation.output_interval_s;
   v.headline_quantity = scene.outputs.constraint_forces.empty() ? "qdot" : scene.outputs.constraint_forces[0].name;
-  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
-
-  // 1. Reference: full model at a tight tolerance, and the change when it is halved.
+  v.quantities = {"qdot"};
+  for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);
+  v.quantities.push_back("mean_qdot");
   v.reference_tolerance = scene.validation.reference_tolerance;
-  engine::FullModel full(scene);
-  auto full_run = [&](double tol) {
-    engine::ForwardOptions fo;
-    fo.duration_s = v.duration_s;
-    fo.output_interval_s = v.output_interval_s;
-    fo.tolerance = tol;
-    fo.integrator = scene.validation.reference_integrator;
-    return engine::simulate_full(full, fo);
-  };
+  return v;
+}
+
+// Stage 2: the full-model tolerance ladder, each run timed by repeats.
+void run_full_ladder(const std::string& name, engine::FullModel& full, const LadderPlan& plan, ValidationResult& v,
+                     Progress& progress) {
+  const long n = static_cast<long>(plan.full.size());
+  for (long i = 0; i < n; ++i) {
+    progress.count(name + ": full-model tolerance ladder", i, n);
+    RunRecord r;
+    r.model = "full";
+    r.integrator = plan.full[i].first;
+    r.tolerance = plan.full[i].second;
+    models::TimeSeries ts;
+    const auto fo = forward_options(v, r.integrator, r.tolerance);
+    std::vector<double> walls;
+    try {
+      walls = time_repeats([&] { ts = engine::simulate_full(full, fo); }, plan.full_repeats);
+    } catch (const models::NumericalError& e) {
+      record_stopped(r, e.what(), v);
+      continue;
+    }
+    finish_run(r, walls, ts, v);
+    v.runs.push_back(r);
+  }
+  progress.count(name + ": full-model tolerance ladder", n, n);
+}
+
+// Stage 3: the reduced ladder, grid × interpolation (× energy-consistent m2) × integrator. A run
+// that stops (divergence, validity domain) is recorded with its reason.
+void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, ValidationResult& v, Progress& progress) {
+  long done = 0;
+  const long total = plan.reduced_runs();
+  for (double grid : plan.grids_deg) {
+    Extraction e;
+    std::vector<double> ms;
+    for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
+      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic);
+      ms.push_back(e.extraction_ms);
+    }
+    v.extractions.push_back({grid, median(ms), e.calls, static_cast<int>(e.samples.q.size())});
+    if (grid == 10) {
+      v.extraction_ms = median(ms);
+      v.samples10 = e.samples;
+    }
+    for (const auto& var : plan.variants) {
+      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interpolation),
+                                                     var.energy_consistent);
+      auto add_run = [&](const std::string& integrator, double tol, double h) {
+        progress.count(scene.name + ": reduced ladder", done++, total);
+        RunRecord r;
+        r.model = "reduced";
+        r.grid_deg = grid;
+        r.interpolation = var.interpolation;
+        r.energy_consistent = var.energy_consistent;
+        r.integrator = integrator;
+        r.tolerance = tol;
+        r.fixed_step_s = h;
+        const auto ro = reduced_options(v, integrator, tol, h);
+        models::TimeSeries ts;
+        std::vector<double> walls;
+        try {
+          walls = time_repeats([&] { ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro); },
+                               plan.reduced_repeats);
+        } catch (const std::runtime_error& e) {  // TableError (validity domain) or NumericalError
+          record_stopped(r, e.what(), v);
+          return;
+        }
+        finish_run(r, walls, ts, v);
+        v.runs.push_back(r);
+        if (grid == 10 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
+            tol == plan.tightest_tolerance()) {
+          v.showcase = ts;
+          v.showcase_run = static_cast<int>(v.runs.size()) - 1;
+        }
+      };
+      for (double tol : plan.rk8pd_tolerances) add_run("rk8pd", tol, 0.0);
+      if (plan.rkck) add_run("rkck", 1e-8, 0.0);
+      // Fixed-step RK4, the real-time stepper (outputs by dense interpolation).
+      for (double h : plan.fixed_steps_s) add_run("rk4-fixed", 0.0, h);
+    }
+  }
+  progress.count(scene.name + ": reduced ladder", total, total);
+}
+
+// The interpolant of the 10° table at 1° (figure 1).
+void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
+  if (v.samples10.q.empty()) return;
+  const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
+  std::vector<int> cols{m.c_m1, m.c_m2};
+  v.dense_names = {"q_deg", "m1", "m2"};
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    cols.push_back(m.c_me1[k]);
+    cols.push_back(m.c_me2[k]);
+    v.dense_names.push_back("me1_" + m.force_names[k]);
+    v.dense_names.push_back("me2_" + m.force_names[k]);
+  }
+  v.dense_params.assign(cols.size() + 1, {});
+  for (int d = 0; d <= 360; ++d) {
+    const double q = v.samples10.q0 + d * M_PI / 180;
+    v.dense_params[0].push_back(q * 180 / M_PI);
+    for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
+  }
+}
+
+// Stage 6: the scene's thresholds; a grid outside the ladder is run now.
+void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
+  for (const auto& th : scene.validation.thresholds) {
+    auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
+    if (!tr) {
+      const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
+      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic);
+      const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
+      RunRecord r;
+      r.model = "reduced";
+      r.grid_deg = th.grid_deg;
+      r.interpolation = interp;
+      r.integrator = "rk8pd";
+      r.tolerance = v.tightest_tolerance;
+      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot,
+                                                reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0));
+      r.errors = compare_series(v.reference, ts, v.window.t_start);
+      tr = judge_threshold_on(th, r);
+    }
+    if (!tr->pass)
+      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr->error,
+                         th.max_error, tr->run));
+    v.thresholds.push_back(*tr);
+  }
+}
+
+}  // namespace
+
+void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  const std::string integrator = scene.validation.reference_integrator;
   progress.count(scene.name + ": reference (full model)", 0, 2);
   const auto t_ref = Clock::now();
-  v.reference = full_run(v.reference_tolerance);
+  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance));
   v.reference_wall_s = seconds_since(t_ref);
   v.reference_run.model = "full";
-  v.reference_run.integrator = scene.validation.reference_integrator;
+  v.reference_run.integrator = integrator;
   v.reference_run.tolerance = v.reference_tolerance;
   v.reference_run.wall_s = v.reference_wall_s;
   v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
@@ -133,7 +288,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   fill_stats(v.reference_run, v.reference);
   v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
   progress.count(scene.name + ": reference (full model)", 1, 2);
-  const auto half = full_run(v.reference_tolerance / 2);
+  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2));
   progress.count(scene.name + ": reference (full model)", 2, 2);
   v.window = detect_steady_window(v.reference, rotating);
   v.reference_change = compare_series(v.reference, half, v.window.t_start);
@@ -146,214 +301,60 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     v.fail(fmt::format("the run never settles into a steady cycle: only {} revolution(s) after the start-up transient "
                        "({}); lengthen validation.duration_s",
                        v.window.revolutions, v.window.how));
+  v.time_scale = calc_time_scale(v.reference, rotating);
+}
 
-  // 2. Full-model tolerance ladder.
-  // Simbody's Runge–Kutta–Merson over the whole ladder; RK3 and CPodes at loose tolerances,
-  // so the full-model baseline is the cheapest Simbody offers at each accuracy.
-  std::vector<std::pair<std::string, double>> full_runs;
-  if (opt.quick) {
-    full_runs = {{"rkmerson", 1e-5}, {"rkmerson", 1e-7}};
-  } else {
-    for (double t : {1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9}) full_runs.push_back({"rkmerson", t});
-    for (double t : {1e-4, 1e-6}) full_runs.push_back({"rk3", t});
-    for (double t : {1e-4, 1e-6}) full_runs.push_back({"cpodes", t});
-  }
-  const int full_repeats = opt.quick ? 1 : 3;
-  auto full_run_with = [&](const std::string& integrator, double tol) {
-    engine::ForwardOptions fo;
-    fo.duration_s = v.duration_s;
-    fo.output_interval_s = v.output_interval_s;
-    fo.tolerance = tol;
-    fo.integrator = integrator;
-    return engine::simulate_full(full, fo);
-  };
-  for (size_t i = 0; i < full_runs.size(); ++i) {
-    progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(i), static_cast<long>(full_runs.size()));
-    RunRecord r;
-    r.model = "full";
-    r.integrator = full_runs[i].first;
-    r.tolerance = full_runs[i].second;
-    std::vector<double> walls;
-    models::TimeSeries ts;
-    for (int k = 0; k < full_repeats; ++k) {
-      const auto t0 = Clock::now();
-      ts = full_run_with(r.integrator, r.tolerance);
-      walls.push_back(seconds_since(t0));
-    }
-    finish_run(r, walls, ts, v);
-    v.runs.push_back(r);
-  }
-  progress.count(scene.name + ": full-model tolerance ladder", static_cast<long>(full_runs.size()),
-                 static_cast<long>(full_runs.size()));
+void analyse_runs(ValidationResult& v) {
+  mark_pareto(v.runs, v.headline_quantity);
+  const auto matched = calc_matched_speedup(v.runs, v.headline_quantity, v.matched_target);
+  v.matched_full = matched.full;
+  v.matched_reduced = matched.reduced;
+  v.speedup_at_matched_error.reset();
+  if (v.failures.empty()) v.speedup_at_matched_error = matched.speedup;  // no claim from a failed validation
+  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.convergence_floor = 10 * std::max(1e-12, ref ? ref->max_rel : 0.0);
+  v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
+}
 
-  // 3. Reduced ladder: grid × interpolation (× energy-consistent m2) × integrator.
-  if (!rotating) throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
-  const std::vector<double> grids =
-      opt.quick ? std::vector<double>{30, 10, 5} : std::vector<double>{30, 20, 10, 5, 2, 1, 0.5};
-  struct Variant {
-    std::string interp;
-    bool ec;
-  };
-  const std::vector<Variant> variants =
-      opt.quick ? std::vector<Variant>{{"cubic", false}, {"fourier", false}}
-                : std::vector<Variant>{{"cubic", false}, {"akima", false},  {"linear", false},
-                                       {"fourier", false}, {"cubic", true}, {"fourier", true}};
-  const std::vector<double> red_tols = opt.quick ? std::vector<double>{1e-8} : std::vector<double>{1e-6, 1e-8, 1e-10};
-  const int red_repeats = opt.quick ? 3 : 5;
-  long done = 0;
-  const long total = static_cast<long>(grids.size() * variants.size() * (red_tols.size() + (opt.quick ? 1 : 6)));
-  for (double grid : grids) {
-    // Extraction cost: median of three for the paper's 10° grid (amortised in the report).
-    Extraction e;
-    std::vector<double> ms;
-    for (int k = 0; k < (grid == 10 && !opt.quick ? 3 : 1); ++k) {
-      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic);
-      ms.push_back(e.extraction_ms);
-    }
-    v.extractions.push_back({grid, median(ms), e.calls, static_cast<int>(e.samples.q.size())});
-    if (grid == 10) {
-      v.extraction_ms = median(ms);
-      v.samples10 = e.samples;
-    }
-    for (const auto& var : variants) {
-      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interp), var.ec);
-      auto add_run = [&](const std::string& integrator, double tol, double h) {
-        progress.count(scene.name + ": reduced ladder", done++, total);
-        RunRecord r;
-        r.model = "reduced";
-        r.grid_deg = grid;
-        r.interpolation = var.interp;
-        r.energy_consistent = var.ec;
-        r.integrator = integrator;
-        r.tolerance = tol;
-        r.fixed_step_s = h;
-        reduced::ReducedOptions ro;
-        ro.duration_s = v.duration_s;
-        ro.output_interval_s = v.output_interval_s;
-        ro.tolerance = tol;
-        ro.integrator = integrator;
-        ro.fixed_step_s = h;
-        std::vector<double> walls;
-        models::TimeSeries ts;
-        try {
-          for (int k = 0; k < red_repeats; ++k) {
-            const auto t0 = Clock::now();
-            ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
-            walls.push_back(seconds_since(t0));
-          }
-        } catch (const std::runtime_error& e) {  // TableError or NumericalError: the run is recorded as stopped
-          // A run that stops (divergence, validity domain) is recorded as failed, with its reason.
-          r.failure = e.what();
-          r.errors.signals.push_back({"qdot", 0.0, INFINITY, INFINITY});
-          for (const auto& c : scene.outputs.constraint_forces) r.errors.signals.push_back({c.name, 0.0, INFINITY, INFINITY});
-          r.errors.signals.push_back({"mean_qdot", 0.0, INFINITY, INFINITY});
-          r.repeats = 0;
-          r.wall_s = r.per_simulated_s = INFINITY;
-          v.runs.push_back(r);
-          return;
-        }
-        finish_run(r, walls, ts, v);
-        v.runs.push_back(r);
-        if (grid == 10 && var.interp == "fourier" && !var.ec && integrator == "rk8pd" && tol == red_tols.back()) {
-          v.showcase = ts;
-          v.showcase_run = static_cast<int>(v.runs.size()) - 1;
-        }
-      };
-      for (double tol : red_tols) add_run("rk8pd", tol, 0.0);
-      if (!opt.quick) add_run("rkck", 1e-8, 0.0);
-      // Fixed-step RK4, the real-time stepper (outputs by dense interpolation).
-      for (double h : opt.quick ? std::vector<double>{5e-3} : std::vector<double>{1e-3, 5e-3, 1e-2, 2e-2, 4e-2})
-        add_run("rk4-fixed", 0.0, h);
-    }
-  }
-  progress.count(scene.name + ": reduced ladder", total, total);
+void calc_first_screen(ValidationResult& v) {
+  const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
+  v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
+  v.baselines.clear();
+  v.budget.reset();
+  if (!rec) return;
+  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
+}
 
-  // Interpolants of the 10° table at 1° (figure 1).
-  if (!v.samples10.q.empty()) {
-    const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
-    std::vector<int> cols{m.c_m1, m.c_m2};
-    v.dense_names = {"q_deg", "m1", "m2"};
-    for (size_t k = 0; k < m.c_me1.size(); ++k) {
-      cols.push_back(m.c_me1[k]);
-      cols.push_back(m.c_me2[k]);
-      v.dense_names.push_back("me1_" + m.force_names[k]);
-      v.dense_names.push_back("me2_" + m.force_names[k]);
-    }
-    v.dense_params.assign(cols.size() + 1, {});
-    for (int d = 0; d <= 360; ++d) {
-      const double q = v.samples10.q0 + d * M_PI / 180;
-      v.dense_params[0].push_back(q * 180 / M_PI);
-      for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
-    }
-  }
-
-  // 4. Pareto front (error of the headline quantity vs time) and the matched-error speedup:
-  //    the cheapest full run within the target, then the cheapest reduced run at equal or
-  //    better error.
-  for (auto& r : v.runs) {
-    r.pareto = true;
-    for (const auto& o : v.runs)
-      if (o.model == r.model && &o != &r && o.per_simulated_s <= r.per_simulated_s &&
-          error_of(o, v.headline_quantity) <= error_of(r, v.headline_quantity) &&
-          (o.per_simulated_s < r.per_simulated_s || error_of(o, v.headline_quantity) < error_of(r, v.headline_quantity)))
-        r.pareto = false;
-  }
-  for (size_t i = 0; i < v.runs.size(); ++i) {
-    const auto& r = v.runs[i];
-    if (r.model != "full" || error_of(r, v.headline_quantity) > v.matched_target) continue;
-    if (v.matched_full < 0 || r.per_simulated_s < v.runs[v.matched_full].per_simulated_s) v.matched_full = static_cast<int>(i);
-  }
-  if (v.matched_full >= 0) {
-    const double e_full = error_of(v.runs[v.matched_full], v.headline_quantity);
-    for (size_t i = 0; i < v.runs.size(); ++i) {
-      const auto& r = v.runs[i];
-      if (r.model != "reduced" || error_of(r, v.headline_quantity) > e_full) continue;
-      if (v.matched_reduced < 0 || r.per_simulated_s < v.runs[v.matched_reduced].per_simulated_s)
-        v.matched_reduced = static_cast<int>(i);
-    }
-    if (v.matched_reduced >= 0 && v.failures.empty())
-      v.speedup_at_matched_error = v.runs[v.matched_full].per_simulated_s / v.runs[v.matched_reduced].per_simulated_s;
-  }
-
+ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
+  ValidationResult v = describe(scene);
+  // 1. Reference: full model at a tight tolerance, and the change when it is halved; the
+  //    scene's time scale from it sets the fixed steps of the ladder.
+  engine::FullModel full(scene);
+  run_reference(scene, full, v, progress);
+  const LadderPlan plan = plan_ladders(v.time_scale, opt.quick);
+  v.fixed_steps = plan.fixed_steps_s;
+  v.tightest_tolerance = plan.tightest_tolerance();
+  // 2–3. The ladders.
+  run_full_ladder(scene.name, full, plan, v, progress);
+  if (scene.find_joint(scene.independent)->type != models::JointType::Revolute)
+    throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
+  run_reduced_ladder(scene, plan, v, progress);
+  calc_dense_params(scene, v);
+  // 4. Pareto front, matched-error speedup, recommended setting, convergence.
+  analyse_runs(v);
   // 5. Calibration (scenes that declare an operating point).
   if (scene.validation.calibrate_cadence_Hz > 0) {
     v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
     v.calibration_options.power_w = scene.validation.calibrate_power_W;
-    progress.note(scene.name + ": calibrating the drive torque");
+    progress.note(scene.name + ": calibrating the drive load");
     v.calibration = calibrate(scene, v.calibration_options, progress);
   }
-
-  // 6. Acceptance thresholds: the reduced run at that grid and interpolation (default
-  //    fourier), rk8pd at the tightest tolerance.
-  for (const auto& th : scene.validation.thresholds) {
-    ThresholdResult tr{th, INFINITY, false, "no matching run"};
-    const std::string interp = th.interpolation.empty() ? "fourier" : th.interpolation;
-    for (const auto& r : v.runs)
-      if (r.model == "reduced" && std::abs(r.grid_deg - th.grid_deg) < 1e-9 && r.interpolation == interp &&
-          !r.energy_consistent && r.integrator == "rk8pd" && r.tolerance == red_tols.back()) {
-        tr.error = error_of(r, th.quantity);
-        tr.run = r.label();
-      }
-    if (tr.run == "no matching run" && std::find(grids.begin(), grids.end(), th.grid_deg) == grids.end()) {
-      // A grid outside the ladder: run it now.
-      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic);
-      const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
-      reduced::ReducedOptions ro;
-      ro.duration_s = v.duration_s;
-      ro.output_interval_s = v.output_interval_s;
-      ro.tolerance = red_tols.back();
-      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
-      RunRecord r;
-      r.errors = compare_series(v.reference, ts, v.window.t_start);
-      tr.error = error_of(r, th.quantity);
-      tr.run = fmt::format("reduced {:g}° {} rk8pd tol {:.0e}", th.grid_deg, interp, red_tols.back());
-    }
-    tr.pass = tr.error <= th.max_error;
-    if (!tr.pass)
-      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr.error,
-                         th.max_error, tr.run));
-    v.thresholds.push_back(tr);
-  }
+  // 6–7. Thresholds, then the first screen: verdicts, baselines, error budget.
+  judge_thresholds(scene, v);
+  calc_first_screen(v);
   return v;
 }
 

@@ -6,53 +6,19 @@
 #include <string>
 #include <vector>
 
+#include "engine/full_model.hpp"
 #include "models/scene.hpp"
 #include "models/timeseries.hpp"
 #include "reduced/samples.hpp"
 #include "validate/calibrate.hpp"
 #include "validate/compare.hpp"
+#include "validate/convergence.hpp"
 #include "validate/progress.hpp"
+#include "validate/run_record.hpp"
+#include "validate/time_scale.hpp"
+#include "validate/verdicts.hpp"
 
 namespace rdyn::validate {
-
-struct RunRecord {
-  std::string model;  // "full" or "reduced"
-  double tolerance = 0.0;
-  std::string integrator;
-  double grid_deg = 0.0;        // reduced
-  std::string interpolation;    // reduced
-  bool energy_consistent = false;
-  double fixed_step_s = 0.0;    // rk4-fixed
-  double wall_s = 0.0;          // median over repeats, whole run
-  double per_simulated_s = 0.0; // wall_s / duration [s per simulated s]
-  int repeats = 0;
-  long steps = 0;
-  long rejected = 0;                 // rejected steps (error control)
-  double smallest_step_s = 0.0;
-  double constraint_violation_m = 0.0;  // full model: largest loop gap seen
-  long events = 0;                   // load switches
-  double energy_residual_rel = 0.0;  // max|E − E0 − W| / max|E|
-  double cycles = 0.0;                // revolutions of the independent coordinate in the run
-  double energy_drift_per_cycle_J = 0.0;  // |E − E0 − W| at the end / cycles
-  Comparison errors;
-  bool pareto = false;
-  std::string failure;  // why the run stopped (empty when it completed)
-  std::string label() const;
-};
-
-struct ExtractionRecord {
-  double grid_deg = 0.0;
-  double ms = 0.0;  // median wall time of the extraction [ms]
-  long calls = 0;   // kinetostatic calls
-  int points = 0;
-};
-
-struct ThresholdResult {
-  models::Threshold threshold;
-  double error = 0.0;
-  bool pass = false;
-  std::string run;
-};
 
 struct ValidationOptions {
   bool quick = false;  // shorter ladders and single repeats (suites, smoke runs)
@@ -60,7 +26,10 @@ struct ValidationOptions {
 
 struct ValidationResult {
   std::string scene, scene_file, note, machine;
+  std::vector<models::CompareValue> compare;  // published values the scene compares with
   double duration_s = 0.0, output_interval_s = 0.0;
+  TimeScale time_scale;              // the scene's, from the reference
+  std::vector<double> fixed_steps;   // rk4-fixed ladder derived from it [s]
   double reference_tolerance = 0.0;
   double reference_wall_s = 0.0;
   RunRecord reference_run;  // the reference's own stability metrics
@@ -68,11 +37,19 @@ struct ValidationResult {
   SteadyWindow window;
   std::vector<RunRecord> runs;
   std::vector<ExtractionRecord> extractions;
-  double extraction_ms = 0.0;  // the 10° table (the paper's grid)
+  double extraction_ms = 0.0;  // the 10° table
+  double tightest_tolerance = 0.0;  // of the reduced rk8pd ladder
   std::string headline_quantity;  // the error that matches: first constraint force, else qdot
+  std::vector<std::string> quantities;  // qdot, the constraint forces, mean_qdot
   double matched_target = 1e-3;
   std::optional<double> speedup_at_matched_error;
   int matched_full = -1, matched_reduced = -1;  // indices into runs
+  int recommended = -1;                         // cheapest reduced run within the target (index)
+  std::vector<Verdict> verdicts;
+  std::vector<Baseline> baselines;              // the recommended run against full-model runs
+  std::optional<ErrorBudget> budget;            // of the recommended run, headline quantity
+  std::vector<ConvergenceSeries> convergence;   // headline quantity against the grid
+  double convergence_floor = 0.0;               // 10× the reference's own change
   models::TimeSeries reference, showcase;        // showcase: reduced, 10°, default settings
   int showcase_run = -1;
   reduced::Samples samples10;                    // the 10° table
@@ -92,7 +69,21 @@ struct ValidationResult {
   std::string failure_summary() const;
 };
 
-// Runs everything (engine + reduced) for one scene. Throws on scene/engine errors.
+// Runs everything (engine + reduced) for one scene. Throws on scene/engine errors. The
+// stages, in order: run_reference, plan_ladders (validate/ladder_plan.hpp), the full and reduced
+// ladders, analyse_runs, calibration, thresholds, calc_first_screen.
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress);
+
+// Stage 1: the reference (full model at the scene's reference tolerance), its change when the
+// tolerance is halved, the compared window and the scene's time scale, into `v` (whose
+// duration, output interval and reference tolerance are set).
+void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress);
+
+// Stage 4 (no simulation): Pareto front, matched-error speedup, recommended setting and
+// convergence series from v.runs.
+void analyse_runs(ValidationResult& v);
+
+// Stage 7 (no simulation): verdicts, baselines and error budget at the recommended setting.
+void calc_first_screen(ValidationResult& v);
 
 }  // namespace rdyn::validate

@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
       "calibrate",
       "Set the scene's resistance to dissipate P watts at cadence F, then find (GSL Brent) the constant drive "
       "torque that holds the mean steady cadence at F with the reduced model, confirmed with the full model. "
-      "Prints JSON on standard output (hip_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
-      "mean_power_w, peak_knee_force_N, speed_fluctuation, ...); progress goes to standard error.");
+      "Prints JSON on standard output (drive_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
+      "mean_power_w, force_name and its peak_force_N, speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
   calibrate->add_option("--cadence-hz", cal.cadence_hz, "Target cadence [Hz] (default 1)");
   calibrate->add_option("--power-w", cal.power_w, "Power the resistance dissipates at that cadence [W] (default 125)");
@@ -99,10 +99,12 @@ int main(int argc, char** argv) {
   auto* validate = app.add_subcommand(
       "validate",
       "Validate the reduced model against full forward dynamics: a converged reference, a ladder of full-model "
-      "tolerances and of reduced models (grid × interpolation × integrator), errors over the steady cycles, median "
-      "timings, the matched-error speedup, calibration when the scene declares an operating point. Writes "
-      "DIR/summary.json, the CSVs and gnuplot scripts behind every figure, and DIR/report.html. With --suite, "
-      "every scene of a folder (exit status 1 if any fails its thresholds).");
+      "tolerances and of reduced models (grid × interpolation × integrator; fixed steps from the scene's time "
+      "scale), errors over the steady cycles (the whole run when it has none), median timings of repeats up to a "
+      "minimum wall time, the matched-error speedup, calibration when the scene declares an operating point. Writes "
+      "DIR/summary.json (every number and the data of every figure), the CSVs and gnuplot scripts behind every "
+      "figure, and DIR/report.html (rendered from summary.json; verdicts first). With --suite, every scene of a "
+      "folder and an index with their verdicts (exit status 1 if any fails its thresholds).");
   validate->add_option("scene", val.scene, "Scene name or YAML file");
   validate->add_option("--suite", val.suite, "Folder of scenes to validate (each may declare thresholds)");
   validate->add_option("--out", val.out, "Output folder (written atomically)")->required();
@@ -111,12 +113,21 @@ int main(int argc, char** argv) {
   validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
   validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
 
+  ReportArgs rep;
+  auto* report = app.add_subcommand(
+      "report",
+      "Re-render a validation report from its summary.json alone (e.g. after editing a gnuplot style or moving "
+      "the folder): writes DIR/report.html, the figures' data, scripts and SVGs, and a copy of the summary.");
+  report->add_option("summary", rep.summary, "summary.json written by `rdyn validate`")->required();
+  report->add_option("--out", rep.out, "Output folder (written atomically)")->required();
+  report->add_flag("--force", rep.force, kForceHelpDir);
+
   SweepArgs sw;
   auto* sweep = app.add_subcommand(
       "sweep",
       "Population sweep: calibrate the drive torque of many cases with the reduced model, in parallel threads. "
-      "One CSV row per case: the varied parameters, the calibrated hip torque, the peak of the first constraint "
-      "force (e.g. the knee) and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
+      "One CSV row per case: the varied parameters, the calibrated drive torque, the peak of the first constraint "
+      "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
       "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
   sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
   sweep->add_option("--vary", sw.vary, "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)")
@@ -150,6 +161,7 @@ int main(int argc, char** argv) {
     if (*calibrate) return run_calibrate(cal);
     if (*validate) return run_validate(val);
     if (*sweep) return run_sweep_command(sw);
+    if (*report) return run_report(rep);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

@@ -1,23 +1,25 @@
-// Writes the outputs of `rdyn validate`: summary.json, the CSVs behind every figure, the
-// gnuplot scripts and their SVGs, and a self-contained report.html.
+// The report of `rdyn validate`, rendered from summary.json alone (validate/summary.hpp): the
+// CSVs behind every figure, gnuplot scripts and their SVGs, and a self-contained report.html
+// whose first screen is the verdict table. Every string a scene gave is HTML-escaped.
 #pragma once
 
-#include <string>
-
+#include <map>
 #include <nlohmann/json.hpp>
-
-#include "validate/harness.hpp"
-#include "validate/output_dir.hpp"
+#include <string>
 
 namespace rdyn::validate {
 
-nlohmann::json summary_json(const ValidationResult& v);
+// Writes summary.json, the figure data and scripts, renders the figures with gnuplot (no
+// shell) and writes report.html into `dir` (a folder being written). When gnuplot fails the
+// report says so and names the log.
+void render_report(const nlohmann::json& summary, const std::string& dir);
 
-// Everything for one scene into `dir` (a folder being written). Figures need gnuplot;
-// when it fails the report says so and names the log.
-void write_validation_report(const ValidationResult& v, const std::string& dir);
+// report.html from the summary and the SVG text of each figure (name → SVG; a missing one
+// is reported as not rendered).
+std::string render_html(const nlohmann::json& summary,
+                        const std::map<std::string, std::string>& figures);
 
 // One-paragraph plain-words headline (also printed by the CLI).
-std::string headline(const ValidationResult& v);
+std::string headline(const nlohmann::json& summary);
 
 }  // namespace rdyn::validate

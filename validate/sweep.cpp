@@ -114,7 +114,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   if (opt.shard == 0) {
     csv = "case";
     for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
-    csv += fmt::format(",status,hip_torque_Nm,mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n",
+    csv += fmt::format(",status,drive_torque_Nm,mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n",
                        force.empty() ? "constraint" : force);
   }
   for (const auto& r : rows) csv += r + "\n";

@@ -33,8 +33,18 @@ TEST(Compare, SteadyWindowSkipsTheTransient) {
   EXPECT_GT(w.t_start, 1.5);
   EXPECT_LT(w.t_start, 4.0);
   EXPECT_GE(w.revolutions, 5);
+  EXPECT_FALSE(w.whole_run);
+  // Without revolutions (a rocking mechanism, a transient) the whole run is compared.
   const auto rocking = detect_steady_window(ts, false);
-  EXPECT_NEAR(rocking.t_start, 2.0, 1e-9);  // 20 % of 10 s
+  EXPECT_EQ(rocking.t_start, 0.0);
+  EXPECT_TRUE(rocking.whole_run);
+  EXPECT_NE(rocking.how.find("whole run"), std::string::npos);
+  // Two revolutions only (the first 2.1 s): still no steady cycles.
+  auto short_run = ts;
+  const size_t n = 2100;
+  for (auto* v : {&short_run.t, &short_run.q, &short_run.qdot, &short_run.forces[0]}) v->resize(n);
+  short_run.gates.resize(n);
+  EXPECT_TRUE(detect_steady_window(short_run, true).whole_run);
 }
 
 TEST(Compare, RelativeErrorsAndGateExclusion) {

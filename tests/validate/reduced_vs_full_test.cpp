@@ -9,25 +9,16 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/compare.hpp"
 
 namespace rdyn::validate {
 namespace {
 
+// Errors over the reference's steady cycles, by the harness's own comparison (one
+// implementation: samples between the two models' switch instants are excluded there).
 struct Errors {
-  double qdot, force;  // max |full − reduced| after 1 s, relative to the full model's peak
+  double qdot, force;  // max |full − reduced| relative to the full model's peak
 };
-
-Errors compare(const models::TimeSeries& f, const models::TimeSeries& r) {
-  double pq = 0, pf = 0, eq = 0, ef = 0;
-  for (size_t i = 0; i < f.t.size(); ++i) {
-    if (f.t[i] < 1.0) continue;
-    pq = std::max(pq, std::abs(f.qdot[i]));
-    pf = std::max(pf, std::abs(f.forces[0][i]));
-    eq = std::max(eq, std::abs(f.qdot[i] - r.qdot[i]));
-    ef = std::max(ef, std::abs(f.forces[0][i] - r.forces[0][i]));
-  }
-  return {eq / pq, ef / pf};
-}
 
 class BicycleReducedVsFull : public ::testing::Test {
  protected:
@@ -39,6 +30,7 @@ class BicycleReducedVsFull : public ::testing::Test {
     opt.output_interval_s = 0.005;
     opt.tolerance = 1e-10;
     full_ = new models::TimeSeries(engine::simulate_full(model, opt));
+    window_ = detect_steady_window(*full_, true);
   }
   static void TearDownTestSuite() {
     delete scene_;
@@ -50,18 +42,27 @@ class BicycleReducedVsFull : public ::testing::Test {
     reduced::ReducedOptions opt;
     opt.duration_s = 5.0;
     opt.output_interval_s = 0.005;
-    return compare(*full_, reduced::simulate_reduced(m, scene_->initial.q, scene_->initial.qdot, opt));
+    opt.tolerance = 1e-10;  // integration error far below the table's
+    const auto c = compare_series(*full_, reduced::simulate_reduced(m, scene_->initial.q, scene_->initial.qdot, opt),
+                                  window_.t_start);
+    return {c.find("qdot")->max_rel, c.find("knee")->max_rel};
   }
   static models::Scene* scene_;
   static models::TimeSeries* full_;
+  static SteadyWindow window_;
 };
+SteadyWindow BicycleReducedVsFull::window_;
 models::Scene* BicycleReducedVsFull::scene_ = nullptr;
 models::TimeSeries* BicycleReducedVsFull::full_ = nullptr;
 
-TEST_F(BicycleReducedVsFull, WithinHalfAPercentAtTenDegrees) {
+// Bounds a few times the measured errors (2.0e-6 on the speed, 1.73e-3 on the knee force at
+// 10° fourier, rk8pd 1e-10, measured 2026-11-22), so a regression of the table, the
+// interpolation or the comparison fails here instead of hiding under the scene's 0.5 %.
+TEST_F(BicycleReducedVsFull, TenDegreesWithinMeasuredErrors) {
   const Errors e = run(10, reduced::Interpolation::Fourier);
-  EXPECT_LT(e.qdot, 5e-3);
-  EXPECT_LT(e.force, 5e-3);
+  EXPECT_LT(e.qdot, 1e-5);
+  EXPECT_LT(e.force, 3e-3);
+  EXPECT_GT(e.force, 1e-4);  // the 10° table does not resolve the knee-force peak exactly
   RecordProperty("qdot_error_10deg", std::to_string(e.qdot));
   RecordProperty("knee_error_10deg", std::to_string(e.force));
 }

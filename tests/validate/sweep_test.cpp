@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <sstream>
+
 #include "models/scene.hpp"
 
 namespace rdyn::validate {
@@ -41,6 +43,22 @@ TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   // header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
   EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 4);
   EXPECT_EQ(whole.find("error"), whole.find("error\n"));  // only the header's column name
+  EXPECT_NE(whole.find(",status,drive_torque_Nm,"), std::string::npos) << whole;
+  EXPECT_NE(whole.find(",peak_knee_force_N,"), std::string::npos) << whole;  // the scene's force name
+  // Column 4 (case, two axes, status, torque): the torque falls as the crank lengthens.
+  std::vector<double> torque;
+  std::istringstream lines(whole);
+  std::string line;
+  std::getline(lines, line);  // header
+  while (std::getline(lines, line)) {
+    std::istringstream cells(line);
+    std::string cell;
+    for (int c = 0; c <= 4; ++c) std::getline(cells, cell, ',');
+    torque.push_back(std::stod(cell));
+  }
+  ASSERT_EQ(torque.size(), 3u);
+  EXPECT_GT(torque[0], torque[1]);
+  EXPECT_GT(torque[1], torque[2]);
 }
 
 }  // namespace

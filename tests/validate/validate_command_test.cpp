@@ -1,4 +1,5 @@
-// `rdyn validate` end to end on a small suite: outputs, thresholds and exit status.
+// `rdyn validate` end to end on a small suite: outputs, thresholds, verdicts, exit status, and a
+// 30 ms transient.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -12,6 +13,38 @@
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(f)), {});
+}
+
+// A 30 ms transient (issue #14): the shipped four-bar's geometry started from rest by a strong
+// motor, about 1.5 accelerating revolutions.
+constexpr const char* kTransient = R"(name: transient
+ground_points: {A: [0.0, 0.0], D: [0.30, 0.0]}
+bodies:
+  - {name: crank,   mass_kg: 0.50, com_m: [0.04, 0], inertia_kgm2: 2.667e-4, points: {B: [0.08, 0]}}
+  - {name: coupler, mass_kg: 1.20, com_m: [0.14, 0], inertia_kgm2: 7.84e-3,  points: {C: [0.28, 0]}}
+  - {name: rocker,  mass_kg: 0.90, com_m: [0.10, 0], inertia_kgm2: 3.0e-3,   points: {C: [0.20, 0]}}
+joints:
+  - {name: crank,   type: revolute, parent: ground, parent_point: A, child: crank,   child_point: [0, 0], guess_deg: 30}
+  - {name: coupler, type: revolute, parent: crank,  parent_point: B, child: coupler, child_point: [0, 0], guess_deg: 4.85}
+  - {name: rocker,  type: revolute, parent: ground, parent_point: D, child: rocker,  child_point: [0, 0], guess_deg: 90.27}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+independent: crank
+loads:
+  - {type: motor, name: motor, joint: crank, stall_torque_Nm: 150.0, no_load_speed_rad_s: 3000.0}
+gravity: {enabled: true, g_m_s2: [0, -9.81]}
+outputs:
+  constraint_forces:
+    - {name: rocker_axial, joint: rocker, direction: C}
+initial: {q_deg: 30, qdot: 0.0}
+simulation: {duration_s: 0.03, output_interval_s: 1.0e-4}
+validation:
+  thresholds: [{quantity: qdot, grid_deg: 10, max_error: 1.0e-3}]
+)";
 
 int run(const std::string& args, std::string& out) {
   FILE* p = popen((std::string(RDYN_BINARY) + " " + args + " 2>&1").c_str(), "r");
@@ -32,26 +65,53 @@ TEST(ValidateCommand, SuiteWritesReportsAndFailsOnAThreshold) {
   std::ofstream(dir / "suite" / "a_pass.yaml") << text << "validation: {duration_s: 2, thresholds: [{quantity: qdot, grid_deg: 10, max_error: 0.05}]}\n";
   std::ofstream(dir / "suite" / "b_fail.yaml") << text << "validation: {duration_s: 2, thresholds: [{quantity: rocker_axial, grid_deg: 30, max_error: 1.0e-12}]}\n";
   std::ofstream(dir / "suite" / "c_broken.yaml") << "name: broken\nbodies: 3\n";
+  std::ofstream(dir / "suite" / "d_transient.yaml") << kTransient;
   std::string out;
   const int status = run("validate --suite " + (dir / "suite").string() + " --out " + (dir / "out").string(), out);
   EXPECT_EQ(status, 1) << out;
   std::ifstream sf(dir / "out" / "summary.json");
   const auto j = nlohmann::json::parse(sf);
-  ASSERT_EQ(j["scenes"].size(), 3u);
+  ASSERT_EQ(j["scenes"].size(), 4u);
   EXPECT_EQ(j["scenes"][0]["status"], "pass");
   EXPECT_EQ(j["scenes"][1]["status"], "fail");
   EXPECT_EQ(j["scenes"][2]["status"], "error");
-  EXPECT_TRUE(fs::exists(dir / "out" / "index.html"));
+  EXPECT_EQ(j["scenes"][3]["status"], "pass") << j["scenes"][3].dump(1);
+  // The index carries each scene's verdicts: the failing threshold shows as FAIL on its row.
+  const std::string index = slurp(dir / "out" / "index.html");
+  const size_t row_b = index.find("b_fail/report.html"), row_c = index.find("c_broken/report.html");
+  ASSERT_NE(row_b, std::string::npos);
+  ASSERT_NE(row_c, std::string::npos);
+  EXPECT_NE(index.substr(row_b, row_c - row_b).find("rocker_axial"), std::string::npos);
+  EXPECT_NE(index.substr(row_b, row_c - row_b).find("FAIL"), std::string::npos);
   for (const char* f : {"report.html", "summary.json", "params.svg", "timeseries.svg", "pareto.svg", "convergence.svg",
                         "params.gp", "compare.csv", "runs.csv"})
     EXPECT_TRUE(fs::exists(dir / "out" / "a_pass" / f)) << f;
-  std::ifstream rep(dir / "out" / "a_pass" / "report.html");
-  const std::string html((std::istreambuf_iterator<char>(rep)), {});
+  const std::string html = slurp(dir / "out" / "a_pass" / "report.html");
   EXPECT_EQ(html.find("could not be rendered"), std::string::npos);
-  EXPECT_GE(std::count(html.begin(), html.end(), '\n'), 1);
   size_t svgs = 0;
   for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++svgs;
-  EXPECT_GE(svgs, 4u);
+  EXPECT_EQ(svgs, 4u);
+  // The verdict table comes before the first figure and names every quantity.
+  const size_t verdict = html.find("<h2>Verdict</h2>"), figure = html.find("<svg");
+  ASSERT_NE(verdict, std::string::npos);
+  for (const char* q : {">qdot<", ">rocker_axial<", ">mean_qdot<"}) EXPECT_LT(html.find(q, verdict), figure) << q;
+  // A four-bar's report holds nothing of the bicycle (issue #14).
+  for (const char* word : {"pedal", "knee", "hip torque", "69.7 N", "Two legs", "original authors", "thigh", "paper"})
+    EXPECT_EQ(html.find(word), std::string::npos) << word;
+
+  // The 30 ms transient: every run takes enough steps, none stops, the whole run is compared
+  // and no cost is extrapolated to a second.
+  const auto t = nlohmann::json::parse(slurp(dir / "out" / "d_transient" / "summary.json"));
+  EXPECT_EQ(t["per_second_measured"], false);
+  EXPECT_EQ(t["steady_window"]["whole_run"], true);
+  for (const auto& r : t["runs"]) {
+    EXPECT_FALSE(r.contains("failure")) << r["label"];
+    EXPECT_GE(r["steps"].get<long>(), 30) << r["label"];
+  }
+  for (const auto& h : t["fixed_steps_s"]) EXPECT_LE(h.get<double>(), 0.03 / 100 * (1 + 1e-12));
+  const std::string th = slurp(dir / "out" / "d_transient" / "report.html");
+  EXPECT_EQ(th.find("per simulated second"), std::string::npos);
+  EXPECT_NE(th.find("for the 0.03 s run"), std::string::npos);
   fs::remove_all(dir);
 }
 

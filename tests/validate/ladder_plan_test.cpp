@@ -1,0 +1,35 @@
+#include "validate/ladder_plan.hpp"
+
+#include <gtest/gtest.h>
+
+namespace rdyn::validate {
+namespace {
+
+TEST(LadderPlan, FullAndQuickLadders) {
+  const TimeScale one_second{1.0, 5.0, ""};
+  const auto p = plan_ladders(one_second, false);
+  EXPECT_EQ(p.full.size(), 10u);
+  EXPECT_EQ(p.grids_deg.front(), 30);
+  EXPECT_EQ(p.grids_deg.back(), 0.5);
+  EXPECT_EQ(p.tightest_tolerance(), 1e-10);
+  EXPECT_EQ(p.fixed_steps_s.size(), 5u);
+  // 7 grids × 6 variants × (3 rk8pd + rkck + 5 rk4).
+  EXPECT_EQ(p.reduced_runs(), 7 * 6 * 9);
+  EXPECT_EQ(p.extraction_repeats_10deg, 3);
+  EXPECT_GE(p.full_repeats.min_repeats, 3);
+  EXPECT_GT(p.reduced_repeats.min_total_s, 0);
+  const auto q = plan_ladders(one_second, true);
+  EXPECT_EQ(q.reduced_runs(), 3 * 2 * 2);  // 3 grids × 2 variants × (rk8pd + one rk4)
+  EXPECT_EQ(q.full_repeats.min_repeats, 1);
+  EXPECT_EQ(q.tightest_tolerance(), 1e-8);
+}
+
+TEST(LadderPlan, FixedStepsFollowTheTimeScale) {
+  // A 30 ms transient: every fixed step leaves at least kMinFixedSteps steps.
+  const auto p = plan_ladders({0.008, 0.03, ""}, false);
+  for (double h : p.fixed_steps_s) EXPECT_LE(h, 0.03 / kMinFixedSteps * (1 + 1e-12));
+  EXPECT_NEAR(p.fixed_steps_s.front(), 0.008 / 1000, 1e-15);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

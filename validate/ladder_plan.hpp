@@ -1,0 +1,36 @@
+// What `rdyn validate` runs: the full-model tolerance ladder, the reduced ladder (grid ×
+// interpolation × integrator) and how each run is timed — one plain record, decided in one
+// place from the options and the scene's time scale.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "validate/time_scale.hpp"
+#include "validate/timing.hpp"
+
+namespace rdyn::validate {
+
+struct ReducedVariant {
+  std::string interpolation;
+  bool energy_consistent = false;
+};
+
+struct LadderPlan {
+  std::vector<std::pair<std::string, double>> full;  // (integrator, tolerance)
+  std::vector<double> grids_deg;                     // coarse to fine
+  std::vector<ReducedVariant> variants;
+  std::vector<double> rk8pd_tolerances;  // ascending accuracy; the last is the tightest
+  bool rkck = false;                     // one rkck run at 1e-8 per variant
+  std::vector<double> fixed_steps_s;     // rk4-fixed, from the time scale
+  RepeatPolicy full_repeats, reduced_repeats;
+  int extraction_repeats_10deg = 1;  // median of this many for the 10° table
+  double tightest_tolerance() const { return rk8pd_tolerances.back(); }
+  long reduced_runs() const;  // runs of the reduced ladder
+};
+
+// `quick`: short ladders and single repeats (suites, smoke runs).
+LadderPlan plan_ladders(const TimeScale& scale, bool quick);
+
+}  // namespace rdyn::validate

@@ -1,0 +1,25 @@
+#include "validate/thresholds.hpp"
+
+#include <cmath>
+
+namespace rdyn::validate {
+
+ThresholdResult judge_threshold_on(const models::Threshold& th, const RunRecord& r) {
+  ThresholdResult t{th, r.error_of(th.quantity), false, r.label()};
+  t.pass = t.error <= th.max_error;  // false for NaN and +∞ (a stopped run)
+  return t;
+}
+
+std::optional<ThresholdResult> judge_threshold(const models::Threshold& th,
+                                               const std::vector<RunRecord>& runs,
+                                               double tolerance) {
+  const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
+  for (const auto& r : runs)
+    if (r.model == "reduced" && std::abs(r.grid_deg - th.grid_deg) < 1e-9 &&
+        r.interpolation == interp && !r.energy_consistent && r.integrator == "rk8pd" &&
+        r.tolerance == tolerance)
+      return judge_threshold_on(th, r);
+  return std::nullopt;
+}
+
+}  // namespace rdyn::validate

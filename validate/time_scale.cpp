@@ -1,0 +1,46 @@
+#include "validate/time_scale.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace rdyn::validate {
+
+TimeScale calc_time_scale(const models::TimeSeries& ref, bool rotating) {
+  TimeScale s;
+  s.duration_s = ref.t.empty() ? 0.0 : ref.t.back() - ref.t.front();
+  double peak = 0;
+  for (double v : ref.qdot)
+    if (std::isfinite(v)) peak = std::max(peak, std::abs(v));
+  const double rev = peak > 0 ? 2 * M_PI / peak : INFINITY;
+  if (rotating && rev < s.duration_s) {
+    s.period_s = rev;
+    s.how = fmt::format("one revolution at the reference's peak speed ({:.4g} rad/s): {:.4g} s",
+                        peak, rev);
+  } else {
+    s.period_s = s.duration_s;
+    s.how = fmt::format(
+        "no full revolution at the peak speed within the run: the run's duration, {:.4g} s",
+        s.duration_s);
+  }
+  return s;
+}
+
+std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
+  const std::vector<double> fractions =
+      quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 50, 25};
+  const double h_max = ts.duration_s / kMinFixedSteps;
+  std::vector<double> h;
+  for (double f : fractions) {
+    const double step = std::min(ts.period_s / f, h_max);
+    if (step > 0 && std::isfinite(step)) h.push_back(step);
+  }
+  std::sort(h.begin(), h.end());
+  h.erase(std::unique(h.begin(), h.end(),
+                      [](double a, double b) { return std::abs(a - b) <= 1e-12 * b; }),
+          h.end());
+  return h;
+}
+
+}  // namespace rdyn::validate
