@@ -297,7 +297,7 @@ void run_reference(const models::Scene& scene, engine::FullModel& full, Validati
     v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
                        "lengthen validation.duration_s or shorten simulation.output_interval_s",
                        v.reference_change.samples, v.window.how, kMinComparedSamples));
-  if (v.window.revolutions > 0 && v.window.revolutions < kMinSteadyRevolutions)
+  if (!v.window.whole_run && v.window.revolutions < kMinSteadyRevolutions)
     v.fail(fmt::format("the run never settles into a steady cycle: only {} revolution(s) after the start-up transient "
                        "({}); lengthen validation.duration_s",
                        v.window.revolutions, v.window.how));
@@ -310,7 +310,8 @@ void analyse_runs(ValidationResult& v) {
   v.matched_full = matched.full;
   v.matched_reduced = matched.reduced;
   v.speedup_at_matched_error.reset();
-  if (v.failures.empty()) v.speedup_at_matched_error = matched.speedup;  // no claim from a failed validation
+  // No claim from too few samples or a validation that already failed.
+  if (v.failures.empty() && v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
   v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
   const SignalError* ref = v.reference_change.find(v.headline_quantity);
   v.convergence_floor = 10 * std::max(1e-12, ref ? ref->max_rel : 0.0);
