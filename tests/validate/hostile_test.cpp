@@ -356,7 +356,7 @@ void scenes(std::vector<Case>& cs) {
       {"direction_zero", edit(fb, "direction: C", "direction: [0, 0]"), "direction"},
       {"joint_type", edit(fb, "type: revolute, parent: crank", "type: spherical, parent: crank"), "type"},
       {"truncated", fb.substr(0, fb.size() / 2) + "\n  - {name: [", ""},
-      {"binary", std::string("\x00\x01\xff\xfe garbage", 13), ""},
+      {"binary", std::string("\x00\x01\xff\xfe garbage", 12), ""},
       {"empty", "", ""},
       {"not_a_map", "- 1\n- 2\n", ""},
       {"deep_nesting", std::string(200, '[') + std::string(200, ']') + "\n", "nest"},
