@@ -20,6 +20,7 @@ constexpr int kPathMax = 4096;    // PATH_MAX on Linux
 constexpr int kMaxDepth = 8;      // rdyn writes at most folder/scene/file
 
 char g_paths[kSlots][kPathMax];
+size_t g_created_top_len[kSlots];  // 0: no parent folders to remove
 std::atomic<bool> g_used[kSlots];
 std::mutex g_mutex;  // registration only; the handler reads without locking
 std::once_flag g_installed;
@@ -74,9 +75,27 @@ int remove_contents(int dirfd, int depth) {
   return seen;
 }
 
+// Removes the now empty parent folders of `path` down to the first `top_len` characters
+// (rmdir fails on a folder that is not empty, and the walk stops there).
+void remove_empty_parents(const char* path, size_t top_len) {
+  char buf[kPathMax];
+  size_t n = 0;
+  while (path[n] && n + 1 < sizeof buf) buf[n] = path[n], ++n;
+  buf[n] = 0;
+  while (n > 0) {
+    while (n > 0 && buf[n - 1] != '/') --n;  // cut the last component
+    if (n > 0) --n;
+    buf[n] = 0;
+    if (n < top_len || rmdir(buf) != 0) return;
+  }
+}
+
 void on_signal(int sig) {
   for (int i = 0; i < kSlots; ++i)
-    if (g_used[i].load(std::memory_order_acquire)) remove_tree_signal_safe(g_paths[i]);
+    if (g_used[i].load(std::memory_order_acquire)) {
+      remove_tree_signal_safe(g_paths[i]);
+      if (g_created_top_len[i] > 0) remove_empty_parents(g_paths[i], g_created_top_len[i]);
+    }
   std::signal(sig, SIG_DFL);
   raise(sig);
 }
@@ -101,13 +120,15 @@ void install_cleanup_handlers() {
   });
 }
 
-int register_temporary(const std::string& path) {
+int register_temporary(const std::string& path, const std::string& created_top) {
   install_cleanup_handlers();
   if (path.size() + 1 > static_cast<size_t>(kPathMax)) return -1;
+  const bool prefix = !created_top.empty() && path.compare(0, created_top.size(), created_top) == 0;
   std::lock_guard<std::mutex> lock(g_mutex);
   for (int i = 0; i < kSlots; ++i) {
     if (g_used[i].load()) continue;
     std::memcpy(g_paths[i], path.c_str(), path.size() + 1);
+    g_created_top_len[i] = prefix ? created_top.size() : 0;
     g_used[i].store(true, std::memory_order_release);
     return i;
   }

@@ -16,8 +16,11 @@ void install_cleanup_handlers();
 
 // Registers a temporary file or folder (absolute path) to remove on a signal; returns a
 // slot id for unregister_temporary, or −1 when the table is full (then the path is still
-// removed by the normal error paths, only not on a signal).
-int register_temporary(const std::string& path);
+// removed by the normal error paths, only not on a signal). `created_top`, when given, is the
+// topmost parent folder this run created (a prefix of `path`): after the temporary, the
+// handler removes the folders from its parent up to `created_top` with rmdir, which only
+// removes empty folders — anything another run or the user put there meanwhile stays.
+int register_temporary(const std::string& path, const std::string& created_top = "");
 void unregister_temporary(int slot);
 
 // Removes a file or a folder tree (depth ≤ 8) with the same async-signal-safe routine the

@@ -106,11 +106,16 @@ std::set<std::string> read_manifest(const fs::path& folder, bool& has_manifest) 
 std::vector<std::string> foreign_entries(const fs::path& folder) {
   bool has_manifest = false;
   const auto listed = read_manifest(folder, has_manifest);
+  // Folders rdyn made are the parents of the files it lists; any other folder is the user's.
+  std::set<std::string> folders;
+  for (const auto& f : listed)
+    for (size_t at = f.find('/'); at != std::string::npos; at = f.find('/', at + 1)) folders.insert(f.substr(0, at + 1));
   std::vector<std::string> foreign;
   for (const auto& e : entries_below(folder)) {
     if (e == kManifest) continue;
-    if (e.back() == '/' ? !has_manifest : !listed.count(e)) foreign.push_back(e);
+    if (!listed.count(e) && !(e.back() == '/' && folders.count(e))) foreign.push_back(e);
   }
+  (void)has_manifest;
   return foreign;
 }
 
@@ -126,7 +131,7 @@ std::string quote_some(const std::vector<std::string>& names) {
 void write_manifest(const fs::path& folder, const std::set<std::string>& also) {
   std::set<std::string> files(also.begin(), also.end());
   for (const auto& e : entries_below(folder))
-    if (e.back() != '/' && e != kManifest) files.insert(e);
+    if (e != kManifest) files.insert(e);  // files, and folders (ending in '/') even when empty
   std::string text = std::string(kManifestHeader) + "\n";
   for (const auto& f : files) text += f + "\n";
   write_text_file((folder / kManifest).string(), text);
@@ -139,7 +144,7 @@ void remove_rdyn_output(const fs::path& folder) {
   const auto listed = read_manifest(folder, has_manifest);
   std::error_code ec;
   for (const auto& f : listed) {
-    if (f.empty() || f.find("..") != std::string::npos || f.front() == '/') continue;
+    if (f.empty() || f.back() == '/' || f.find("..") != std::string::npos || f.front() == '/') continue;
     fs::remove(folder / f, ec);
   }
   fs::remove(folder / kManifest, ec);
@@ -187,8 +192,8 @@ OutputDir::OutputDir(std::string final_path, bool force) {
     remove_created_parents(target, created_);
     throw OutputError(final_path + ": cannot create a temporary folder beside it: " + why);
   }
-  // On a signal, remove the parents this run created too (they hold only the temporary).
-  slot_ = register_temporary(created_.empty() ? tmp_ : created_);
+  // On a signal: the temporary, then the parents this run created while they are empty.
+  slot_ = register_temporary(tmp_, created_);
 }
 
 OutputDir::~OutputDir() {
@@ -298,7 +303,7 @@ OutputFile::OutputFile(std::string path, bool force, Recogniser is_ours) {
   created_ = make_parents(path, target);
   require_writable(path, target.parent_path());
   write_ = (target.parent_path() / ("." + target.filename().string() + ".rdyn-tmp-" + random_suffix())).string();
-  slot_ = register_temporary(created_.empty() ? write_ : created_);
+  slot_ = register_temporary(write_, created_);
 }
 
 OutputFile::~OutputFile() {

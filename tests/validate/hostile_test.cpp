@@ -285,6 +285,25 @@ void outputs(std::vector<Case>& cs) {
     c.limits.signal = sig;
     cs.push_back(c);
   }
+  // An interrupted run removes only its own temporary and the parent folders it created while
+  // they are empty: another run's results and the user's files put there meanwhile stay.
+  {
+    Case c{"interrupted_run_keeps_others_files_in_created_parent",
+           {"simulate", "bicycle", "--duration", "500", "--out", "shared/o1"}, 128 + SIGINT, ""};
+    c.limits.signal_after_ms = 2500;
+    c.limits.during_after_ms = 800;  // once the first run has created shared/
+    c.limits.during = [](const fs::path& d) {
+      const RdynRun other = run_rdyn({"simulate", "fourbar", "--duration", "0.1", "--out", "shared/o2"}, d);
+      EXPECT_EQ(other.status, 0) << other.err;
+      std::ofstream(d / "shared/readme.txt") << "mine\n";
+    };
+    c.check = [](const fs::path& d, const RdynRun&) {
+      EXPECT_EQ(slurp(d / "shared/readme.txt"), "mine\n");
+      EXPECT_TRUE(fs::exists(d / "shared/o2/timeseries.csv"));
+      EXPECT_FALSE(fs::exists(d / "shared/o1"));
+    };
+    cs.push_back(c);
+  }
   // Suites: names that would escape or collide are refused before any work.
   const std::string fb = scene_text("fourbar");
   cs.push_back({"suite_collision", {"validate", "--suite", "s", "--out", "o"}, 2, "same name",

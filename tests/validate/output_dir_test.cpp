@@ -50,7 +50,7 @@ TEST_F(Outputs, NewFolderGetsTheResultsAndAManifestOfThem) {
     out.commit();
   }
   EXPECT_EQ(read(dir_ / "a/b/res/x.csv"), "1\n");
-  EXPECT_EQ(read(dir_ / "a/b/res/.rdyn-output"), "rdyn output v1\nsub/y.csv\nx.csv\n");
+  EXPECT_EQ(read(dir_ / "a/b/res/.rdyn-output"), "rdyn output v1\nsub/\nsub/y.csv\nx.csv\n");
   EXPECT_EQ(temporaries(), 0);
 }
 
@@ -103,6 +103,17 @@ TEST_F(Outputs, AFileAddedDuringTheRunStopsTheReplacement) {
   EXPECT_THROW(second.commit(), OutputError);
   EXPECT_EQ(read(dir_ / "res/notes.txt"), "written by the user meanwhile");
   EXPECT_EQ(read(dir_ / "res/a.csv"), "a");
+}
+
+TEST_F(Outputs, AUserFolderInsideAnRdynOutputIsForeign) {
+  {
+    OutputDir first((dir_ / "res").string());
+    write_text_file(first.file("a.csv"), "a");
+    first.commit();
+  }
+  fs::create_directories(dir_ / "res/my_notes/sub");
+  EXPECT_THROW(OutputDir((dir_ / "res").string()), OutputError);
+  EXPECT_TRUE(fs::exists(dir_ / "res/my_notes/sub"));
 }
 
 TEST_F(Outputs, SymlinkedFolderIsFollowed) {

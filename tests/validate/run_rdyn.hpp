@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -32,6 +33,8 @@ struct RunLimits {
   long file_size_limit = -1;    // RLIMIT_FSIZE in bytes (a "full disk"); −1: none
   int signal_after_ms = -1;     // send `signal` after this many milliseconds
   int signal = SIGINT;
+  int during_after_ms = -1;  // run `during` (in the test) this many milliseconds after the start
+  std::function<void(const std::filesystem::path& cwd)> during;
 };
 
 inline std::string slurp(const std::filesystem::path& p) {
@@ -68,11 +71,15 @@ inline RdynRun run_rdyn(const std::vector<std::string>& args, const std::filesys
     _exit(127);
   }
   const auto start = std::chrono::steady_clock::now();
-  bool signalled = false;
+  bool signalled = false, during_done = false;
   int st = 0;
   for (;;) {
     if (waitpid(pid, &st, WNOHANG) == pid) break;
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (!during_done && limits.during && limits.during_after_ms >= 0 && ms >= limits.during_after_ms) {
+      limits.during(cwd);
+      during_done = true;
+    }
     if (!signalled && limits.signal_after_ms >= 0 && ms >= limits.signal_after_ms) {
       kill(pid, limits.signal);
       signalled = true;
