@@ -177,7 +177,7 @@ int run_extract(const ExtractArgs& a) {
   const auto method = reduced::parse_method(a.method);
   OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
   const auto e = extract_from_full(scene, a.grid_deg, method);
-  write_text_file(out.write_path(), reduced::format_samples_csv(e.samples));
+  out.write(reduced::format_samples_csv(e.samples));
   out.commit();
   std::fprintf(stderr, "%s\n",
                fmt::format("rdyn: extracted {} ({}, {}° grid, {} points) in {:.3g} ms with {} kinetostatic calls; "
@@ -224,7 +224,7 @@ int run_calibrate(const CalibrateArgs& a) {
       {"wall_time_s", r.wall_time_s},
   };
   if (out) {
-    write_text_file(out->write_path(), calibrated_scene_yaml(a.scene, base, scene, opt, r));
+    out->write(calibrated_scene_yaml(a.scene, base, scene, opt, r));
     out->commit();
     j["written_scene"] = a.write_scene;
   }
@@ -307,7 +307,7 @@ int run_sweep_command(const SweepArgs& a) {
   for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
   OutputFile out(a.out, a.force, is_rdyn_sweep);  // fails early on an unusable destination
   const SweepResult r = run_sweep(o, Progress().enabled());
-  write_text_file(out.write_path(), r.csv);
+  out.write(r.csv);
   out.commit();
   if (r.failed > 0) {
     std::fprintf(stderr, "rdyn: sweep shard %s: %ld of %ld cases failed (rows with status 'error' in %s)\n",

@@ -274,6 +274,23 @@ void OutputDir::commit() {
 
 OutputFile::OutputFile(std::string path, bool force, Recogniser is_ours) {
   if (path.empty()) throw OutputError("--out: empty path");
+  // Standard streams and devices by name (/dev/stdout → /proc/self/fd/1 → "pipe:[…]" cannot be
+  // resolved as a path): written through, checked like a FIFO when they are one.
+  struct stat given {};
+  const bool stream_name = path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
+  if (stat(path.c_str(), &given) == 0 && (stream_name || S_ISCHR(given.st_mode) || S_ISFIFO(given.st_mode))) {
+    if (S_ISDIR(given.st_mode)) throw OutputError(path + ": is a folder; give a file name");
+    if (S_ISFIFO(given.st_mode)) {
+      fifo_fd_ = open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (fifo_fd_ < 0)
+        throw OutputError(path + ": is a FIFO " + (errno == ENXIO ? "with no reader" : "that cannot be opened: " + sys_error()));
+    } else if (S_ISSOCK(given.st_mode) || S_ISBLK(given.st_mode)) {
+      throw OutputError(path + ": is a special file (socket or block device); refused");
+    }
+    through_ = true;
+    final_ = write_ = path;
+    return;
+  }
   const fs::path target = resolve_links(path);
   if (target.filename().empty() || target.filename() == "." || target.filename() == "..")
     throw OutputError(path + ": names a folder; give a file name");
@@ -314,6 +331,12 @@ OutputFile::~OutputFile() {
   unregister_temporary(slot_);
 }
 
+void OutputFile::write(const std::string& text) const {
+  TextSink sink(write_, through_);
+  sink.add(text);
+  sink.close();
+}
+
 void OutputFile::commit() {
   if (!through_) {
     if (std::rename(write_.c_str(), final_.c_str()) != 0)
@@ -325,8 +348,9 @@ void OutputFile::commit() {
 
 // ---------------------------------------------------------------------------------------
 
-TextSink::TextSink(std::string path) : path_(std::move(path)) {
-  fd_ = open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+TextSink::TextSink(std::string path, bool append) : path_(std::move(path)) {
+  fd_ = append ? open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC)
+               : open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) throw OutputError(path_ + ": cannot open for writing: " + sys_error());
 }
 

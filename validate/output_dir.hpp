@@ -12,6 +12,8 @@
 //   when it is empty or recognisably rdyn's (`is_ours` on its first bytes), or with `force`.
 //   Character devices (/dev/null, /dev/stdout) and FIFOs with a reader are written through;
 //   a FIFO without a reader, sockets, block devices and folders are refused.
+// Paths under /dev/ and /proc/ (/dev/stdout, /dev/fd/N) are written through whatever they
+// name — a terminal, a pipe, a redirected file — since they name a stream, not a file to keep.
 // Both follow symbolic links (the link stays, its target is written), create missing
 // parent folders, and register their temporaries for removal on SIGINT/SIGTERM/SIGHUP.
 #pragma once
@@ -68,6 +70,9 @@ class OutputFile {
 
   // Where to write: a temporary file beside the target, or the device itself.
   const std::string& write_path() const { return write_; }
+  // Writes the whole result (checked): into the temporary file, or appended to the device,
+  // FIFO or redirected standard stream without truncating it.
+  void write(const std::string& text) const;
   void commit();
   const std::string& final_path() const { return final_; }
 
@@ -84,7 +89,9 @@ class OutputFile {
 // quota is an OutputError naming the file and the system's reason.
 class TextSink {
  public:
-  explicit TextSink(std::string path);  // creates or truncates
+  // Creates or truncates `path`; with `append`, opens an existing file, device or FIFO for
+  // appending instead (a redirected /dev/stdout keeps what is already there).
+  explicit TextSink(std::string path, bool append = false);
   ~TextSink();
   TextSink(const TextSink&) = delete;
   TextSink& operator=(const TextSink&) = delete;

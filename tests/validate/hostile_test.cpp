@@ -251,6 +251,11 @@ void outputs(std::vector<Case>& cs) {
                   EXPECT_EQ(r.status, 0) << r.err;
                 }});
   cs.push_back({"extract_to_dev_null", {"extract", "fourbar", "--out", "/dev/null"}, 0, ""});
+  // Standard output redirected to a file (as the test runs rdyn): written through, appended.
+  for (const std::string name : {"/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"})
+    cs.push_back({"extract_to_" + std::string(name == "/dev/stdout" ? "stdout" : name == "/dev/fd/1" ? "dev_fd" : "proc_fd"),
+                  {"extract", "fourbar", "--out", name}, 0, "", {}, nullptr, "", {},
+                  [](const fs::path&, const RdynRun& r) { EXPECT_EQ(r.out.rfind("# rdyn-table v1", 0), 0u) << r.out; }});
   cs.push_back({"extract_to_dev_full", {"extract", "fourbar", "--out", "/dev/full"}, 2, "No space left"});
   cs.push_back({"extract_follows_symlink_to_file", {"extract", "fourbar", "--out", "link.csv"}, 0, "", {},
                 [](const fs::path& d) { fs::create_symlink("real.csv", d / "link.csv"); }, "", {},
