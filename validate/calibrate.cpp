@@ -258,11 +258,15 @@ std::string calibrated_scene_yaml(const std::string& source, const std::vector<m
   o.push_back({"initial.qdot", fmt::format("{:.17g}", r.steady_qdot)});
   const std::string body = models::rewrite_scene_yaml(
       text, scene.source_file, o, {"initial.q", "initial.q_deg", "initial.qdot", "initial.cadence_Hz"});
+  // The source name goes into a YAML comment: one line, no control characters (a file name
+  // with a newline must not add keys to the scene).
+  std::string from;
+  for (char c : source) from += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
   return fmt::format(
       "# Calibrated by `rdyn calibrate` from {}: drive torque {:.6g} N·m holds a mean cadence of {:.6g} Hz\n"
       "# (reduced) / {:.6g} Hz (full) with the resistance dissipating {:.6g} W at {:.6g} Hz. The initial\n"
       "# conditions are a point of the steady cycle.\n{}",
-      source, r.torque_Nm, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, opt.power_w, opt.cadence_hz, body);
+      from, r.torque_Nm, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, opt.power_w, opt.cadence_hz, body);
 }
 
 }  // namespace rdyn::validate

@@ -100,18 +100,14 @@ int run_simulate(const SimulateArgs& a) {
   const double dt_out = a.dt_out.value_or(scene.simulation.output_interval_s);
   const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
   require_timing(duration, dt_out);
-  if (a.model == "full") {
-    require_in("--tolerance", tolerance, kMinTolerance, kMaxTolerance, "");
-  } else {
-    require_in("--reduced-tolerance", a.reduced_tolerance, kMinTolerance, kMaxTolerance, "");
-    if (a.table.empty()) require_grid("--grid-deg", a.grid_deg);
-    if (a.reduced_integrator == "rk4-fixed") {
-      require_in("--fixed-step", a.fixed_step, kMinFixedStep_s, kMaxFixedStep_s, " s");
-      if (duration / a.fixed_step > kMaxFixedSteps)
-        throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}",
-                                        a.fixed_step, duration, duration / a.fixed_step, kMaxFixedSteps));
-    }
-  }
+  // Every number given is checked, also those of the other model: a typo is never ignored.
+  require_in("--tolerance", tolerance, kMinTolerance, kMaxTolerance, "");
+  require_in("--reduced-tolerance", a.reduced_tolerance, kMinTolerance, kMaxTolerance, "");
+  require_grid("--grid-deg", a.grid_deg);
+  require_in("--fixed-step", a.fixed_step, kMinFixedStep_s, kMaxFixedStep_s, " s");
+  if (a.model == "reduced" && a.reduced_integrator == "rk4-fixed" && duration / a.fixed_step > kMaxFixedSteps)
+    throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}", a.fixed_step,
+                                    duration, duration / a.fixed_step, kMaxFixedSteps));
   OutputDir out(a.out, a.force);  // fails early on an unusable folder
 
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
@@ -353,6 +349,8 @@ std::vector<std::string> suite_files(const std::string& suite) {
       throw models::SceneError(f, 0, "--suite",
                                "the file name must be a plain name (letters, digits, '_', '-', '.'; not starting with "
                                "'.' or '-'; at most 64 characters): it names the scene's report folder");
+    if (stem == "summary.json" || stem == "index.html")
+      throw models::SceneError(f, 0, "--suite", "the name '" + stem + "' is the suite's own output file; rename the scene");
     if (seen.count(stem))
       throw models::SceneError(f, 0, "--suite", "has the same name as " + seen[stem] + " (both would write " + stem + "/)");
     seen[stem] = f;
@@ -363,6 +361,7 @@ std::vector<std::string> suite_files(const std::string& suite) {
 int run_suite(const ValidateArgs& a, Progress& progress) {
   namespace fs = std::filesystem;
   const auto files = suite_files(a.suite);
+  const auto overrides = overrides_of(a.sets);  // a malformed --set is the user's error (exit 2), not a scene's
   OutputDir out(a.out, a.force);
   ValidationOptions opt;
   opt.quick = !a.thorough;
@@ -374,7 +373,7 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
     progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
     nlohmann::json entry;
     try {
-      const auto scene = models::load_scene(files[i], overrides_of(a.sets));
+      const auto scene = models::load_scene(files[i], overrides);
       out.make_subfolder(stem);
       bool pass = false;
       entry = validate_one(scene, opt, out.file(stem), progress, pass);

@@ -58,6 +58,10 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
       models::load_scene(opt.scene, o);
     }
 
+  for (size_t i = 0; i < opt.axes.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (opt.axes[i].key == opt.axes[j].key)
+        throw models::SceneError("", 0, "--vary " + opt.axes[i].key, "the key is varied twice; give it once");
   constexpr long kMaxCases = 1000000;
   long total = 1;
   for (const auto& a : opt.axes) {
@@ -91,9 +95,10 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
       try {
         const auto scene = models::load_scene(opt.scene, o);
         const auto r = calibrate(scene, copt, quiet);
-        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},", index, params, r.torque_Nm,
-                          r.mean_cadence_hz_reduced, r.mean_power_w, force.empty() ? NAN : r.peak_force_N,
-                          r.speed_fluctuation);
+        // No constraint force requested: an empty field, never NaN.
+        const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
+        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.torque_Nm,
+                          r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
       } catch (const std::exception& e) {
         row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
         ++failed;

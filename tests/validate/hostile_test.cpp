@@ -526,8 +526,51 @@ void ground_truth(std::vector<Case>& cs) {
                   }});
 }
 
+// Found by a hostile tester (issue #9 session notes): each now refused or written cleanly.
+void found_later(std::vector<Case>& cs) {
+  // A four-bar driven by a crank torque, without gravity and without constraint forces.
+  std::string driven = edit(scene_text("fourbar"), "loads:\n",
+                            "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  driven = edit(driven, "gravity: {enabled: true, g_m_s2: [0, -9.81]}", "gravity: {enabled: false}");
+  const std::string no_forces = driven.substr(0, driven.find("outputs:")) + driven.substr(driven.find("initial:"));
+  cs.push_back({"sweep_without_constraint_force_writes_no_nan",
+                {"sweep", "nf.yaml", "--vary", "bodies.crank.mass_kg=0.4:0.6:2", "--cadence-hz", "1", "--power-w",
+                 "0.5", "--out", "w.csv"},
+                0, "", {{"nf.yaml", no_forces}}});
+  cs.push_back({"sweep_same_key_twice",
+                {"sweep", "bicycle", "--vary", "bicycle_leg.subject.height_m=1.6:1.7:2", "--vary",
+                 "bicycle_leg.subject.height_m=1.8:1.9:2", "--out", "w.csv"},
+                2, "varied twice", {}, nullptr, "w.csv"});
+  cs.push_back({"calibrate_file_name_cannot_inject_yaml",
+                {"calibrate", "x\ngravity: {enabled: true}\n#.yaml", "--cadence-hz", "1", "--power-w", "0.5",
+                 "--write-scene", "cal.yaml"},
+                0, "", {{"x\ngravity: {enabled: true}\n#.yaml", driven}}, nullptr, "", {},
+                [](const fs::path& d, const RdynRun&) {
+                  const RdynRun again = run_rdyn({"simulate", "cal.yaml", "--duration", "0.1", "--out", "o"}, d);
+                  EXPECT_EQ(again.status, 0) << again.err;  // the written scene loads: nothing was injected
+                }});
+  for (const std::string reserved : {"summary.json", "index.html"})
+    cs.push_back({"suite_name_" + reserved.substr(0, reserved.find('.')), {"validate", "--suite", "s", "--out", "o"}, 2,
+                  "suite's own output", {{"s/" + reserved + ".yaml", scene_text("fourbar")}}, nullptr, "o"});
+  for (const auto& [tag, set] : std::vector<std::pair<std::string, std::string>>{{"noequals", "noequals"}, {"empty_key", "=1"}})
+    cs.push_back({"suite_bad_set_" + tag, {"validate", "--suite", "s", "--set", set, "--out", "o"}, 2, "--set",
+                  {{"s/a.yaml", scene_text("fourbar")}}, nullptr, "o"});
+  const std::vector<std::vector<std::string>> other_model{{"--model", "reduced", "--tolerance", "nan"},
+                                                          {"--model", "full", "--reduced-tolerance", "nan"},
+                                                          {"--model", "full", "--fixed-step", "nan"},
+                                                          {"--model", "full", "--grid-deg", "7"},
+                                                          {"--model", "reduced", "--fixed-step", "1e-12"}};
+  for (size_t k = 0; k < other_model.size(); ++k) {
+    std::vector<std::string> args{"simulate", "fourbar", "--duration", "0.1"};
+    args.insert(args.end(), other_model[k].begin(), other_model[k].end());
+    args.insert(args.end(), {"--out", "o"});
+    cs.push_back({"simulate_other_model_option_checked" + std::to_string(k), args, 2, other_model[k][2], {}, nullptr, "o"});
+  }
+}
+
 std::vector<Case> all_cases() {
   std::vector<Case> cs;
+  found_later(cs);
   ground_truth(cs);
   bad_numbers(cs);
   outputs(cs);
