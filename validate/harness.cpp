@@ -297,6 +297,9 @@ void run_reference(const models::Scene& scene, engine::FullModel& full, Validati
     v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
                        "lengthen validation.duration_s or shorten simulation.output_interval_s",
                        v.reference_change.samples, v.window.how, kMinComparedSamples));
+  if (const SignalError* speed = v.reference_change.find("qdot"); speed && !(speed->peak > 0))
+    v.fail("the mechanism does not move in the reference run (its speed is 0 throughout): there is nothing to "
+           "compare");
   if (!v.window.whole_run && v.window.revolutions < kMinSteadyRevolutions)
     v.fail(fmt::format("the run never settles into a steady cycle: only {} revolution(s) after the start-up transient "
                        "({}); lengthen validation.duration_s",

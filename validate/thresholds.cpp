@@ -6,6 +6,13 @@ namespace rdyn::validate {
 
 ThresholdResult judge_threshold_on(const models::Threshold& th, const RunRecord& r) {
   ThresholdResult t{th, r.error_of(th.quantity), false, r.label()};
+  // An error relative to a peak of zero (a mechanism at rest, a force that never acts) is no
+  // error at all: the threshold cannot be met (issue #9, "never exit 0 on nothing").
+  const SignalError* s = r.errors.find(th.quantity);
+  if (s && !(s->peak > 0)) {
+    t.error = NAN;
+    t.run += " (the reference's peak of " + th.quantity + " is 0: no relative error exists)";
+  }
   t.pass = t.error <= th.max_error;  // false for NaN and +∞ (a stopped run)
   return t;
 }

@@ -555,6 +555,11 @@ void found_later(std::vector<Case>& cs) {
   for (const auto& [tag, set] : std::vector<std::pair<std::string, std::string>>{{"noequals", "noequals"}, {"empty_key", "=1"}})
     cs.push_back({"suite_bad_set_" + tag, {"validate", "--suite", "s", "--set", set, "--out", "o"}, 2, "--set",
                   {{"s/a.yaml", scene_text("fourbar")}}, nullptr, "o"});
+  // A mechanism at rest: every error is 0 of a peak of 0 — a failure, not a pass.
+  cs.push_back({"validate_mechanism_at_rest_fails",
+                {"validate", "fourbar", "--quick", "--set", "gravity.enabled=false", "--set", "initial.qdot=0", "--out",
+                 "o"},
+                1, "does not move"});
   const std::vector<std::vector<std::string>> other_model{{"--model", "reduced", "--tolerance", "nan"},
                                                           {"--model", "full", "--reduced-tolerance", "nan"},
                                                           {"--model", "full", "--fixed-step", "nan"},
