@@ -136,10 +136,12 @@ TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
   ASSERT_EQ(rdyn_workspace_new(fb, &fb_ws), RDYN_OK);
   EXPECT_EQ(rdyn_step(m, fb_ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_WRONG_WORKSPACE);
   EXPECT_EQ(rdyn_step(fb, fb_ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_OK);
-  EXPECT_EQ(rdyn_workspace_new(nullptr, &fb_ws), RDYN_BAD_ARGUMENT);
-  EXPECT_EQ(fb_ws, nullptr);
+  rdyn_workspace* none = reinterpret_cast<rdyn_workspace*>(0x1);  // must be reset to NULL
+  EXPECT_EQ(rdyn_workspace_new(nullptr, &none), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(none, nullptr);
 
   rdyn_workspace_free(ws);
+  rdyn_workspace_free(fb_ws);
   rdyn_model_free(m);
   rdyn_model_free(fb);
 }
