@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -777,6 +778,21 @@ Override parse_override(const std::string& text) {
   return o;
 }
 
+namespace {
+// The shipped scenes of an installed rdyn: <exe dir>/RDYN_INSTALLED_SCENES_REL (CMake computes
+// it from the install layout, ../share/rdyn/scenes), so an install prefix can be moved.
+// Empty when the executable's path is unknown. A build-tree executable has no such folder.
+std::string installed_scenes_dir() {
+  char exe[4096];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0) return "";
+  const std::string path(exe, static_cast<size_t>(n));
+  const auto slash = path.rfind('/');
+  if (slash == std::string::npos) return "";
+  return path.substr(0, slash + 1) + RDYN_INSTALLED_SCENES_REL;
+}
+}  // namespace
+
 std::string resolve_scene_path(const std::string& name_or_path) {
   struct stat st {};
   if (stat(name_or_path.c_str(), &st) == 0) {
@@ -788,7 +804,8 @@ std::string resolve_scene_path(const std::string& name_or_path) {
   if (plain_name) {
     std::vector<std::string> dirs;
     if (const char* env = std::getenv("RDYN_SCENES_DIR")) dirs.push_back(env);
-    dirs.push_back(RDYN_SCENES_DIR);
+    if (std::string installed = installed_scenes_dir(); !installed.empty()) dirs.push_back(installed);
+    dirs.push_back(RDYN_SCENES_DIR);  // the source folder (build tree)
     for (const auto& d : dirs) {
       const std::string p = d + "/" + name_or_path + ".yaml";
       if (stat(p.c_str(), &st) == 0) return p;

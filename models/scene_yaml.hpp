@@ -19,8 +19,9 @@ struct Override {
 // Parses "key=value"; throws SceneError (field "--set") when malformed.
 Override parse_override(const std::string& text);
 
-// Resolves a shipped scene name (models/scenes/NAME.yaml, also $RDYN_SCENES_DIR) or a
-// path. Throws SceneError when neither exists.
+// Resolves a shipped scene name or a path. A name is looked up in $RDYN_SCENES_DIR, then in
+// an installed rdyn's share/rdyn/scenes (found from the executable's own location), then in
+// the source folder models/scenes. Throws SceneError when neither exists.
 std::string resolve_scene_path(const std::string& name_or_path);
 
 // Reads, overrides, expands generators (bicycle_leg) and checks a scene.

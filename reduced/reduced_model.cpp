@@ -97,9 +97,12 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
 
 ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)
     : gate_on(m.gates.size(), 1),
+      torque_value(m.torques.size()),
       scratch(m.rhs_cols.size()),
       scratch_out(m.out_cols.size()),
-      scratch_rec(m.record_cols.size()) {}
+      scratch_rec(m.record_cols.size()) {
+  for (size_t i = 0; i < m.torques.size(); ++i) torque_value[i] = m.torques[i].value;
+}
 
 namespace {
 
@@ -109,8 +112,9 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
   const double m1 = v[0], m2 = v[1];
   double F_nc = 0.0;  // generalized force of the non-conservative loads on q
   const double* r = v + 3;
-  for (const auto& t : m.torques) {
-    if (t.gate < 0 || ws.gate_on[t.gate]) F_nc += t.value * *r;
+  for (size_t i = 0; i < m.torques.size(); ++i) {
+    const auto& t = m.torques[i];
+    if (t.gate < 0 || ws.gate_on[t.gate]) F_nc += ws.torque_value[i] * *r;
     ++r;
   }
   for (const auto& mo : m.motors) {
@@ -178,8 +182,10 @@ void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, d
     // Q_x,k of the applied loads along x_k, by virtual power with q̇ = 0, ẋ_k = 1; the
     // velocity-dependent loads see the actual joint rates r_j·q̇.
     double Qx = T.eval(m.c_Qx[k], q);
-    for (const auto& t : m.torques)
-      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += t.value * T.eval(t.c_rx[k], q);
+    for (size_t i = 0; i < m.torques.size(); ++i) {
+      const auto& t = m.torques[i];
+      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += ws.torque_value[i] * T.eval(t.c_rx[k], q);
+    }
     for (const auto& mo : m.motors)
       Qx += mo.stall * (1.0 - T.eval(mo.c_r, q) * qdot / mo.no_load_speed) * T.eval(mo.c_rx[k], q);
     for (const auto& b : m.brakes)
@@ -213,8 +219,9 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
     const double me1 = c[0], me2 = c[1];
     double Qx = c[2];  // Q_x,k: loads along x_k by virtual power (q̇ = 0, ẋ_k = 1)
     c += 3;
-    for (const auto& t : m.torques) {
-      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += t.value * *c;
+    for (size_t i = 0; i < m.torques.size(); ++i) {
+      const auto& t = m.torques[i];
+      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += ws.torque_value[i] * *c;
       ++c;
     }
     for (const auto& mo : m.motors) {
@@ -271,7 +278,10 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
       fr[g] = ((s0[g] > 0) != (s1 > 0) && s0[g] != s1) ? s0[g] / (s0[g] - s1) : 0.0;
       frac = std::min(frac, fr[g]);
     }
-    if (frac > 1.0) break;
+    if (frac > 1.0) {
+      remaining = 0.0;  // the step to the end stands
+      break;
+    }
     ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
     const double h1 = std::max(0.0, std::min(1.0, frac)) * remaining;
     if (h1 > 0) rk4(m, ws, h1);
@@ -280,6 +290,10 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
       if (fr[g] <= frac + 1e-9) ws.gate_on[g] = !ws.gate_on[g];
     remaining -= h1;
   }
+  // Gates still disagreeing after 8 splits chatter: a load whose switching drives its own
+  // switching function back through zero (sliding). Time must still advance by h, so the rest
+  // of the step runs with the gates as they now are.
+  if (remaining > 0) rk4(m, ws, remaining);
   return t_first;
 }
 

@@ -8,6 +8,7 @@
 // (virtual power), and likewise Q_x,k with the ratios along x_k.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,9 @@ ReducedModel make_reduced_model(const Samples& samples, const models::Scene& sce
 struct ReducedWorkspace {
   double t = 0.0, q = 0.0, qdot = 0.0, work = 0.0;
   std::vector<char> gate_on;
+  // Each scene joint torque as applied now [N·m or N]: the scene's values, unless a drive
+  // command (reduced/runtime.hpp) scales or overrides them during the run.
+  std::vector<double> torque_value;
   std::vector<double> scratch;      // rhs_cols values
   std::vector<double> scratch_out;  // out_cols values
   std::vector<double> scratch_rec;  // record_cols values
@@ -104,9 +108,18 @@ double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, doubl
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces);
 
+// Divergence guard of the reduced integrators: the reduced equation's own energy balance
+// E − E0 = W (W: work of the non-conservative loads) holds to interpolation accuracy; off by
+// more than half the largest |E| seen so far (E_scale) means the table or the step is too
+// coarse for the run to be stable.
+inline bool energy_balance_diverged(double E, double E0, double work, double E_scale) {
+  return std::abs(E - E0 - work) > 0.5 * E_scale + 1e-9;
+}
+
 // One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside
 // the step is located by linear interpolation of the switching function and the step is
-// split there. Returns the time of that switch, or NaN when none happened.
+// split there (at most 8 splits; the step always advances t by h). Returns the time of the
+// first switch, or NaN when none happened.
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
 
 }  // namespace rdyn::reduced

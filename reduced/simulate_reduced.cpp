@@ -414,7 +414,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       const AdaptiveIntegrator::Point b = point(ws);
       const double E = calc_energy(m, b.q, b.qdot);  // divergence guard, as for the adaptive path
       E_scale = std::max(E_scale, std::abs(E));
-      if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
+      if (energy_balance_diverged(E, E0, b.work, E_scale))
         throw models::NumericalError(fmt::format(
             "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J — the table or the fixed "
             "step is too coarse for this run",
@@ -452,7 +452,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       // interpolation accuracy; a gross failure means the table is too coarse to be stable.
       const double E = calc_energy(m, b.q, b.qdot);
       E_scale = std::max(E_scale, std::abs(E));
-      if (std::abs(E - E0 - b.work) > 0.5 * E_scale + 1e-9)
+      if (energy_balance_diverged(E, E0, b.work, E_scale))
         throw models::NumericalError(fmt::format(
             "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
             "initially {:.3g} J) — the table is too coarse for this run (refine the grid, or use "

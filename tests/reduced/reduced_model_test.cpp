@@ -14,6 +14,7 @@
 #include <new>
 
 #include "analytic_source.hpp"
+#include "count_allocations.hpp"
 #include "models/scene_hash.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/simulate_reduced.hpp"
@@ -22,7 +23,7 @@
 // replacements pair operator new with malloc and operator delete with free, which GCC's
 // -Wmismatched-new-delete cannot see through.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-static long g_allocations = 0;
+long g_allocations = 0;
 void* operator new(std::size_t n) {
   ++g_allocations;
   if (void* p = std::malloc(n ? n : 1)) return p;

@@ -1,0 +1,181 @@
+#include "reduced/runtime.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "models/scene_yaml.hpp"
+#include "reduced/simulate_reduced.hpp"
+
+namespace rdyn::reduced {
+
+const char* status_message(Status s) {
+  switch (s) {
+    case Status::Ok:
+      return "ok";
+    case Status::BadStep:
+      return "step size is not finite or outside [1e-7, 1] s";
+    case Status::BadDrive:
+      return "drive is not finite or a joint torque it commands exceeds 1e6 N·m (N)";
+    case Status::BadState:
+      return "state is not finite, |q̇| exceeds 1e4 rad/s (m/s), or q lies outside the table's "
+             "range";
+    case Status::WrongWorkspace:
+      return "the workspace was made for another model";
+    case Status::NonFinite:
+      return "the step produced a non-finite state or output; the state was kept";
+    case Status::LeftTable:
+      return "q left the range of the (non-periodic) table; the state was kept";
+    case Status::Diverged:
+      return "the reduced model diverges (its energy balance broke): the table or the step is too "
+             "coarse; "
+             "the state was kept";
+  }
+  return "unknown status";
+}
+
+RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& scene,
+                                const RuntimeOptions& options) {
+  const Interpolation interp = options.interpolation.value_or(
+      samples.periodic ? Interpolation::Fourier : Interpolation::CubicSpline);
+  RuntimeModel m;
+  m.reduced = make_reduced_model(samples, scene, interp,
+                                 options.energy_consistent_m2);  // checks the scene hash
+  m.scene_name = scene.name;
+  m.revolute = samples.revolute;
+  m.initial_q = scene.initial.q;
+  m.initial_qdot = scene.initial.qdot;
+  for (const auto& t : scene.joint_torques) {
+    m.drive_names.push_back(t.name);
+    m.drive_nominal.push_back(t.value);
+  }
+  return m;
+}
+
+RuntimeModel load_runtime_model(const std::string& table_path,
+                                const std::string& scene_name_or_path,
+                                const RuntimeOptions& options) {
+  const models::Scene scene = models::load_scene(scene_name_or_path);
+  return make_runtime_model(read_samples_csv(table_path), scene, options);
+}
+
+RuntimeWorkspace::RuntimeWorkspace(const RuntimeModel& model)
+    : state_(model.reduced),
+      forces_(model.reduced.force_names.size()),
+      saved_(model.reduced),
+      forces_saved_(model.reduced.force_names.size()) {
+  // The scene's initial state was checked with the scene (limits::kMaxRate, kMaxAngle_rad);
+  // a non-periodic table may still not cover it, which the first reset() would report.
+  if (reset(model, *this, model.initial_q, model.initial_qdot) != Status::Ok) {
+    state_.q = model.initial_q, state_.qdot = model.initial_qdot;
+  }
+}
+
+bool RuntimeWorkspace::fits(const RuntimeModel& model) const {
+  const auto& m = model.reduced;
+  return state_.gate_on.size() == m.gates.size() &&
+         state_.torque_value.size() == m.torques.size() &&
+         state_.scratch.size() == m.rhs_cols.size() &&
+         state_.scratch_out.size() == m.out_cols.size() &&
+         state_.scratch_rec.size() == m.record_cols.size() &&
+         forces_.size() == m.force_names.size();
+}
+
+// Checks the whole command before writing any torque, so a refused drive changes nothing.
+Status RuntimeWorkspace::apply_drive(const RuntimeModel& model, const Drive& drive) {
+  const auto& torques = model.reduced.torques;
+  auto commanded = [&](size_t i) {
+    const double nominal = torques[i].value;
+    return drive.mode == Drive::Mode::Scale ? drive.value * nominal
+                                            : (nominal < 0 ? -1.0 : 1.0) * drive.value;
+  };
+  if (!std::isfinite(drive.value)) return Status::BadDrive;
+  for (size_t i = 0; i < torques.size(); ++i)
+    if (!(std::abs(commanded(i)) <= models::limits::kMaxForce)) return Status::BadDrive;
+  for (size_t i = 0; i < torques.size(); ++i) state_.torque_value[i] = commanded(i);
+  return Status::Ok;
+}
+
+// q̈, energy and constraint forces at the current state from one fused table lookup.
+Status RuntimeWorkspace::calc_outputs(const RuntimeModel& model) {
+  double qddot, power;
+  const double energy =
+      calc_sample(model.reduced, state_, state_.q, state_.qdot, qddot, power, forces_.data());
+  bool finite = std::isfinite(qddot) && std::isfinite(power) && std::isfinite(energy);
+  for (double f : forces_) finite = finite && std::isfinite(f);
+  if (!finite) return Status::NonFinite;
+  qddot_ = qddot, power_nc_ = power, energy_ = energy;
+  return Status::Ok;
+}
+
+namespace {
+
+// Copies the stepping state (not the scratch space) from one workspace into another of the
+// same model; no allocation, as both vectors already have their sizes.
+void copy_state(const ReducedWorkspace& from, ReducedWorkspace& to) {
+  to.t = from.t, to.q = from.q, to.qdot = from.qdot, to.work = from.work;
+  std::copy(from.gate_on.begin(), from.gate_on.end(), to.gate_on.begin());
+  std::copy(from.torque_value.begin(), from.torque_value.end(), to.torque_value.begin());
+}
+
+}  // namespace
+
+Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double qdot,
+             const Drive& drive) noexcept {
+  if (!ws.fits(model)) return Status::WrongWorkspace;
+  const double q_max =
+      model.revolute ? models::limits::kMaxAngle_rad : models::limits::kMaxCoordinate_m;
+  if (!(std::abs(q) <= q_max) || !(std::abs(qdot) <= models::limits::kMaxRate) ||
+      !model.reduced.table.in_range(q))
+    return Status::BadState;
+  copy_state(ws.state_, ws.saved_);
+  std::copy(ws.forces_.begin(), ws.forces_.end(), ws.forces_saved_.begin());
+  if (const Status s = ws.apply_drive(model, drive); s != Status::Ok) return s;
+  auto& st = ws.state_;
+  st.t = 0.0, st.q = q, st.qdot = qdot, st.work = 0.0;
+  init_gates(model.reduced, st);
+  if (const Status s = ws.calc_outputs(model); s != Status::Ok) {
+    copy_state(ws.saved_, ws.state_);
+    std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
+    return s;
+  }
+  ws.energy0_ = ws.energy_;
+  ws.energy_scale_ = std::abs(ws.energy_);
+  ws.steps_ = ws.switches_ = 0;
+  return Status::Ok;
+}
+
+Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
+            const Drive& drive) noexcept {
+  if (!ws.fits(model)) return Status::WrongWorkspace;
+  if (!(dt >= kMinFixedStep_s && dt <= kMaxFixedStep_s)) return Status::BadStep;
+  const auto& m = model.reduced;
+  auto& st = ws.state_;
+  copy_state(st, ws.saved_);
+  std::copy(ws.forces_.begin(), ws.forces_.end(), ws.forces_saved_.begin());
+  const double qddot0 = ws.qddot_, power0 = ws.power_nc_, energy0 = ws.energy_;
+  if (const Status s = ws.apply_drive(model, drive); s != Status::Ok) return s;
+
+  const double t_switch = step_fixed_rk4(m, st, dt);
+  Status s = Status::Ok;
+  if (!std::isfinite(st.q) || !std::isfinite(st.qdot) || !std::isfinite(st.work))
+    s = Status::NonFinite;
+  else if (!m.table.in_range(st.q))
+    s = Status::LeftTable;
+  else
+    s = ws.calc_outputs(model);
+  if (s == Status::Ok && energy_balance_diverged(ws.energy_, ws.energy0_, st.work,
+                                                 std::max(ws.energy_scale_, std::abs(ws.energy_))))
+    s = Status::Diverged;
+  if (s != Status::Ok) {  // roll back: the caller sees the state before the call
+    copy_state(ws.saved_, st);
+    std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
+    ws.qddot_ = qddot0, ws.power_nc_ = power0, ws.energy_ = energy0;
+    return s;
+  }
+  ws.energy_scale_ = std::max(ws.energy_scale_, std::abs(ws.energy_));
+  ++ws.steps_;
+  if (!std::isnan(t_switch)) ++ws.switches_;
+  return Status::Ok;
+}
+
+}  // namespace rdyn::reduced

@@ -1,0 +1,165 @@
+// The C interface: errors as codes and messages, never an exception; the same numbers as the
+// C++ runtime it wraps, field by field.
+#include "reduced/rdyn_reduced.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include "cli_table.hpp"
+#include "reduced/runtime.hpp"
+
+namespace rdyn::reduced {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tables written by the CLI once for the whole suite: the bicycle (drive torques, a knee
+// force) and the fourbar (no drive torque).
+class CApi : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("rdyn_c_api_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    ASSERT_EQ(test::extract_table_with_cli("bicycle", "10", bicycle()), 0);
+    ASSERT_EQ(test::extract_table_with_cli("fourbar", "30", fourbar()), 0);
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static std::string bicycle() { return (dir_ / "bicycle.csv").string(); }
+  static std::string fourbar() { return (dir_ / "fourbar.csv").string(); }
+  static fs::path dir_;
+};
+fs::path CApi::dir_;
+
+TEST_F(CApi, LoadErrorsAreCodesWithMessages) {
+  char msg[512];
+  rdyn_model* m = reinterpret_cast<rdyn_model*>(0x1);  // must be reset to NULL on failure
+  EXPECT_EQ(rdyn_model_load((dir_ / "missing.csv").c_str(), "bicycle", &m, msg, sizeof msg),
+            RDYN_BAD_INPUT);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(std::string(msg).find("missing.csv"), std::string::npos) << msg;
+  // A table of another scene.
+  EXPECT_EQ(rdyn_model_load(fourbar().c_str(), "bicycle", &m, msg, sizeof msg), RDYN_BAD_INPUT);
+  EXPECT_NE(std::string(msg).find("was extracted from a different scene"), std::string::npos)
+      << msg;
+  EXPECT_EQ(rdyn_model_load(bicycle().c_str(), "no-such-scene", &m, msg, sizeof msg),
+            RDYN_BAD_INPUT);
+  EXPECT_NE(std::string(msg).find("no such scene file"), std::string::npos) << msg;
+  // The message is truncated to the buffer, NUL-terminated; a NULL buffer is allowed.
+  char small[8];
+  std::memset(small, 'x', sizeof small);
+  EXPECT_EQ(rdyn_model_load(fourbar().c_str(), "bicycle", &m, small, sizeof small), RDYN_BAD_INPUT);
+  EXPECT_EQ(std::strlen(small), 7u);
+  EXPECT_EQ(rdyn_model_load(fourbar().c_str(), "bicycle", &m, nullptr, 0), RDYN_BAD_INPUT);
+  // Null arguments.
+  EXPECT_EQ(rdyn_model_load(nullptr, "bicycle", &m, msg, sizeof msg), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_model_load(bicycle().c_str(), nullptr, &m, msg, sizeof msg), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_model_load(bicycle().c_str(), "bicycle", nullptr, msg, sizeof msg),
+            RDYN_BAD_ARGUMENT);
+  rdyn_model_free(nullptr);
+  rdyn_workspace_free(nullptr);
+}
+
+TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
+  char msg[512];
+  rdyn_model* m = nullptr;
+  ASSERT_EQ(rdyn_model_load(bicycle().c_str(), "bicycle", &m, msg, sizeof msg), RDYN_OK) << msg;
+  rdyn_workspace* ws = nullptr;
+  ASSERT_EQ(rdyn_workspace_new(m, &ws), RDYN_OK);
+  const auto model = load_runtime_model(bicycle(), "bicycle");
+  RuntimeWorkspace cxx(model);
+
+  double q0, qd0;
+  ASSERT_EQ(rdyn_model_initial_state(m, &q0, &qd0), RDYN_OK);
+  EXPECT_EQ(q0, model.initial_q);
+  EXPECT_EQ(qd0, model.initial_qdot);
+  ASSERT_EQ(rdyn_model_num_forces(m), 1);
+  EXPECT_STREQ(rdyn_model_force_name(m, 0), "knee");
+  EXPECT_EQ(rdyn_model_force_name(m, 1), nullptr);
+  EXPECT_EQ(rdyn_model_force_name(m, -1), nullptr);
+  ASSERT_EQ(rdyn_model_num_drive_torques(m), 2);  // both hips
+  double nominal = 0;
+  ASSERT_EQ(rdyn_model_drive_torque(m, 1, &nominal), RDYN_OK);
+  EXPECT_EQ(nominal, model.drive_nominal[1]);
+  ASSERT_EQ(rdyn_model_drive_torque(m, 0, &nominal), RDYN_OK);
+  EXPECT_EQ(rdyn_model_drive_torque(m, 2, &nominal), RDYN_BAD_ARGUMENT);
+
+  // Both modes of the drive, alternating, from a state that is not the scene's.
+  ASSERT_EQ(rdyn_reset(m, ws, 1.0, 5.0, {RDYN_DRIVE_SCALE, 0.5}), RDYN_OK);
+  ASSERT_EQ(reset(model, cxx, 1.0, 5.0, Drive::scaled(0.5)), Status::Ok);
+  for (int i = 0; i < 1500; ++i) {
+    const double value = 40.0 + 20.0 * std::sin(1e-2 * i);
+    const rdyn_drive d = i % 2 ? rdyn_drive{RDYN_DRIVE_TORQUE, value}
+                               : rdyn_drive{RDYN_DRIVE_SCALE, value / nominal};
+    ASSERT_EQ(rdyn_step(m, ws, 1e-3, d), RDYN_OK);
+    ASSERT_EQ(step(model, cxx, 1e-3, i % 2 ? Drive::torque(value) : Drive::scaled(value / nominal)),
+              Status::Ok);
+  }
+  rdyn_state st;
+  ASSERT_EQ(rdyn_get_state(ws, &st), RDYN_OK);
+  EXPECT_EQ(st.t, cxx.get_t());
+  EXPECT_EQ(st.q, cxx.get_q());
+  EXPECT_EQ(st.qdot, cxx.get_qdot());
+  EXPECT_EQ(st.qddot, cxx.get_qddot());
+  EXPECT_EQ(st.work, cxx.get_work());
+  EXPECT_EQ(st.energy, cxx.get_energy());
+  EXPECT_GT(st.q, 1.0 + 2 * M_PI);  // more than a turn: gates switched along the way
+  double f[3] = {NAN, NAN, -7.0};
+  ASSERT_EQ(rdyn_get_forces(ws, f, 3), RDYN_OK);  // copies only the one force there is
+  EXPECT_EQ(f[0], cxx.get_forces()[0]);
+  EXPECT_TRUE(std::isnan(f[1]));
+  EXPECT_EQ(rdyn_get_forces(ws, f, -1), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_get_forces(ws, nullptr, 1), RDYN_BAD_ARGUMENT);
+
+  // Refusals are the C++ statuses, and change nothing.
+  EXPECT_EQ(rdyn_step(m, ws, NAN, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_STEP);
+  EXPECT_EQ(rdyn_step(m, ws, 1e-3, {RDYN_DRIVE_TORQUE, 2e6}), RDYN_BAD_DRIVE);
+  EXPECT_EQ(rdyn_step(m, ws, 1e-3, {7, 1.0}), RDYN_BAD_DRIVE);
+  EXPECT_EQ(rdyn_reset(m, ws, NAN, 0.0, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_STATE);
+  rdyn_state again;
+  ASSERT_EQ(rdyn_get_state(ws, &again), RDYN_OK);
+  EXPECT_EQ(std::memcmp(&st, &again, sizeof st), 0);
+  EXPECT_EQ(rdyn_step(nullptr, ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_step(m, nullptr, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_get_state(ws, nullptr), RDYN_BAD_ARGUMENT);
+
+  // A workspace of the fourbar is not the bicycle's.
+  rdyn_model* fb = nullptr;
+  rdyn_workspace* fb_ws = nullptr;
+  ASSERT_EQ(rdyn_model_load(fourbar().c_str(), "fourbar", &fb, msg, sizeof msg), RDYN_OK) << msg;
+  ASSERT_EQ(rdyn_workspace_new(fb, &fb_ws), RDYN_OK);
+  EXPECT_EQ(rdyn_step(m, fb_ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_WRONG_WORKSPACE);
+  EXPECT_EQ(rdyn_step(fb, fb_ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_OK);
+  rdyn_workspace* none = reinterpret_cast<rdyn_workspace*>(0x1);  // must be reset to NULL
+  EXPECT_EQ(rdyn_workspace_new(nullptr, &none), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(none, nullptr);
+
+  rdyn_workspace_free(ws);
+  rdyn_workspace_free(fb_ws);
+  rdyn_model_free(m);
+  rdyn_model_free(fb);
+}
+
+TEST(CApiStatus, EveryStatusHasItsOwnSentence) {
+  const rdyn_status all[] = {
+      RDYN_OK,         RDYN_BAD_STEP,      RDYN_BAD_DRIVE, RDYN_BAD_STATE,    RDYN_WRONG_WORKSPACE,
+      RDYN_NON_FINITE, RDYN_LEFT_TABLE,    RDYN_DIVERGED,  RDYN_BAD_ARGUMENT, RDYN_BAD_INPUT,
+      RDYN_NUMERICAL,  RDYN_OUT_OF_MEMORY, RDYN_INTERNAL};
+  std::set<std::string> seen;
+  for (rdyn_status s : all) {
+    const std::string text = rdyn_status_string(s);
+    EXPECT_NE(text, "unknown status") << s;
+    EXPECT_TRUE(seen.insert(text).second) << "duplicate sentence for " << s;
+  }
+  EXPECT_STREQ(rdyn_status_string(-3), "unknown status");
+  EXPECT_STREQ(rdyn_status_string(12), "unknown status");
+}
+
+}  // namespace
+}  // namespace rdyn::reduced

@@ -1,0 +1,303 @@
+// The embedding runtime: the same trajectory as the simulator's fixed-step path, drive
+// commands, argument checks that leave the state alone, no allocation, tables checked
+// against their scene.
+#include "reduced/runtime.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+
+#include "analytic_source.hpp"
+#include "cli_table.hpp"
+#include "count_allocations.hpp"
+#include "reduced/extract.hpp"
+#include "reduced/simulate_reduced.hpp"
+
+namespace rdyn::reduced {
+namespace {
+
+// The analytic slider-crank with every kind of load the runtime must carry: a drive torque on
+// the lever gated by the lever's rate (it switches twice a turn), a viscous brake on the crank,
+// and the constraint force F.
+models::Scene driven_scene(double torque) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"drive", "lever", torque, models::RateGate{"lever", +1}});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
+  return scene;
+}
+
+Samples analytic_samples(const models::Scene& scene) {
+  test::AnalyticSource src;
+  src.k = 0.01;
+  ExtractOptions opt;
+  opt.step_rad = 5 * M_PI / 180;
+  return extract_samples(src, scene, opt);
+}
+
+RuntimeModel driven_model(double torque) {
+  const auto scene = driven_scene(torque);
+  return make_runtime_model(analytic_samples(scene), scene, {Interpolation::CubicSpline});
+}
+
+// Absolute-plus-relative closeness.
+void expect_close(double a, double b, double tol, const char* what, int step) {
+  EXPECT_NEAR(a, b, tol * (1.0 + std::abs(b))) << what << " at step " << step;
+}
+
+// Runs n steps of dt with a fixed drive and compares every step with rdyn's simulator on the
+// fixed-step path (rk4-fixed, outputs at every step) for `reference`.
+void expect_matches_simulator(const RuntimeModel& model, const Drive& drive,
+                              const ReducedModel& reference, double q0, double qdot0) {
+  const double dt = 1e-3;
+  const int n = 2000;
+  ReducedOptions opt;
+  opt.integrator = "rk4-fixed";
+  opt.fixed_step_s = dt;
+  opt.output_interval_s = dt;
+  opt.duration_s = n * dt;
+  const auto ts = simulate_reduced(reference, q0, qdot0, opt);
+  ASSERT_EQ(ts.t.size(), static_cast<size_t>(n + 1));
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, q0, qdot0, drive), Status::Ok);
+  // Both start from the same outputs (gates set from the same state).
+  expect_close(ws.get_qddot(), ts.qddot[0], 1e-12, "q̈", 0);
+  for (int i = 1; i <= n; ++i) {
+    ASSERT_EQ(step(model, ws, dt, drive), Status::Ok) << "step " << i;
+    // The simulator's outputs are its step ends read through its quintic Hermite interpolant
+    // at the output times i·dt, which differ from the summed step times by ~1e-13 s (so q by
+    // ~1e-13 s × 35 rad/s); q̇ there is a difference of q values (~20 rad, ulp 4e-15) over the
+    // 1 ms step, so it carries ~1e-10 rad/s of rounding. Any other integrator or step split
+    // would differ by RK4's own error, ~1e-6. q̈ and F are then recomputed from (q, q̇), where
+    // m1, m2 change fast near the slider-crank's dead points and amplify that rounding to
+    // ~1e-7; what they check is the loads in them: a gate or drive torque taken wrongly
+    // changes q̈ by T·r/m1 ≈ 0.05/0.01 = O(1).
+    expect_close(ws.get_t(), ts.t[i], 1e-13, "t", i);
+    expect_close(ws.get_q(), ts.q[i], 1e-12, "q", i);
+    expect_close(ws.get_qdot(), ts.qdot[i], 1e-11, "q̇", i);
+    expect_close(ws.get_qddot(), ts.qddot[i], 1e-6, "q̈", i);
+    expect_close(ws.get_work(), ts.work[i], 1e-12, "W", i);
+    expect_close(ws.get_energy(), ts.energy[i], 1e-11, "E", i);
+    expect_close(ws.get_forces()[0], ts.forces[0][i], 1e-6, "F", i);
+    if (::testing::Test::HasFailure()) return;
+  }
+  EXPECT_GT(ws.get_switches(), 4);  // the gated torque switched: the split steps were compared too
+  EXPECT_GT(std::abs(ws.get_q() - q0), 1.0);  // it moved (a braking drive turns it back)
+}
+
+TEST(Runtime, StepFollowsTheSimulatorsFixedStepPath) {
+  const auto model = driven_model(0.05);
+  expect_matches_simulator(model, Drive::scaled(1.0), model.reduced, 0.3, 10.0);
+}
+
+TEST(Runtime, DriveScalesOrSetsTheSceneTorques) {
+  // Load values are not part of the table: a scene with three times the torque runs on the
+  // same samples, and a drive of ×3 (or of |T| = 0.15 with the scene's sign) must reproduce it.
+  for (double sign : {1.0, -1.0}) {
+    const auto model = driven_model(sign * 0.05);
+    const auto stronger = driven_scene(sign * 0.15);
+    const auto reference =
+        make_reduced_model(analytic_samples(stronger), stronger, Interpolation::CubicSpline);
+    SCOPED_TRACE(sign > 0 ? "positive torque" : "negative torque");
+    expect_matches_simulator(model, Drive::scaled(3.0), reference, 0.3, 10.0);
+    expect_matches_simulator(model, Drive::torque(0.15), reference, 0.3, 10.0);
+    RuntimeWorkspace ws(model);
+    ASSERT_EQ(step(model, ws, 1e-3, Drive::torque(0.15)), Status::Ok);
+    EXPECT_EQ(ws.get_drive_torques()[0], sign * 0.15);
+  }
+  // And the command matters: ×3 is not the scene's own run.
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace a(model), b(model);
+  for (int i = 0; i < 1000; ++i) {
+    step(model, a, 1e-3, Drive::scaled(1.0));
+    step(model, b, 1e-3, Drive::scaled(3.0));
+  }
+  EXPECT_GT(b.get_work(),
+            2.5 * a.get_work() - 1e-12);  // the drive does ~3× the work (minus the brake's)
+}
+
+TEST(Runtime, EveryStepAdvancesTimeEvenWhenAGateChatters) {
+  // A negative torque gated on the lever's positive rate brakes the lever whenever it is on,
+  // which drives its own switching function back through zero: the gate chatters (sliding).
+  // The split steps must still add up to dt.
+  const auto model = driven_model(-0.15);
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.3, 10.0), Status::Ok);
+  for (int i = 1; i <= 3000; ++i) {
+    ASSERT_EQ(step(model, ws, 1e-3, Drive{}), Status::Ok);
+    ASSERT_NEAR(ws.get_t(), i * 1e-3, 1e-12) << "step " << i;
+  }
+  EXPECT_GT(ws.get_switches(), 4);
+}
+
+TEST(Runtime, WorkspaceStartsAtTheScenesInitialState) {
+  auto scene = driven_scene(0.05);
+  scene.initial.q = 0.7;
+  scene.initial.qdot = 4.0;
+  const auto model = make_runtime_model(analytic_samples(scene), scene, {});
+  const RuntimeWorkspace ws(model);
+  EXPECT_EQ(ws.get_t(), 0.0);
+  EXPECT_EQ(ws.get_q(), 0.7);
+  EXPECT_EQ(ws.get_qdot(), 4.0);
+  EXPECT_EQ(model.drive_names, std::vector<std::string>{"drive"});
+  EXPECT_EQ(model.drive_nominal, std::vector<double>{0.05});
+  // q̈ from Eksergian at that state (the lever's rate cos q · q̇ > 0: the torque is on).
+  const test::SliderCrank sc;
+  const double expected =
+      (-0.01 * std::sin(0.7) + 0.05 * std::cos(0.7) - 1e-4 * 4.0 - sc.m2(0.7) * 16.0) / sc.m1(0.7);
+  EXPECT_NEAR(ws.get_qddot(), expected, 1e-6 * std::abs(expected));
+}
+
+TEST(Runtime, ResetAndStepAllocateNothing) {
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  const long before = g_allocations;
+  ASSERT_EQ(reset(model, ws, 0.0, 10.0), Status::Ok);
+  for (int i = 0; i < 3000; ++i) {
+    const Status s = step(model, ws, 1e-3, Drive::torque(0.05 + 0.01 * std::sin(i * 1e-2)));
+    if (s != Status::Ok) FAIL() << status_message(s);
+  }
+  step(model, ws, NAN, Drive{});  // refusals allocate nothing either
+  step(model, ws, 1e-3, Drive::scaled(INFINITY));
+  EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_GT(ws.get_switches(), 4);
+}
+
+// Everything a caller can read, to check that a refused call changed nothing.
+std::vector<double> snapshot(const RuntimeWorkspace& ws) {
+  std::vector<double> v{ws.get_t(),     ws.get_q(),    ws.get_qdot(),
+                        ws.get_qddot(), ws.get_work(), ws.get_energy()};
+  v.insert(v.end(), ws.get_forces().begin(), ws.get_forces().end());
+  v.insert(v.end(), ws.get_drive_torques().begin(), ws.get_drive_torques().end());
+  for (char g : ws.get_state().gate_on) v.push_back(g);
+  return v;
+}
+
+TEST(Runtime, BadArgumentsAreRefusedAndChangeNothing) {
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.3, 10.0, Drive::scaled(2.0)), Status::Ok);
+  for (int i = 0; i < 10; ++i) ASSERT_EQ(step(model, ws, 1e-3, Drive::scaled(2.0)), Status::Ok);
+  const auto before = snapshot(ws);
+  // Steps outside [1e-7, 1] s (the simulator's fixed-step range).
+  for (double dt : std::initializer_list<double>{NAN, INFINITY, -1e-3, 0.0, 9e-8, 1.5}) {
+    EXPECT_EQ(step(model, ws, dt, Drive{}), Status::BadStep) << dt;
+    EXPECT_EQ(snapshot(ws), before) << dt;
+  }
+  EXPECT_EQ(step(model, ws, 1e-7, Drive::scaled(2.0)),
+            Status::Ok);  // the bounds themselves are valid
+  const auto after_min_step = snapshot(ws);
+  // Drives that are not finite or command more than 1e6 N·m (models::limits::kMaxForce).
+  for (const Drive& d : {Drive::scaled(NAN), Drive::scaled(-INFINITY), Drive::torque(NAN),
+                         Drive::torque(1.5e6), Drive::torque(-1.5e6), Drive::scaled(2.1e7)}) {
+    EXPECT_EQ(step(model, ws, 1e-3, d), Status::BadDrive) << d.value;
+    EXPECT_EQ(snapshot(ws), after_min_step) << d.value;
+  }
+  EXPECT_EQ(reset(model, ws, 0.3, 10.0, Drive::torque(1.5e6)), Status::BadDrive);
+  // States that are not finite or out of range (|q̇| ≤ 1e4, models::limits::kMaxRate).
+  for (auto [q, qd] : std::initializer_list<std::pair<double, double>>{
+           {NAN, 1.0}, {0.0, INFINITY}, {0.0, 1.1e4}, {2e6, 0.0}}) {
+    EXPECT_EQ(reset(model, ws, q, qd), Status::BadState) << q << " " << qd;
+    EXPECT_EQ(snapshot(ws), after_min_step);
+  }
+  EXPECT_EQ(reset(model, ws, 0.0, -1e4), Status::Ok);
+}
+
+TEST(Runtime, AWorkspaceOfAnotherModelIsRefused) {
+  const auto model = driven_model(0.05);
+  auto plain_scene = test::analytic_scene();  // no torque, no brake: other sizes
+  const auto plain = make_runtime_model(analytic_samples(plain_scene), plain_scene, {});
+  RuntimeWorkspace ws(plain);
+  EXPECT_EQ(step(model, ws, 1e-3, Drive{}), Status::WrongWorkspace);
+  EXPECT_EQ(reset(model, ws, 0.0, 1.0), Status::WrongWorkspace);
+  EXPECT_EQ(step(plain, ws, 1e-3, Drive{}), Status::Ok);
+}
+
+TEST(Runtime, NonFiniteStepIsReportedAndRolledBack) {
+  // m2 = 1e300: q̈ = −m2 q̇²/m1 is finite at q̇ = 1 but the state overflows within a step.
+  const auto scene = driven_scene(0.05);
+  auto s = analytic_samples(scene);
+  for (auto& v : s.columns[s.require("m2")]) v = 1e300;
+  const auto model = make_runtime_model(s, scene, {Interpolation::Linear});
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.2, 1.0), Status::Ok);
+  const auto before = snapshot(ws);
+  EXPECT_EQ(step(model, ws, 1e-3, Drive{}), Status::NonFinite);
+  EXPECT_EQ(snapshot(ws), before);                           // rolled back: never a NaN to read
+  EXPECT_EQ(reset(model, ws, 0.2, 1e4), Status::NonFinite);  // q̈ overflows at once
+  EXPECT_EQ(snapshot(ws), before);
+}
+
+TEST(Runtime, LeavingANonPeriodicTableIsReported) {
+  // The same samples read as a non-periodic table over [0°, 355°].
+  const auto scene = driven_scene(0.05);
+  auto s = analytic_samples(scene);
+  s.periodic = false;
+  const auto model = make_runtime_model(s, scene, {});  // cubic spline: Fourier needs a period
+  RuntimeWorkspace ws(model);
+  EXPECT_EQ(reset(model, ws, -0.1, 0.0), Status::BadState);
+  ASSERT_EQ(reset(model, ws, 6.0, 5.0), Status::Ok);
+  Status st = Status::Ok;
+  int steps = 0;
+  while (st == Status::Ok && steps < 1000) st = step(model, ws, 1e-3, Drive{}), ++steps;
+  EXPECT_EQ(st, Status::LeftTable);
+  EXPECT_LT(steps, 100);  // 355° − 6 rad ≈ 0.2 rad at 5 rad/s: ~40 steps
+  EXPECT_TRUE(model.reduced.table.in_range(ws.get_q()));  // the last valid state is kept
+  EXPECT_GT(ws.get_q(), 6.0);
+}
+
+TEST(Runtime, DivergenceIsReported) {
+  // One-second RK4 steps at 40 rad/s cover six turns of a mechanism whose inertia varies
+  // three-fold within a turn: the energy balance breaks, and the step is refused.
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.0, 40.0), Status::Ok);
+  Status st = Status::Ok;
+  for (int i = 0; i < 20 && st == Status::Ok; ++i) st = step(model, ws, 1.0, Drive{});
+  EXPECT_EQ(st, Status::Diverged);
+  for (double v : snapshot(ws)) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(Runtime, StatusMessagesExistForEveryStatus) {
+  for (int s = 0; s <= static_cast<int>(Status::Diverged); ++s)
+    EXPECT_STRNE(status_message(static_cast<Status>(s)), "unknown status") << s;
+  EXPECT_STREQ(status_message(static_cast<Status>(99)), "unknown status");
+}
+
+TEST(Runtime, LoadsATableFileCheckedAgainstItsScene) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_runtime_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string table = (dir / "fourbar.csv").string();
+  ASSERT_EQ(test::extract_table_with_cli("fourbar", "30", table), 0);
+  // Its own scene: loaded, at the scene's initial state (fourbar.yaml: 30°, 8 rad/s).
+  const auto model = load_runtime_model(table, "fourbar");
+  EXPECT_EQ(model.scene_name, "fourbar");
+  EXPECT_NEAR(model.initial_q, 30 * M_PI / 180, 1e-15);
+  EXPECT_EQ(model.initial_qdot, 8.0);
+  EXPECT_EQ(model.reduced.force_names, std::vector<std::string>{"rocker_axial"});
+  RuntimeWorkspace ws(model);
+  EXPECT_EQ(ws.get_qdot(), 8.0);
+  for (int i = 0; i < 100; ++i) ASSERT_EQ(step(model, ws, 1e-3, Drive{}), Status::Ok);
+  EXPECT_GT(ws.get_q(), model.initial_q + 0.05);  // it turned (gravity slows it: no full turn)
+  EXPECT_NEAR(ws.get_t(), 0.1, 1e-12);
+  // Another scene: refused before anything runs.
+  try {
+    load_runtime_model(table, "bicycle");
+    ADD_FAILURE() << "a fourbar table was accepted for the bicycle";
+  } catch (const TableError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("table " + table + " was extracted from a different scene"),
+        std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(load_runtime_model((dir / "missing.csv").string(), "fourbar"), TableError);
+  EXPECT_THROW(load_runtime_model(table, "no-such-scene"), models::SceneError);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rdyn::reduced
