@@ -843,9 +843,12 @@ std::string read_scene_text(const std::string& name_or_path) {
   const std::string path = resolve_scene_path(name_or_path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, 0, "", "cannot open for reading");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  return buf.str();
+  // Read at most one byte more than a scene may have: /dev/zero or a huge file cannot
+  // exhaust memory (parse_scene refuses the oversized text with its size limit).
+  std::string text(kMaxSceneBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(std::max<std::streamsize>(0, in.gcount())));
+  return text;
 }
 
 Scene load_scene(const std::string& name_or_path, const std::vector<Override>& overrides) {

@@ -231,10 +231,9 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   return r;
 }
 
-std::string calibrated_scene_yaml(const std::string& source, const std::vector<models::Override>& base,
-                                  const models::Scene& scene, const CalibrationOptions& opt,
-                                  const CalibrationResult& r) {
-  const std::string text = models::read_scene_text(source);
+std::string calibrated_scene_yaml(const std::string& source, const std::string& text,
+                                  const std::vector<models::Override>& base, const models::Scene& scene,
+                                  const CalibrationOptions& opt, const CalibrationResult& r) {
   std::vector<models::Override> o = base;
   auto num = [](double v) { return fmt::format("{:.12g}", v); };
   if (models::scene_yaml_has(text, "bicycle_leg")) {

@@ -50,9 +50,10 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress);
 
 // The scene's YAML rewritten with the calibrated torque, resistance and steady initial
-// conditions (for --write-scene). `source` and `base` are how the scene was loaded.
-std::string calibrated_scene_yaml(const std::string& source, const std::vector<models::Override>& base,
-                                  const models::Scene& scene, const CalibrationOptions& opt,
-                                  const CalibrationResult& r);
+// conditions (for --write-scene). `source`, `text` and `base` are how the scene was loaded
+// (the text read once: a scene given as /dev/stdin cannot be read twice).
+std::string calibrated_scene_yaml(const std::string& source, const std::string& text,
+                                  const std::vector<models::Override>& base, const models::Scene& scene,
+                                  const CalibrationOptions& opt, const CalibrationResult& r);
 
 }  // namespace rdyn::validate

@@ -188,7 +188,8 @@ int run_calibrate(const CalibrateArgs& a) {
   require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
   require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
   require_grid("--grid-deg", a.grid_deg);
-  const models::Scene scene = models::load_scene(a.scene, base);
+  const std::string text = models::read_scene_text(a.scene);  // once: the scene may be a stream
+  const models::Scene scene = models::parse_scene(text, models::resolve_scene_path(a.scene), base);
   std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
   if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
   CalibrationOptions opt;
@@ -220,7 +221,7 @@ int run_calibrate(const CalibrateArgs& a) {
       {"wall_time_s", r.wall_time_s},
   };
   if (out) {
-    out->write(calibrated_scene_yaml(a.scene, base, scene, opt, r));
+    out->write(calibrated_scene_yaml(a.scene, text, base, scene, opt, r));
     out->commit();
     j["written_scene"] = a.write_scene;
   }
@@ -335,7 +336,12 @@ std::vector<std::string> suite_files(const std::string& suite) {
   std::vector<std::string> files;
   for (auto it = fs::directory_iterator(suite, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
     const auto ext = it->path().extension();
-    if ((ext == ".yaml" || ext == ".yml") && it->is_regular_file(ec)) files.push_back(it->path().string());
+    if (ext != ".yaml" && ext != ".yml") continue;
+    std::error_code fe;
+    if (!it->is_regular_file(fe))  // a dangling link, a FIFO, a device or a folder named *.yaml
+      throw models::SceneError(it->path().string(), 0, "--suite", "not a readable scene file (a link to nothing, a FIFO, a "
+                                                                  "device or a folder); remove it or rename it");
+    files.push_back(it->path().string());
     if (files.size() > kMaxSuiteScenes)
       throw models::SceneError(suite, 0, "--suite", fmt::format("more than {} scenes", kMaxSuiteScenes));
   }

@@ -555,6 +555,13 @@ void found_later(std::vector<Case>& cs) {
   for (const auto& [tag, set] : std::vector<std::pair<std::string, std::string>>{{"noequals", "noequals"}, {"empty_key", "=1"}})
     cs.push_back({"suite_bad_set_" + tag, {"validate", "--suite", "s", "--set", set, "--out", "o"}, 2, "--set",
                   {{"s/a.yaml", scene_text("fourbar")}}, nullptr, "o"});
+  // Endless or special files as scenes: read up to the size limit, never to the end.
+  for (const std::string dev : {"/dev/zero", "/dev/urandom"})
+    cs.push_back({"scene_from_" + dev.substr(5), {"simulate", dev, "--out", "o"}, 2, "too large", {}, nullptr, "o"});
+  cs.push_back({"suite_dangling_link_named_yaml", {"validate", "--suite", "s", "--out", "o"}, 2, "not a readable scene",
+                {{"s/a.yaml", scene_text("fourbar")}}, [](const fs::path& d) {
+                  fs::create_symlink("nowhere.yaml", d / "s/b.yaml");
+                }, "o"});
   // A mechanism at rest: every error is 0 of a peak of 0 — a failure, not a pass.
   cs.push_back({"validate_mechanism_at_rest_fails",
                 {"validate", "fourbar", "--quick", "--set", "gravity.enabled=false", "--set", "initial.qdot=0", "--out",
