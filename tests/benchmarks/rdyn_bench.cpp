@@ -5,7 +5,10 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <map>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
@@ -116,6 +119,24 @@ void BM_ExtractionPerGridPoint(benchmark::State& st) {
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_ExtractionPerGridPoint)->Unit(benchmark::kMillisecond);
+
+// Building the fused table with `fourier` interpolation (trigonometric interpolant resampled
+// at ≤ 0.25° into the cubic table) from synthetic samples with the bicycle's 21 columns; the
+// argument is the grid step in millidegrees (10000 = 10°).
+void BM_FourierTableBuild(benchmark::State& st) {
+  const int n = static_cast<int>(std::lround(360000.0 / static_cast<double>(st.range(0))));
+  reduced::Samples s;
+  s.step = 2 * M_PI / n;
+  for (int i = 0; i < n; ++i) s.q.push_back(i * s.step);
+  for (int c = 0; c < 21; ++c) {
+    std::vector<double> v(n);
+    for (int i = 0; i < n; ++i) v[i] = (1 + 0.1 * c) * std::exp(std::sin(s.q[i] + c)) + 0.2 * std::cos(3 * s.q[i]);
+    s.add("c" + std::to_string(c), v);
+  }
+  for (auto _ : st) benchmark::DoNotOptimize(reduced::build_table(s, reduced::Interpolation::Fourier).coef.data());
+  st.counters["grid_points"] = n;
+}
+BENCHMARK(BM_FourierTableBuild)->Arg(10000)->Arg(1000)->Arg(500)->Arg(300)->Arg(100)->Arg(50)->Unit(benchmark::kMillisecond);
 
 // Full-model forward dynamics (Simbody), per simulated second, at tolerance 1e-6 (the
 // cheapest full run within 0.1 % knee-force error) and at the 1e-10 reference.

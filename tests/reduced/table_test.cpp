@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <random>
 
 namespace rdyn::reduced {
 namespace {
@@ -68,6 +69,101 @@ TEST(Table, FourierIsSpectralForSmoothPeriodicColumns) {
   const double cubic = max_error(build_table(periodic_samples(36), Interpolation::CubicSpline), 2, f_exact);
   const double fourier = max_error(build_table(periodic_samples(36), Interpolation::Fourier), 2, f_exact);
   EXPECT_LT(fourier, cubic / 100);
+}
+
+// The former O(N·M) direct DFT resampling (reduced/table.cpp before issue #11), kept as the
+// reference the FFT route must reproduce.
+Samples direct_dft_resample(const Samples& s, int refine) {
+  const int n = static_cast<int>(s.q.size()), m = n * refine;
+  Samples out = s;
+  out.step = s.step * n / m;
+  out.q.resize(m);
+  for (int i = 0; i < m; ++i) out.q[i] = s.q0 + i * out.step;
+  const int kmax = n / 2;
+  for (size_t c = 0; c < s.columns.size(); ++c) {
+    std::vector<double> a(kmax + 1, 0.0), b(kmax + 1, 0.0);
+    for (int k = 0; k <= kmax; ++k) {
+      for (int i = 0; i < n; ++i) {
+        a[k] += s.columns[c][i] * std::cos(2 * M_PI * k * i / n);
+        b[k] += s.columns[c][i] * std::sin(2 * M_PI * k * i / n);
+      }
+      const double w = (k == 0 || (n % 2 == 0 && k == kmax)) ? 1.0 / n : 2.0 / n;
+      a[k] *= w, b[k] *= w;
+    }
+    if (n % 2 == 0) b[kmax] = 0.0;
+    auto& col = out.columns[c];
+    col.assign(m, 0.0);
+    for (int i = 0; i < m; ++i)
+      for (int k = 0; k <= kmax; ++k) {
+        const double ph = 2 * M_PI * k * (static_cast<double>(i) / refine) / n;
+        col[i] += a[k] * std::cos(ph) + b[k] * std::sin(ph);
+      }
+  }
+  return out;
+}
+
+// Random smooth periodic columns: a random trigonometric series with decaying amplitudes
+// (up to degree 40, above the Nyquist degree of the coarse grids, so aliasing is exercised).
+Samples random_smooth_samples(int n, unsigned seed, double q0) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Samples s;
+  s.step = 2 * M_PI / n;
+  s.q0 = q0;
+  for (int i = 0; i < n; ++i) s.q.push_back(q0 + i * s.step);
+  for (int c = 0; c < 3; ++c) {
+    double a[41], b[41];
+    for (int k = 0; k <= 40; ++k) a[k] = u(rng) * std::exp(-0.15 * k), b[k] = u(rng) * std::exp(-0.15 * k);
+    std::vector<double> v(n);
+    for (int i = 0; i < n; ++i)
+      for (int k = 0; k <= 40; ++k) v[i] += a[k] * std::cos(k * s.q[i]) + b[k] * std::sin(k * s.q[i]);
+    s.add("c" + std::to_string(c), v);
+  }
+  return s;
+}
+
+TEST(Table, FourierByFftMatchesTheDirectDftForOddAndEvenGrids) {
+  // Odd and even N, prime N (GSL's generic factor), grids from 15° to 0.3° (refine 60 to 2),
+  // and a first grid point off zero.
+  for (int n : {24, 25, 36, 37, 71, 72, 360, 1200}) {
+    const auto s = random_smooth_samples(n, 100 + n, n % 2 ? 0.3 : 0.0);
+    const int refine = std::max(1, static_cast<int>(std::ceil(s.step / (M_PI / 720.0) - 1e-9)));
+    ASSERT_GE(refine, 2) << n;
+    const Table fft = build_table(s, Interpolation::Fourier);
+    const Table dft = build_table(direct_dft_resample(s, refine), Interpolation::CubicSpline);
+    ASSERT_EQ(fft.coef.size(), dft.coef.size()) << n;
+    EXPECT_DOUBLE_EQ(fft.step, dft.step);
+    for (int c = 0; c < 3; ++c) {
+      double scale = 0, diff = 0;
+      for (int iv = 0; iv < fft.intervals; ++iv) {
+        const size_t at = (static_cast<size_t>(iv) * fft.cols + c) * 4;
+        scale = std::max(scale, std::abs(dft.coef[at]));
+        diff = std::max(diff, std::abs(fft.coef[at] - dft.coef[at]));
+      }
+      EXPECT_LT(diff, 1e-12 * scale) << "N = " << n << ", column " << c;
+      // Values between the fine grid points too (the cubic coefficients agree, not only the knots).
+      for (int i = 0; i < 200; ++i) {
+        const double q = s.q0 + 2 * M_PI * (i + 0.37) / 200;
+        EXPECT_NEAR(fft.eval(c, q), dft.eval(c, q), 1e-12 * scale) << "N = " << n << ", q = " << q;
+      }
+    }
+  }
+}
+
+TEST(Table, FourierReproducesASampledTrigonometricPolynomialExactly) {
+  // A degree-4 trigonometric polynomial sampled at N = 9 (odd) and N = 10 (even, whose Nyquist
+  // degree 5 is absent) is its own interpolant: the fine grid values are the polynomial.
+  for (int n : {9, 10}) {
+    Samples s;
+    s.step = 2 * M_PI / n;
+    std::vector<double> v;
+    auto p = [](double q) { return 1.5 + std::cos(q) - 0.5 * std::sin(2 * q) + 0.25 * std::cos(4 * q + 0.3); };
+    for (int i = 0; i < n; ++i) s.q.push_back(i * s.step), v.push_back(p(i * s.step));
+    s.add("p", v);
+    const Table t = build_table(s, Interpolation::Fourier);
+    ASSERT_EQ(t.step, 2 * M_PI / t.intervals);
+    for (int i = 0; i < t.intervals; ++i) EXPECT_NEAR(t.eval(0, i * t.step), p(i * t.step), 1e-13) << n;
+  }
 }
 
 TEST(Table, EnergyConsistentM2IsHalfTheDerivativeOfM1) {
