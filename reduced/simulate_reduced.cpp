@@ -272,10 +272,12 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
     gsl_odeiv2_evolve_reset(d.evolve.get());
     d.end = d.point(t, d.y);
     // Every gate whose switching function has changed sign by the cut flips — several do at
-    // once when q̇ itself crosses zero (the crank stalls and turns back).
+    // once when q̇ itself crosses zero (the crank stalls and turns back) — and when the step
+    // stops at q_stop on a switch angle, whose cut lies past both crossings (a lost flip left
+    // the gate disagreeing with its witness, and the next steps chattered without end).
     for (size_t g = 0; g < ng; ++g) {
       d.s_after[g] = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
-      if (which >= 0 && d.s_before[g] != 0.0 && (d.s_before[g] > 0) != (d.s_after[g] > 0)) {
+      if (d.s_before[g] != 0.0 && (d.s_before[g] > 0) != (d.s_after[g] > 0)) {
         d.pending[g] = 1;
         ++d.events;
       }
@@ -289,7 +291,9 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   if (!m.table.in_range(d.ws.q))
     throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
                                  t, d.ws.q));
-  return which == -2;
+  // A cut at a switch located just before q_stop may lie past q_stop too (q_stop on a switch
+  // angle): that is the stop, or every later step would start beyond it and never stop.
+  return which == -2 || (which >= 0 && stop_at_q && stop_before != 0.0 && (stop_before > 0) != (d.y[0] - q_stop > 0));
 }
 
 bool AdaptiveIntegrator::advance(double t_end, double q_stop) {

@@ -12,6 +12,7 @@
 #include "engine/full_model.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
+#include "reduced/steady_cycle.hpp"
 #include "validate/build_reduced.hpp"
 
 namespace rdyn::validate {
@@ -36,35 +37,29 @@ models::Scene with_loads(models::Scene s, double T, double coefficient) {
 
 struct Cycle {
   bool ok = false;
-  double speed = 0.0;   // q̇ at the section q = q_s on the steady cycle
-  double period = 0.0;  // [s]
+  double speed = 0.0;            // q̇ at the section q = q_s on the steady cycle
+  double period = 0.0;           // [s]
+  reduced::SteadyCycle detail;   // extremes, work, counts (when ok)
 };
 
-// Steady cycle of the reduced model: fixed point of the Poincaré map at q = q_s
-// (speed after one revolution as a function of the starting speed), by the secant method.
-Cycle steady_cycle(const reduced::ReducedModel& m, double q_s, double v_guess, double tol, int& evals) {
-  reduced::AdaptiveIntegrator integ(m, tol);
-  auto map = [&](double v, double& period) {
-    ++evals;
-    integ.reset(0.0, q_s, v);
-    // A revolution takes 2π/v at the starting speed; allow 20 times that before calling it a stall.
-    const bool done = integ.advance(20.0 * 2 * M_PI / std::max(v, 1e-3), q_s + 2 * M_PI);
-    period = integ.state().t;
-    return done ? integ.state().qdot : NAN;
-  };
-  double p0, p1;
-  double v0 = v_guess, g0 = map(v0, p0) - v0;
-  double v1 = std::isfinite(g0) ? v0 + g0 : v0 * 1.01, g1 = map(v1, p1) - v1;
-  for (int it = 0; it < 40 && std::isfinite(g0) && std::isfinite(g1); ++it) {
-    if (std::abs(g1) < 1e-12 * std::abs(v1)) return {true, v1, p1};
-    const double v2 = v1 - g1 * (v1 - v0) / (g1 - g0);
-    if (!(v2 > 0)) break;
-    v0 = v1, g0 = g1, p0 = p1;
-    v1 = v2;
-    g1 = map(v1, p1) - v1;
+// Steady cycle of the reduced model at section q_s (reduced/steady_cycle.hpp): by the first
+// integral of Eksergian's equation, by time stepping (Poincaré map) where q̇ does not keep its
+// sign. Not ok when neither finds one (a stall). `extremes`: also sample the cycle for the
+// speed fluctuation and the peak constraint forces.
+Cycle steady_cycle(const reduced::ReducedModel& m, double q_s, double v_guess, double tol, int& evals,
+                   bool extremes = false) {
+  reduced::SteadyCycleOptions o;
+  o.q_section = q_s;
+  o.qdot_guess = v_guess;
+  o.tolerance = tol;
+  o.extremes = extremes;
+  try {
+    const auto c = reduced::find_steady_cycle(m, o);
+    evals += c.passes;
+    return {true, c.qdot_section, c.period_s, c};
+  } catch (const models::NumericalError&) {
+    return {};  // (the failed search's passes are not counted)
   }
-  if (std::isfinite(g1) && std::abs(g1) < 1e-9 * std::abs(v1)) return {true, v1, p1};
-  return {};
 }
 
 struct RootContext {
@@ -160,7 +155,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   progress.note("");
   r.torque_Nm = T;
   for (auto& t : m.torques) t.value = (t.value < 0 ? -1.0 : 1.0) * T;
-  const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals);
+  const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
   if (!cy.ok)
     throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the torque found "
                                              "({:.6g} N·m)", T));
@@ -179,21 +174,16 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
         "(off by {:.3g} %, allowed {:g} %)",
         r.mean_cadence_hz_reduced, T, opt.cadence_hz, 100 * miss_reduced, 100 * kReducedCadenceTolerance));
 
-  // The steady cycle sampled finely: fluctuation and peak force.
-  reduced::ReducedOptions ro;
-  ro.duration_s = cy.period;
-  ro.output_interval_s = cy.period / 1440;
-  ro.tolerance = opt.tolerance;
-  const auto cyc = reduced::simulate_reduced(m, r.steady_q, r.steady_qdot, ro);
+  // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
   auto fluct = [](const std::vector<double>& v, size_t from) {
     double lo = INFINITY, hi = -INFINITY, sum = 0;
     for (size_t i = from; i < v.size(); ++i) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]), sum += v[i];
     return (hi - lo) / (sum / (v.size() - from));
   };
-  r.speed_fluctuation = fluct(cyc.qdot, 0);
+  r.speed_fluctuation = cy.detail.speed_fluctuation;
   if (!scene.outputs.constraint_forces.empty()) {
     r.force_name = scene.outputs.constraint_forces[0].name;
-    for (double f : cyc.forces[0]) r.peak_force_N = std::max(r.peak_force_N, std::abs(f));
+    r.peak_force_N = cy.detail.peak_force_N[0];
   }
 
   // Confirmation with the full model from the same point of the steady cycle.

@@ -4,6 +4,8 @@
 // matched knee-force accuracy (≤ 0.1 % of its peak against the converged reference).
 #include <benchmark/benchmark.h>
 
+#include <time.h>
+
 #include <cmath>
 #include <map>
 #include <random>
@@ -17,6 +19,8 @@
 #include "reduced/extract.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
+#include "reduced/steady_cycle.hpp"
+#include "validate/calibrate.hpp"
 
 namespace {
 
@@ -82,16 +86,53 @@ void BM_ReducedFixedStep(benchmark::State& st) {
 }
 BENCHMARK(BM_ReducedFixedStep)->Unit(benchmark::kMicrosecond);
 
-// Reduced simulation with the validation's outputs (every 5 ms), per simulated second.
+// CPU seconds per call of f, over n calls (the process clock: this machine is shared).
+template <typename F>
+double cpu_seconds_per_call(long n, F&& f) {
+  timespec a{}, b{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
+  for (long i = 0; i < n; ++i) f(i);
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &b);
+  return ((b.tv_sec - a.tv_sec) + 1e-9 * (b.tv_nsec - a.tv_nsec)) / n;
+}
+
+// Reduced simulation with the validation's outputs (every 5 ms), per simulated second, next to
+// its floor (issue #11 item 6): the steps it takes times the cost of one rk8pd step (13
+// right-hand sides) plus the output samples times one output evaluation (one fused table
+// lookup: q̈, energy, constraint forces), both measured here on the same model.
 void BM_ReducedPerSimulatedSecond(benchmark::State& st) {
   const auto& m = model(static_cast<double>(st.range(0)));
   reduced::ReducedOptions o;
   o.duration_s = 10;
   o.output_interval_s = 0.005;
   o.tolerance = 1e-6;
-  for (auto _ : st) benchmark::DoNotOptimize(reduced::simulate_reduced(m, 0, 2 * M_PI, o).q.back());
+  models::RunStats stats;
+  size_t rows = 0;
+  for (auto _ : st) {
+    const auto ts = reduced::simulate_reduced(m, 0, 2 * M_PI, o);
+    stats = ts.stats, rows = ts.t.size();
+  }
   st.counters["s_per_simulated_s"] = benchmark::Counter(o.duration_s * st.iterations(),
                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  reduced::ReducedWorkspace ws(m);
+  std::vector<double> f(m.force_names.size());
+  double sink = 0;
+  const double rhs_s = cpu_seconds_per_call(200000, [&](long i) {
+    double qdd, p;
+    reduced::calc_acceleration(m, ws, 0.001 * static_cast<double>(i % 6283), 6.28, qdd, p);
+    sink += qdd;
+  });
+  const double sample_s = cpu_seconds_per_call(200000, [&](long i) {
+    double qdd, p;
+    sink += reduced::calc_sample(m, ws, 0.001 * static_cast<double>(i % 6283), 6.28, qdd, p, f.data());
+  });
+  benchmark::DoNotOptimize(sink);
+  const double floor = (13.0 * static_cast<double>(stats.steps_attempted) * rhs_s + static_cast<double>(rows) * sample_s) /
+                       o.duration_s;
+  st.counters["floor_s_per_simulated_s"] = floor;
+  st.counters["steps_per_simulated_s"] = static_cast<double>(stats.steps_attempted) / o.duration_s;
+  st.counters["rhs_s"] = rhs_s;
+  st.counters["output_sample_s"] = sample_s;
 }
 BENCHMARK(BM_ReducedPerSimulatedSecond)->Arg(10)->Arg(5)->Unit(benchmark::kMicrosecond);
 
@@ -119,6 +160,36 @@ void BM_ExtractionPerGridPoint(benchmark::State& st) {
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_ExtractionPerGridPoint)->Unit(benchmark::kMillisecond);
+
+// The bicycle's steady cycle (10° fourier table, the scene's loads, section at q = 0) with
+// its extremes: by the first integral of Eksergian's equation (Arg 0) and by the time-stepping
+// Poincaré map (Arg 1), tolerance 1e-10 as calibration uses.
+void BM_SteadyCycle(benchmark::State& st) {
+  const auto& m = model(10);
+  reduced::SteadyCycleOptions o;
+  o.qdot_guess = 2 * M_PI;
+  o.tolerance = 1e-10;
+  reduced::SteadyCycle c;
+  for (auto _ : st)
+    c = st.range(0) == 0 ? reduced::calc_steady_cycle(m, o) : reduced::calc_steady_cycle_time_stepping(m, o);
+  st.counters["passes"] = c.passes;
+  st.counters["steps"] = static_cast<double>(c.steps);
+  st.counters["evals"] = static_cast<double>(c.rhs_evaluations);
+}
+BENCHMARK(BM_SteadyCycle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// One calibration without the full-model confirmation — what one `rdyn sweep` case costs:
+// table extraction (10°) plus the reduced part (torque search over steady cycles, the final
+// cycle's extremes). BM_ExtractionPerGridPoint × 36 is the extraction's share.
+void BM_CalibrationWithoutFullCheck(benchmark::State& st) {
+  validate::CalibrationOptions o;
+  o.full_check_s = 0.0;
+  validate::Progress quiet(false);
+  validate::CalibrationResult r;
+  for (auto _ : st) r = validate::calibrate(bicycle(), o, quiet);
+  st.counters["passes"] = r.evaluations;
+}
+BENCHMARK(BM_CalibrationWithoutFullCheck)->Unit(benchmark::kMillisecond);
 
 // Building the fused table with `fourier` interpolation (trigonometric interpolant resampled
 // at ≤ 0.25° into the cubic table) from synthetic samples with the bicycle's 21 columns; the
