@@ -33,6 +33,7 @@ class FullKinetostaticSource : public reduced::KinetostaticSource {
   std::optional<reduced::DirectPoint> direct_here(double q);
   const FullModel& model_;
   FullWorkspace ws_;
+  double max_jump_;  // longest continuation move: 10° (revolute) or 1/20 of the mechanism's size (prismatic)
   double q_now_;
   long calls_ = 0;
 };

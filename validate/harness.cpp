@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "engine/forward_dynamics.hpp"
+#include "engine/independent_range.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
@@ -237,9 +238,14 @@ void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
     v.dense_names.push_back("me2_" + m.force_names[k]);
   }
   v.dense_params.assign(cols.size() + 1, {});
+  // A range table: 360 equal steps over its range (deg or m), not a turn.
+  const bool range = !v.samples10.periodic;
+  const double span = range ? v.samples10.q.back() - v.samples10.q0 : 2 * M_PI;
+  const double unit = v.samples10.revolute ? 180 / M_PI : 1.0;
+  if (!v.samples10.revolute) v.dense_names[0] = "q_m";
   for (int d = 0; d <= 360; ++d) {
-    const double q = v.samples10.q0 + d * M_PI / 180;
-    v.dense_params[0].push_back(q * 180 / M_PI);
+    const double q = v.samples10.q0 + d * span / 360;
+    v.dense_params[0].push_back(q * unit);
     for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
   }
 }
@@ -273,7 +279,9 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
 }  // namespace
 
 void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
-  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  // A coordinate confined to a range (a rocker, a slider) has no revolutions to count.
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute &&
+                        engine::calc_independent_domain(full).periodic;
   const std::string integrator = scene.validation.reference_integrator;
   progress.count(scene.name + ": reference (full model)", 0, 2);
   const auto t_ref = Clock::now();
@@ -343,8 +351,6 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   v.tightest_tolerance = plan.tightest_tolerance();
   // 2–3. The ladders.
   run_full_ladder(scene.name, full, plan, v, progress);
-  if (scene.find_joint(scene.independent)->type != models::JointType::Revolute)
-    throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
   run_reduced_ladder(scene, plan, v, progress);
   calc_dense_params(scene, v);
   // 4. Pareto front, matched-error speedup, recommended setting, convergence.

@@ -98,9 +98,9 @@ std::string params_gp(const json& fig) {
   gp += fmt::format(fmt::runtime(kSvgHead), nf ? 640 : 330);
   gp += fmt::format(
       "set output 'params.svg'\nset datafile separator ','\nset grid\nset key bottom right\n"
-      "set xlabel 'q [deg]'\nset xtics 60\nset multiplot layout {},2 title 'Reduced parameters "
+      "set xlabel '{}'\n{}set multiplot layout {},2 title 'Reduced parameters "
       "(points: samples from kinetostatic calls; lines: interpolant)'\n",
-      nf ? 2 : 1);
+      names[0] == "q_m" ? "q [m]" : "q [deg]", names[0] == "q_m" ? "" : "set xtics 60\n", nf ? 2 : 1);
   for (size_t c = 1; c < names.size(); ++c) {
     const std::string unit = c <= 2 ? "kg·m^2" : "kg·m";
     gp += fmt::format(
