@@ -199,7 +199,7 @@ long range_intervals(double span, double step_rad, bool revolute) {
   if (!(n + 1 <= static_cast<double>(kMaxTableRows)))
     throw TableError(fmt::format("a range table of {:.6g} with a {:.6g}° grid would have {:.3g} points, more than {}",
                                  span, step_rad * 180 / kPi, n + 1, kMaxTableRows));
-  return std::max(3L, static_cast<long>(n));
+  return std::max(4L, static_cast<long>(n));
 }
 
 Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, const ExtractOptions& opt) {

@@ -39,7 +39,7 @@ struct ExtractRange {
 // Intervals of a range table for a grid step [rad]: a revolute range gets the fewest equal
 // intervals no longer than the step; a prismatic one as many intervals as the step makes over a
 // turn (a 10° grid: 36 intervals over the stroke), so the grid ladders of `rdyn validate` apply
-// to both. At least 3 intervals (4 points, what a spline takes). Throws TableError when the
+// to both. At least 4 intervals (5 points, what every interpolation takes: GSL's Akima needs 5). Throws TableError when the
 // span is not finite and positive, or makes more than kMaxTableRows points.
 long range_intervals(double span, double step_rad, bool revolute);
 

@@ -210,6 +210,10 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
   std::vector<double> x(m), y(m);
   for (int i = 0; i < m; ++i) x[i] = s.q0 + i * s.step;
   std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(type, m), gsl_spline_free);
+  // GSL refuses (returns null) fewer points than the type needs (Akima: 5).
+  if (!sp)
+    throw TableError(fmt::format("{} interpolation needs more than the table's {} grid points",
+                                 interpolation_name(interp), n));
   std::unique_ptr<gsl_interp_accel, decltype(&gsl_interp_accel_free)> acc(gsl_interp_accel_alloc(),
                                                                          gsl_interp_accel_free);
   gsl_set_error_handler_off();

@@ -428,9 +428,12 @@ std::string headline(const json& s) {
     first = false;
   }
   out += " of their peaks. ";
-  out += s.at("steady_window").value("whole_run", false)
-             ? "The run has no steady cycles: errors are maxima over the whole run."
-             : "Errors are maxima over the steady cycles.";
+  const auto& w = s.at("steady_window");
+  // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
+  const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
+  out += !w.value("whole_run", false) ? "Errors are maxima over the steady cycles."
+         : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
+                                      : "The run has no steady cycles: errors are maxima over the whole run.";
   return out;
 }
 

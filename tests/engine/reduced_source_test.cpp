@@ -206,3 +206,63 @@ TEST(ReducedSourceRange, SliderDrivenSliderCrankMatchesTheClosedForm) {
 
 }  // namespace
 }  // namespace rdyn::engine
+
+#include "reduced/table.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+// Issue #10: the crane's cylinder stroke L as the independent coordinate. The potential of
+// gravity and the gas spring in closed form, V(L) = g·Σ m_i y_i(L) + ½ k (L − L0)², gives
+// Q_cons = −dV/dL; the static equilibrium stroke, where the 4 kN pressure balances it
+// (virtual work: F = dV/dL), follows from the table and from the closed form alike.
+TEST(ReducedSourceRange, CraneGeneralizedForceAndEquilibriumStrokeMatchVirtualWork) {
+  const auto scene = models::load_scene("crane-luffing");
+  FullModel model(scene);
+  const auto d = calc_independent_domain(model);
+  ASSERT_FALSE(d.periodic);
+  EXPECT_EQ(d.min, 1.0);
+  EXPECT_EQ(d.max, 1.9);
+  EXPECT_EQ(d.max_edge, "declared limit");
+  FullKinetostaticSource src(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = 10 * M_PI / 180;
+  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
+  const auto s = reduced::extract_samples(src, scene, opt);
+  ASSERT_EQ(s.q.size(), 37u);
+
+  const double g = 9.81, Ax = 0.6, Ay = -0.4, OB = 1.5, k = 40000, L0 = 1.583;
+  auto V = [&](double L) {
+    // Boom angle φ from L² = OB² + |OA|² − 2·OB·(Ax cos φ + Ay sin φ), boom above the line OA.
+    const double R = std::hypot(Ax, Ay), delta = std::atan2(-Ay, Ax);
+    const double phi = std::acos((OB * OB + R * R - L * L) / (2 * OB * R)) - delta;
+    const double Bx = OB * std::cos(phi), By = OB * std::sin(phi);
+    const double psi = std::atan2(By - Ay, Bx - Ax);  // cylinder direction A → B
+    return g * (300 * 2.6667 * std::sin(phi) + 30 * (Ay + 0.6 * std::sin(psi)) + 15 * (By - 0.5 * std::sin(psi))) +
+           0.5 * k * (L - L0) * (L - L0);
+  };
+  auto Q = [&](double L) { return -(V(L + 1e-6) - V(L - 1e-6)) / 2e-6; };
+  const int c_Q = s.require("Q_cons"), c_V = s.require("V");
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    EXPECT_NEAR(s.columns[c_Q][i], Q(s.q[i]), 1e-6 * 1e4) << s.q[i];
+    EXPECT_NEAR(s.columns[c_V][i] - s.columns[c_V][0], V(s.q[i]) - V(s.q[0]), 1e-6 * 1e4) << s.q[i];
+  }
+  // Equilibrium stroke: Q_cons(L*) + 4000 N = 0, by bisection on the closed form and on the
+  // not-a-knot table.
+  auto bisect = [](auto f, double a, double b) {
+    for (int it = 0; it < 200 && b - a > 1e-13; ++it) {
+      const double m = 0.5 * (a + b);
+      ((f(a) > 0) == (f(m) > 0) ? a : b) = m;
+    }
+    return 0.5 * (a + b);
+  };
+  const double L_closed = bisect([&](double L) { return Q(L) + 4000; }, 1.2, 1.7);
+  const auto table = reduced::build_table(s, reduced::Interpolation::CubicSpline);
+  const int t_Q = table.column("Q_cons");
+  const double L_table = bisect([&](double L) { return table.eval(t_Q, L) + 4000; }, 1.2, 1.7);
+  EXPECT_NEAR(L_closed, 1.46, 0.01);
+  EXPECT_NEAR(L_table, L_closed, 1e-6);
+}
+
+}  // namespace
+}  // namespace rdyn::engine

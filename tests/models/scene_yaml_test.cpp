@@ -164,7 +164,7 @@ TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
         EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
         ++n;
       }
-  EXPECT_EQ(n, 13);
+  EXPECT_EQ(n, 14);
 }
 
 TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {

@@ -31,12 +31,12 @@ Samples range_samples(test::AnalyticSource& src, const models::Scene& scene, dou
 
 TEST(ExtractRange, GridRules) {
   // Revolute: the fewest equal intervals no longer than the step; prismatic: as many as the
-  // step makes over a turn; never fewer than 3.
+  // step makes over a turn; never fewer than 4 (5 points: Akima's minimum).
   EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true), 12);
   EXPECT_EQ(range_intervals(125 * kDeg, 10 * kDeg, true), 13);
   EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false), 36);
   EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false), 180);
-  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 3);
+  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 4);
   EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true), TableError);
   EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true), TableError);
   EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true), TableError);  // > kMaxTableRows points
@@ -59,6 +59,19 @@ TEST(ExtractRange, SamplesTheRangeWithClosedFormValuesAndNoWrap) {
     EXPECT_NEAR(s.columns[s.require("m1")][i], src.sc.m1(s.q[i]), 1e-14);
     EXPECT_NEAR(s.columns[s.require("Q_cons")][i], -2.0 * std::sin(s.q[i]), 1e-14);
   }
+}
+
+TEST(ExtractRange, EveryInterpolationBuildsOnTheCoarsestRangeTable) {
+  test::AnalyticSource src;
+  const auto scene = test::analytic_scene();
+  const Samples s = range_samples(src, scene, 0.3, 0.6, 90);  // 4 intervals, 5 points
+  ASSERT_EQ(s.q.size(), 5u);
+  for (auto i : {Interpolation::CubicSpline, Interpolation::Akima, Interpolation::Linear, Interpolation::Fourier})
+    EXPECT_NO_THROW(build_table(s, i)) << interpolation_name(i);
+  Samples four = s;  // hand-made, below the reader's minimum for Akima
+  four.q.pop_back();
+  for (auto& c : four.columns) c.pop_back();
+  EXPECT_THROW(build_table(four, Interpolation::Akima), TableError);
 }
 
 TEST(ExtractRange, PrismaticNeedsARange) {
