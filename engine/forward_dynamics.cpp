@@ -116,7 +116,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
 
   // The validity domain of the independent coordinate: a run that leaves it stops (exit 1),
   // as the reduced model stops at its table's edge (reduced/simulate_reduced.cpp).
-  const IndependentDomain domain = calc_independent_domain(model);
+  const IndependentDomain domain = opt.domain ? *opt.domain : calc_independent_domain(model);
 
   // Consistent initial state: a kinetostatic projection at (q0, q̇0), then the independent
   // coordinate is released.

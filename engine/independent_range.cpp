@@ -108,29 +108,46 @@ IndependentDomain calc_independent_domain(const FullModel& model) {
   if (!jt) throw EngineError(sc.source_file + ": unknown independent joint '" + sc.independent + "'");
   IndependentDomain d;
   d.revolute = jt->type == models::JointType::Revolute;
+  const double h0 = d.revolute ? 10.0 * kPi / 180 : calc_length_scale(sc) / 20;
+  long moves = 0;
+  const std::string unit = d.revolute ? "°" : " m";
+  const double k = d.revolute ? 180 / kPi : 1.0;
   if (sc.independent_range) {
     d.min = sc.independent_range->min;
     d.max = sc.independent_range->max;
     d.min_edge = d.max_edge = "declared limit";
+    // The declared range must be reachable: walk to both ends (a dead point inside is refused,
+    // as extraction would refuse it).
+    const double q0 = sc.initial.q;
+    for (const auto& [dir, span] : {std::pair{+1.0, d.max - q0}, std::pair{-1.0, q0 - d.min}}) {
+      if (!(span > 0)) continue;
+      const Walk w = walk(model, dir, std::min(h0, span), span, false, moves);
+      if (w.dead)
+        throw EngineError(fmt::format("{}: independent_range [{:.9g}, {:.9g}]{} of '{}' crosses a dead point at "
+                                      "{:.9g}{} (the loops cannot close beyond it): declare a range inside the dead "
+                                      "points, or leave it out and rdyn finds them",
+                                      sc.source_file, d.min * k, d.max * k, unit, sc.independent, *w.dead * k, unit));
+    }
     return d;
   }
-  const double h0 = d.revolute ? 10.0 * kPi / 180 : calc_length_scale(sc) / 20;
   const double limit = d.revolute ? 2 * kPi : 40 * calc_length_scale(sc);
-  long moves = 0;
   const Walk up = walk(model, +1.0, h0, limit, d.revolute, moves);
   if (up.full_turn) {
     d.periodic = true;
     return d;
   }
   const Walk down = walk(model, -1.0, h0, limit, d.revolute, moves);
-  const std::string unit = d.revolute ? "°" : " m";
-  const double k = d.revolute ? 180 / kPi : 1.0;
-  if (!up.dead || !down.dead)
-    throw EngineError(fmt::format(
+  if (!up.dead || !down.dead) {
+    // No range can be found: unbounded for the full model (which can run), refused by extraction.
+    d.min = -INFINITY;
+    d.max = INFINITY;
+    d.unbounded_reason = fmt::format(
         "{}: the independent coordinate '{}' meets {} within {:g}{} of its initial value: rdyn cannot find its "
         "range; declare independent_range: [min, max] in the scene",
         sc.source_file, sc.independent, up.dead || down.dead ? "only one dead point" : "no dead point", limit * k,
-        unit));
+        unit);
+    return d;
+  }
   d.dead_min = *down.dead;
   d.dead_max = *up.dead;
   const double margin = kDeadPointMargin * (*d.dead_max - *d.dead_min);

@@ -24,14 +24,20 @@ struct IndependentDomain {
   // The dead points themselves, located to ~1e-10 by bisection [rad or m] (found ranges only).
   std::optional<double> dead_min, dead_max;
   bool revolute = true;
+  // Not periodic, yet no range could be found (a prismatic coordinate meeting no dead point, or
+  // only one): min = −∞, max = +∞ and this says why. The full model runs unbounded; a reduced
+  // table needs a declared independent_range (extraction refuses with this message).
+  std::string unbounded_reason;
 };
 
-// Declared range: returned as given (no work). Otherwise walks the full model from the scene's
+// Declared range: returned as given after walking to both ends (EngineError when a dead point
+// lies inside it). Otherwise walks the full model from the scene's
 // initial q in both directions (continuation in moves of 10°, or 1/20 of the mechanism's size
 // for a prismatic coordinate, refined to 1/50 of that when a projection fails) until the loops
 // cannot close, then bisects to the dead point. A revolute that completes a turn is periodic.
-// Throws EngineError when a prismatic coordinate meets no dead point within 40 mechanism sizes
-// (declare independent_range) or only one of its two dead points.
+// A prismatic coordinate that meets no dead point within 40 mechanism sizes, or only one,
+// gets an unbounded domain (unbounded_reason). Throws EngineError when the initial q lies within
+// the margin of a dead point.
 IndependentDomain calc_independent_domain(const FullModel& model);
 
 // Size of the mechanism [m]: the largest distance of any point (ground points, body points,

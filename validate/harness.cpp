@@ -105,8 +105,11 @@ std::string RunRecord::label() const {
 
 namespace {
 
-engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol) {
+// The domain is computed once per model, outside the timed runs.
+engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                       const engine::IndependentDomain& domain) {
   engine::ForwardOptions fo;
+  fo.domain = domain;
   fo.duration_s = v.duration_s;
   fo.output_interval_s = v.output_interval_s;
   fo.tolerance = tol;
@@ -147,6 +150,7 @@ ValidationResult describe(const models::Scene& scene) {
 void run_full_ladder(const std::string& name, engine::FullModel& full, const LadderPlan& plan, ValidationResult& v,
                      Progress& progress) {
   const long n = static_cast<long>(plan.full.size());
+  const auto domain = engine::calc_independent_domain(full);
   for (long i = 0; i < n; ++i) {
     progress.count(name + ": full-model tolerance ladder", i, n);
     RunRecord r;
@@ -154,7 +158,7 @@ void run_full_ladder(const std::string& name, engine::FullModel& full, const Lad
     r.integrator = plan.full[i].first;
     r.tolerance = plan.full[i].second;
     models::TimeSeries ts;
-    const auto fo = forward_options(v, r.integrator, r.tolerance);
+    const auto fo = forward_options(v, r.integrator, r.tolerance, domain);
     std::vector<double> walls;
     try {
       walls = time_repeats([&] { ts = engine::simulate_full(full, fo); }, plan.full_repeats);
@@ -280,12 +284,12 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
 
 void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
   // A coordinate confined to a range (a rocker, a slider) has no revolutions to count.
-  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute &&
-                        engine::calc_independent_domain(full).periodic;
+  const auto domain = engine::calc_independent_domain(full);
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute && domain.periodic;
   const std::string integrator = scene.validation.reference_integrator;
   progress.count(scene.name + ": reference (full model)", 0, 2);
   const auto t_ref = Clock::now();
-  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance));
+  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance, domain));
   v.reference_wall_s = seconds_since(t_ref);
   v.reference_run.model = "full";
   v.reference_run.integrator = integrator;
@@ -296,7 +300,7 @@ void run_reference(const models::Scene& scene, engine::FullModel& full, Validati
   fill_stats(v.reference_run, v.reference);
   v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
   progress.count(scene.name + ": reference (full model)", 1, 2);
-  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2));
+  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2, domain));
   progress.count(scene.name + ": reference (full model)", 2, 2);
   v.window = detect_steady_window(v.reference, rotating);
   v.reference_change = compare_series(v.reference, half, v.window.t_start);

@@ -61,6 +61,39 @@ TEST(IndependentRange, ADeclaredRangeIsTakenAsGiven) {
   EXPECT_FALSE(d.dead_min);
 }
 
+TEST(IndependentRange, ADeclaredRangeAcrossADeadPointIsRefused) {
+  auto scene = models::load_scene("slider-crank-slider");
+  scene.independent_range = models::IndependentRange{0.10, 0.24};  // the loops close only from 0.15
+  const FullModel model(scene);
+  try {
+    calc_independent_domain(model);
+    FAIL() << "accepted";
+  } catch (const EngineError& e) {
+    EXPECT_NE(std::string(e.what()).find("crosses a dead point at 0.14999"), std::string::npos) << e.what();
+  }
+}
+
+TEST(IndependentRange, APrismaticJointWithoutDeadPointsIsUnbounded) {
+  // A free slider: nothing stops it, so no range can be found; the full model may still run it.
+  const auto scene = models::parse_scene(R"(
+name: free
+ground_points: {O: [0, 0]}
+bodies:
+  - {name: slider, mass_kg: 1.0, inertia_kgm2: 1.0e-3, points: {P: [0.2, 0]}}
+joints:
+  - {name: slide, type: prismatic, parent: ground, parent_point: O, child: slider, axis: [1, 0]}
+independent: slide
+initial: {q: 0.1}
+)",
+                                         "free.yaml");
+  const FullModel model(scene);
+  const auto d = calc_independent_domain(model);
+  EXPECT_FALSE(d.periodic);
+  EXPECT_EQ(d.min, -INFINITY);
+  EXPECT_EQ(d.max, INFINITY);
+  EXPECT_NE(d.unbounded_reason.find("no dead point within 8 m"), std::string::npos) << d.unbounded_reason;
+}
+
 TEST(IndependentRange, AnInitialPositionNextToADeadPointIsRefused) {
   auto scene = models::load_scene("slider-crank-slider");
   scene.initial.q = 0.151;  // inside the loops' range, within the 5 % margin of the dead point
