@@ -36,8 +36,8 @@ SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, 
     w.how = rotating ? fmt::format("fewer than three full revolutions in {:.3g} s, so no steady cycles: compared over "
                                    "the whole run",
                                    T)
-                     : fmt::format("the coordinate moves within a range, not in revolutions: compared over the whole "
-                                   "run of {:.3g} s",
+                     : fmt::format("the coordinate moves within a range (it does not turn): compared over "
+                                   "the whole run of {:.3g} s",
                                    T);
     return w;
   }

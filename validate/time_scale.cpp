@@ -20,8 +20,8 @@ TimeScale calc_time_scale(const models::TimeSeries& ref, bool rotating) {
                         peak, rev);
   } else if (!rotating) {
     s.period_s = s.duration_s;
-    s.how = fmt::format("the coordinate moves within a range, not in revolutions: the run's duration, {:.4g} s",
-                        s.duration_s);
+    s.how = fmt::format(
+        "the coordinate moves within a range (it does not turn): the run's duration, {:.4g} s", s.duration_s);
   } else {
     s.period_s = s.duration_s;
     s.how = fmt::format(
