@@ -23,9 +23,10 @@ constexpr double kMaxJump = 10.0 * 3.14159265358979323846 / 180.0;
 constexpr double kMaxApproachMoves = 10000;
 }
 
-FullKinetostaticSource::FullKinetostaticSource(const FullModel& model)
+FullKinetostaticSource::FullKinetostaticSource(const FullModel& model, bool wrap_turns)
     : model_(model),
       ws_(model),
+      wrap_turns_(wrap_turns),
       // A prismatic coordinate moves in metres: 10° read as 0.17 m could cross a whole stroke.
       max_jump_(model.scene().find_joint(model.scene().independent)->type == models::JointType::Revolute
                     ? kMaxJump
@@ -70,7 +71,8 @@ void FullKinetostaticSource::approach(double q, double max_jump) {
   // (the same configuration; the projection only relabels the angle).
   double target = q;
   const auto& jt = *model_.scene().find_joint(model_.scene().independent);
-  if (jt.type == models::JointType::Revolute) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
+  if (jt.type == models::JointType::Revolute && wrap_turns_)
+    target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
   const double moves = std::ceil(std::abs(target - q_now_) / max_jump - 1e-9);
   if (!(moves <= kMaxApproachMoves))  // also NaN
     throw models::NumericalError(fmt::format(

@@ -41,7 +41,7 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
   e.range = opt.range;
   e.dead_min = domain->dead_min;
   e.dead_max = domain->dead_max;
-  engine::FullKinetostaticSource source(model);
+  engine::FullKinetostaticSource source(model, /*wrap_turns=*/false);
   e.samples = reduced::extract_samples(source, scene, opt);
   return finish(source);
 }

@@ -266,3 +266,38 @@ TEST(ReducedSourceRange, CraneGeneralizedForceAndEquilibriumStrokeMatchVirtualWo
 
 }  // namespace
 }  // namespace rdyn::engine
+
+namespace rdyn::engine {
+namespace {
+
+// Two routes on one mechanism: the four-bar's crank turns fully, so a periodic table and a range
+// table over [−170°, 170°] (more than half a turn from the initial 30°: walked directly, not by
+// its periodic image) must agree at their common grid points.
+TEST(ReducedSourceRange, ARangeTableOfAFullTurnCrankAgreesWithThePeriodicTable) {
+  auto scene = models::load_scene("fourbar");
+  const double lo = -170 * M_PI / 180, hi = 170 * M_PI / 180;
+  scene.independent_range = models::IndependentRange{lo, hi};
+  FullModel model(scene);
+  reduced::ExtractOptions opt;
+  opt.step_rad = 10 * M_PI / 180;
+  FullKinetostaticSource per_src(model);
+  const auto per = reduced::extract_samples(per_src, scene, opt);
+  opt.range = reduced::ExtractRange{lo, hi, "declared limit", "declared limit"};
+  FullKinetostaticSource rng_src(model, false);
+  const auto rng = reduced::extract_samples(rng_src, scene, opt);
+  ASSERT_EQ(rng.q.size(), 35u);
+  int matched = 0;
+  for (size_t i = 0; i < rng.q.size(); ++i)
+    for (size_t j = 0; j < per.q.size(); ++j)
+      if (std::abs(std::remainder(rng.q[i] - per.q[j], 2 * M_PI)) < 1e-9) {
+        ++matched;
+        for (const char* c : {"m1", "m2", "V", "me1_rocker_axial", "r_rocker"})
+          EXPECT_NEAR(rng.columns[rng.require(c)][i], per.columns[per.require(c)][j],
+                      1e-10 * (1 + std::abs(per.columns[per.require(c)][j])))
+              << c << " at " << rng.q[i];
+      }
+  EXPECT_EQ(matched, 35);
+}
+
+}  // namespace
+}  // namespace rdyn::engine

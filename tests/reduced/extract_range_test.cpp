@@ -74,6 +74,40 @@ TEST(ExtractRange, EveryInterpolationBuildsOnTheCoarsestRangeTable) {
   EXPECT_THROW(build_table(four, Interpolation::Akima), TableError);
 }
 
+// A source whose sample at one q is flagged singular and carries garbage (as a configuration
+// where the loop Jacobian lost rank would).
+class SingularAt : public test::AnalyticSource {
+ public:
+  double q_bad = 0.0;
+  GridSample sample(double q, bool with_conservative) override {
+    GridSample g = KinetostaticSource::sample(q, with_conservative);
+    if (std::abs(q - q_bad) < 1e-12) {
+      g.singular = true;
+      g.acceleration.driving_force = 1e6;  // m1
+    }
+    return g;
+  }
+};
+
+TEST(ExtractRange, ASingularSampleInsideTheRangeIsRepairedWithoutWrapping) {
+  SingularAt src;
+  const auto scene = test::analytic_scene();
+  const Samples clean = range_samples(src, scene, 0.3, 2.5, 5);
+  src.q_bad = clean.q[10];
+  const Samples s = range_samples(src, scene, 0.3, 2.5, 5);
+  ASSERT_EQ(s.singular_q.size(), 1u);
+  EXPECT_EQ(s.singular_q[0], clean.q[10]);
+  // Replaced by the spline through the regular samples: close to the closed form, far from 1e6.
+  EXPECT_NEAR(s.columns[s.require("m1")][10], src.sc.m1(clean.q[10]), 1e-4 * src.sc.m1(clean.q[10]));
+  for (size_t i = 0; i < s.q.size(); ++i)
+    if (i != 10) {
+      EXPECT_EQ(s.columns[s.require("m1")][i], clean.columns[clean.require("m1")][i]);
+    }
+  // At the range's very edge there is nothing to interpolate from on one side: refused.
+  src.q_bad = clean.q.back();
+  EXPECT_THROW(range_samples(src, scene, 0.3, 2.5, 5), models::NumericalError);
+}
+
 TEST(ExtractRange, PrismaticNeedsARange) {
   test::AnalyticSource src;
   auto scene = test::analytic_scene();
