@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "engine/full_model_impl.hpp"
+#include "engine/independent_range.hpp"
 #include "engine/kinetostatic.hpp"
 
 namespace rdyn::engine {
@@ -113,6 +114,10 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   const auto start = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
 
+  // The validity domain of the independent coordinate: a run that leaves it stops (exit 1),
+  // as the reduced model stops at its table's edge (reduced/simulate_reduced.cpp).
+  const IndependentDomain domain = opt.domain ? *opt.domain : calc_independent_domain(model);
+
   // Consistent initial state: a kinetostatic projection at (q0, q̇0), then the independent
   // coordinate is released.
   FullWorkspace ws(model);
@@ -170,8 +175,21 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     const double t = std::min(opt.duration_s, i * opt.output_interval_s);
     try {
       while (integ->getTime() < t - 1e-14) {
+        const double t_before = integ->getTime(), q_before = m.joint_q(integ->getState(), m.independent);
         stepper.stepTo(t);
         const double h = integ->getPreviousStepSizeTaken();
+        if (!domain.periodic) {
+          const double q_now = m.joint_q(integ->getState(), m.independent);
+          if (q_now < domain.min || q_now > domain.max) {
+            // Crossing time by linear interpolation inside the step (for the message only).
+            const bool low = q_now < domain.min;
+            const double edge = low ? domain.min : domain.max;
+            const double t_cross = t_before + (integ->getTime() - t_before) * (edge - q_before) / (q_now - q_before);
+            throw models::NumericalError(fmt::format(
+                "full model left the validity domain at {} ({}) at t = {:.6g} s", format_coordinate(edge, domain.revolute),
+                low ? domain.min_edge : domain.max_edge, t_cross));
+          }
+        }
         if (h > 0) smallest = std::min(smallest, h);
         const long steps = std::max<long>(++calls, integ->getNumStepsAttempted());
         const double w = wall();

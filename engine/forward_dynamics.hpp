@@ -2,10 +2,12 @@
 // switches (rate gates) located as events. This is rdyn's ground truth.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
 #include "models/timeseries.hpp"
 
 namespace rdyn::engine {
@@ -29,6 +31,10 @@ struct ForwardOptions {
   // the loosest tolerance the validation uses (CPodes at 1e-7 through the parallelogram's
   // singular positions) stays near 1e-4, a run that lost its energy is off by tens of percent.
   double energy_tolerance = 0.01;  // (0, ∞)
+  // The independent coordinate's validity domain (a run leaving it stops with NumericalError).
+  // Empty: simulate_full computes it (calc_independent_domain: a continuation walk of ~10 ms on
+  // the bicycle), so callers that time repeated runs pass it in.
+  std::optional<IndependentDomain> domain = std::nullopt;
 };
 
 // Output rows (duration / interval + 1) a run may produce: 1e7 rows of ~8 doubles is ~0.6 GB.

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "engine/full_model_impl.hpp"
+#include "engine/independent_range.hpp"
 #include "engine/kinetostatic.hpp"
 
 namespace rdyn::engine {
@@ -22,8 +23,15 @@ constexpr double kMaxJump = 10.0 * 3.14159265358979323846 / 180.0;
 constexpr double kMaxApproachMoves = 10000;
 }
 
-FullKinetostaticSource::FullKinetostaticSource(const FullModel& model)
-    : model_(model), ws_(model), q_now_(model.scene().initial.q) {}
+FullKinetostaticSource::FullKinetostaticSource(const FullModel& model, bool wrap_turns)
+    : model_(model),
+      ws_(model),
+      wrap_turns_(wrap_turns),
+      // A prismatic coordinate moves in metres: 10° read as 0.17 m could cross a whole stroke.
+      max_jump_(model.scene().find_joint(model.scene().independent)->type == models::JointType::Revolute
+                    ? kMaxJump
+                    : calc_length_scale(model.scene()) / 20),
+      q_now_(model.scene().initial.q) {}
 
 int FullKinetostaticSource::num_constraint_forces() const {
   return static_cast<int>(model_.scene().outputs.constraint_forces.size());
@@ -34,20 +42,20 @@ template <typename F>
 auto FullKinetostaticSource::at(double q, F&& call) {
   const double q_start = q_now_;
   const Vector q_backup = ws_.impl().state.getQ();  // the last good configuration
-  for (double jump : {kMaxJump, kMaxJump / 5, kMaxJump / 50}) {
+  for (double jump : {max_jump_, max_jump_ / 5, max_jump_ / 50}) {
     try {
       approach(q, jump);
       ++calls_;
       return call();
     } catch (const EngineError& e) {
-      if (jump == kMaxJump / 50) {
+      if (jump == max_jump_ / 50) {
         const auto& sc = model_.scene();
         const bool rev = sc.find_joint(sc.independent)->type == models::JointType::Revolute;
         const double k = rev ? 180.0 / M_PI : 1.0;
         throw EngineError(fmt::format(
             "{}: the independent coordinate '{}' cannot move from {:.6g} to {:.6g} {}: a dead point of the mechanism "
-            "lies in between (the loops cannot close beyond it). Reduced tables need an independent coordinate that "
-            "covers the whole range without dead points, such as a crank that turns fully. ({})",
+            "lies in between (the loops cannot close beyond it). A reduced table's range must lie between the "
+            "mechanism's dead points: declare independent_range inside them, or leave it out and rdyn finds them. ({})",
             sc.source_file, sc.independent, q_start * k, q * k, rev ? "degrees" : "m", e.what()));
       }
       ws_.impl().state.updQ() = q_backup;  // back to the last good configuration
@@ -63,7 +71,8 @@ void FullKinetostaticSource::approach(double q, double max_jump) {
   // (the same configuration; the projection only relabels the angle).
   double target = q;
   const auto& jt = *model_.scene().find_joint(model_.scene().independent);
-  if (jt.type == models::JointType::Revolute) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
+  if (jt.type == models::JointType::Revolute && wrap_turns_)
+    target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
   const double moves = std::ceil(std::abs(target - q_now_) / max_jump - 1e-9);
   if (!(moves <= kMaxApproachMoves))  // also NaN
     throw models::NumericalError(fmt::format(

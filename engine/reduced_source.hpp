@@ -8,7 +8,10 @@ namespace rdyn::engine {
 
 class FullKinetostaticSource : public reduced::KinetostaticSource {
  public:
-  explicit FullKinetostaticSource(const FullModel& model);
+  // wrap_turns: a revolute independent coordinate is approached by its periodic image nearest
+  // the current configuration (periodic tables); false for a range table, whose points lie on
+  // one side of the dead points and must be walked to directly (a range may exceed 180°).
+  explicit FullKinetostaticSource(const FullModel& model, bool wrap_turns = true);
   int num_constraint_forces() const override;
   int num_joints() const override;
   reduced::ForcePoint inertial(double q, double qdot, double qddot) override;
@@ -33,6 +36,8 @@ class FullKinetostaticSource : public reduced::KinetostaticSource {
   std::optional<reduced::DirectPoint> direct_here(double q);
   const FullModel& model_;
   FullWorkspace ws_;
+  bool wrap_turns_;
+  double max_jump_;  // longest continuation move: 10° (revolute) or 1/20 of the mechanism's size (prismatic)
   double q_now_;
   long calls_ = 0;
 };

@@ -348,6 +348,14 @@ void check_scene(const Scene& s) {
   c.abs_at_most("gravity.g_m_s2[1]", s.gravity.g_m_s2.y, limits::kMaxGravity_m_s2, "m/s²");
   c.coordinate("initial.q", independent, s.initial.q);
   c.abs_at_most("initial.qdot", s.initial.qdot, limits::kMaxRate, "rad/s or m/s");
+  if (const auto& r = s.independent_range) {
+    const std::string f = "independent_range";
+    c.coordinate(f + "[0]", independent, r->min);
+    c.coordinate(f + "[1]", independent, r->max);
+    if (!(r->min < r->max)) fail(f, fmt::format("needs min < max (got [{:g}, {:g}])", r->min, r->max));
+    if (!(s.initial.q >= r->min && s.initial.q <= r->max))
+      fail("initial.q", fmt::format("{:.9g} lies outside independent_range [{:.9g}, {:.9g}] (rad or m)", s.initial.q, r->min, r->max));
+  }
 
   const auto& sim = s.simulation;
   if (!(sim.duration_s > 0.0 && sim.duration_s <= limits::kMaxDuration_s))

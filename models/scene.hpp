@@ -202,6 +202,14 @@ struct Initial {
   double qdot = 0.0;  // [rad/s or m/s]
 };
 
+// Range of the independent coordinate over which the reduced table spans and both models run
+// (scene keys independent_range [rad or m] or independent_range_deg). Absent: a revolute that
+// turns fully is periodic; otherwise the range is found from the mechanism's dead points.
+struct IndependentRange {
+  double min = 0.0;  // [rad or m]
+  double max = 0.0;  // [rad or m], > min
+};
+
 struct Simulation {
   double duration_s = 5.0;
   double output_interval_s = 0.01;
@@ -252,6 +260,7 @@ struct Scene {
   std::vector<Loop> loops;
   std::vector<Gear> gears;
   std::string independent;  // joint name
+  std::optional<IndependentRange> independent_range;  // declared range of the independent coordinate
   std::vector<JointTorque> joint_torques;
   std::vector<Resistance> resistances;
   std::vector<Spring> springs;

@@ -63,6 +63,8 @@ std::string canonical_scene_text(const Scene& s) {
   for (const auto& g : s.gears)
     c.str("name", g.name).str("driver", g.driver).str("driven", g.driven).num("ratio", g.ratio);
   c.str("independent", s.independent);
+  // Only when declared, so the hashes of scenes without a range stay what they were.
+  if (s.independent_range) c.num("range_min", s.independent_range->min).num("range_max", s.independent_range->max);
   c.integer("gravity", s.gravity.enabled ? 1 : 0).vec("g", s.gravity.g_m_s2);
   c.open("constraint_forces", s.outputs.constraint_forces.size());
   for (const auto& f : s.outputs.constraint_forces) c.str("name", f.name).str("joint", f.joint).vec("dir", f.direction);

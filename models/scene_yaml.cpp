@@ -541,6 +541,28 @@ void read_mechanism(const Fields& top, Scene& s) {
   s.independent = top.str("independent");
 }
 
+// independent_range: [min, max] in rad or m (as initial.q), or independent_range_deg for a
+// revolute; values checked by check_scene.
+void read_independent_range(const Fields& top, Scene& s) {
+  const bool deg = top.has("independent_range_deg");
+  if (!deg && !top.has("independent_range")) return;
+  if (deg && top.has("independent_range"))
+    top.fail("independent_range", "give independent_range or independent_range_deg, not both");
+  const std::string key = deg ? "independent_range_deg" : "independent_range";
+  const Joint* j = s.find_joint(s.independent);
+  if (deg && j && j->type == JointType::Prismatic)
+    top.fail(key, "a prismatic independent coordinate takes independent_range in metres, not degrees");
+  const Vec2 v = top.vec2(key);
+  const double k = deg ? kPi / 180.0 : 1.0;
+  if (deg) {
+    const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
+    if (std::abs(v.x) > max_deg || std::abs(v.y) > max_deg)
+      top.fail(key, fmt::format("must be finite with |value| ≤ {:g} degrees", max_deg));
+  }
+  if (!(v.x < v.y)) top.fail(key, fmt::format("needs min < max (got [{:g}, {:g}])", v.x, v.y));  // here: the line
+  s.independent_range = IndependentRange{v.x * k, v.y * k};
+}
+
 struct PendingDissipation {
   size_t index;
   double power_W, cadence_Hz;
@@ -628,7 +650,8 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   Fields top(
       root, "", ctx,
       {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
-       "independent", "loads", "gravity", "outputs", "initial", "simulation", "validation"});
+       "independent", "independent_range", "independent_range_deg", "loads", "gravity", "outputs", "initial",
+       "simulation", "validation"});
   s.name = top.name("name");
   s.description = top.str_or("description", "");
 
@@ -660,6 +683,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   } else {
     read_mechanism(top, s);
   }
+  read_independent_range(top, s);
   std::vector<PendingDissipation> pending;
   read_loads(top, s, pending);
   for (const auto& p : pending) {

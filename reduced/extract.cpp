@@ -10,6 +10,7 @@
 #include <gsl/gsl_spline.h>
 
 #include "models/scene_hash.hpp"
+#include "reduced/table.hpp"
 
 namespace rdyn::reduced {
 
@@ -59,6 +60,37 @@ std::vector<double> periodic_integral(const std::vector<double>& q, const std::v
   const PeriodicSpline sp(q, y, period);
   std::vector<double> out(q.size());
   for (size_t i = 0; i < q.size(); ++i) out[i] = gsl_spline_eval_integ(sp.sp.get(), sp.x[0], sp.x[i], nullptr);
+  return out;
+}
+
+// GSL natural cubic spline through (q, y) over a range (not periodic).
+struct RangeSpline {
+  std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp{nullptr, gsl_spline_free};
+  double lo, hi;
+  RangeSpline(const std::vector<double>& q, const std::vector<double>& v) : lo(q.front()), hi(q.back()) {
+    sp.reset(gsl_spline_alloc(gsl_interp_cspline, q.size()));
+    gsl_spline_init(sp.get(), q.data(), v.data(), q.size());
+  }
+  double eval(double q) const { return q < lo || q > hi ? NAN : gsl_spline_eval(sp.get(), q, nullptr); }
+};
+
+// ∫ from q[0] to q[i] of the range tables' not-a-knot cubic spline through (q, y) (uniform grid),
+// for every grid point: the non-periodic integral of the integrated method, m1 from the range's
+// minimum. Each interval's cubic a + b x + c x² + d x³ integrates to a h + b h²/2 + c h³/3 + d h⁴/4.
+std::vector<double> range_integral(const std::vector<double>& q, const std::vector<double>& y) {
+  Samples one;
+  one.periodic = false;
+  one.q0 = q.front();
+  one.step = (q.back() - q.front()) / static_cast<double>(q.size() - 1);
+  one.q = q;
+  one.add("m2", y);
+  const Table t = build_table(one, Interpolation::CubicSpline);
+  const double h = t.step;
+  std::vector<double> out(q.size(), 0.0);
+  for (int iv = 0; iv < t.intervals; ++iv) {
+    const double* c = &t.coef[static_cast<size_t>(iv) * 4];
+    out[iv + 1] = out[iv] + h * (c[0] + h * (c[1] / 2 + h * (c[2] / 3 + h * c[3] / 4)));
+  }
   return out;
 }
 
@@ -159,17 +191,31 @@ long check_grid_step(double step_rad) {
   return n;
 }
 
+long range_intervals(double span, double step_rad, bool revolute) {
+  if (!(std::isfinite(span) && span > 0))
+    throw TableError(fmt::format("the range of the independent coordinate must be finite and positive (got {:g})",
+                                 span));
+  const double n = revolute ? std::ceil(span / step_rad - 1e-9) : std::round(2 * kPi / step_rad);
+  if (!(n + 1 <= static_cast<double>(kMaxTableRows)))
+    throw TableError(fmt::format("a range table of {:.6g} with a {:.6g}° grid would have {:.3g} points, more than {}",
+                                 span, step_rad * 180 / kPi, n + 1, kMaxTableRows));
+  return std::max(4L, static_cast<long>(n));
+}
+
 Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, const ExtractOptions& opt) {
   gsl_set_error_handler_off();  // GSL reports through return codes, never abort()
-  const long n = check_grid_step(opt.step_rad);  // before any allocation
+  const long per_turn = check_grid_step(opt.step_rad);  // before any allocation
   const auto* ind_joint = scene.find_joint(scene.independent);
   if (!ind_joint) throw TableError("the independent joint '" + scene.independent + "' does not exist");
   const auto& ind = *ind_joint;
-  if (ind.type != models::JointType::Revolute)
-    throw TableError("reduced tables over a range of a prismatic coordinate are not supported yet; "
-                     "the independent coordinate must be a revolute joint turning fully");
+  const bool revolute = ind.type == models::JointType::Revolute;
+  const bool periodic = !opt.range;
+  if (!revolute && periodic)
+    throw TableError("a prismatic independent coordinate needs a range: a table over [q_min, q_max] "
+                     "(independent_range, or the range rdyn finds from the dead points)");
   if (!std::isfinite(scene.initial.q)) throw TableError("the initial q is not finite");
-  const double h = 2 * kPi / n;
+  const long n = periodic ? per_turn : range_intervals(opt.range->max - opt.range->min, opt.step_rad, revolute) + 1;
+  const double h = periodic ? 2 * kPi / n : (opt.range->max - opt.range->min) / static_cast<double>(n - 1);
   const int nk = src.num_constraint_forces(), nj = src.num_joints();
   const auto& forces = scene.outputs.constraint_forces;
   if (nk != static_cast<int>(forces.size()) || nj != static_cast<int>(scene.joints.size()))
@@ -183,16 +229,23 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
                                  "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
                                  opt.step_rad * 180 / kPi, n, cols + 1, kMaxTableColumns, kMaxTableValues));
 
-  // Grid anchored at 0, visited from the point nearest the initial q.
-  const long first = std::lround(scene.initial.q / h);
   Samples s;
   s.scene = scene.name;
   s.scene_hash = models::scene_hash(scene);
   s.method = method_name(opt.method);
-  s.periodic = true;
-  s.revolute = true;
+  s.periodic = periodic;
+  s.revolute = revolute;
   s.step = h;
-  for (long i = 0; i < n; ++i) s.q.push_back((first + i) * h);
+  if (periodic) {
+    // Grid anchored at 0, visited from the point nearest the initial q.
+    const long first = std::lround(scene.initial.q / h);
+    for (long i = 0; i < n; ++i) s.q.push_back((first + i) * h);
+  } else {
+    // From the range's minimum upward; the last point is the maximum itself.
+    for (long i = 0; i < n; ++i) s.q.push_back(i + 1 == n ? opt.range->max : opt.range->min + i * h);
+    s.min_edge = opt.range->min_edge;
+    s.max_edge = opt.range->max_edge;
+  }
   s.q0 = s.q[0];
 
   std::vector<double> m1(n), m2(n), Q(n), V(n);
@@ -254,7 +307,9 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     if (ra == 0.0 || ((ra > 0) != (rb > 0) && rb != 0.0)) {
       const long im = (i0 + n - 1) % n;
       const double xm = s.q[im] - (im > i0 ? 2 * kPi : 0.0);
-      const double est = quadratic_zero(xm, r[j][im], a, ra, b, rb);
+      // A range table has no sample before its first point: the chord there.
+      const double est = !periodic && i0 == 0 ? a - ra * (b - a) / (rb - ra)
+                                               : quadratic_zero(xm, r[j][im], a, ra, b, rb);
       gate_roots[g].push_back(refine_root(src, j, a, ra, b, rb, est));
     }
   };
@@ -283,12 +338,13 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     if (i >= 1)
       for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, i - 1, i, 0.0);
   }
-  for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, n - 1, 0, 2 * kPi);  // the wrap-around interval
+  if (periodic)
+    for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, n - 1, 0, 2 * kPi);  // the wrap-around interval
   if (opt.method == Method::Integrated) {
     // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).
     std::vector<double> two_m2(n);
     for (long i = 0; i < n; ++i) two_m2[i] = 2 * m2[i];
-    const auto integral = periodic_integral(s.q, two_m2, 2 * kPi);
+    const auto integral = periodic ? periodic_integral(s.q, two_m2, 2 * kPi) : range_integral(s.q, two_m2);
     for (long i = 1; i < n; ++i) m1[i] = m1[0] + integral[i];
   }
 
@@ -300,6 +356,14 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     for (long i = 0; i < n; ++i)
       if (!singular[i]) x.push_back(s.q[i]), y.push_back(col[i]);
     if (x.size() < 4 || x.size() == static_cast<size_t>(n)) return;
+    if (!periodic) {
+      // Inside a range: the natural spline through the regular samples (a singular end point
+      // stays NaN and fails the finite check below: a range must stop short of singularities).
+      const RangeSpline sp(x, y);
+      for (long i = 0; i < n; ++i)
+        if (singular[i]) col[i] = sp.eval(s.q[i]);
+      return;
+    }
     const PeriodicSpline sp(x, y, 2 * kPi);
     for (long i = 0; i < n; ++i)
       if (singular[i]) col[i] = sp.eval(s.q[i]);
@@ -355,7 +419,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
         throw models::NumericalError(fmt::format(
             "extraction produced a non-finite value ({}) in column '{}' at q = {:.6g}° of scene '{}'; the full model "
             "cannot be sampled there (a singular or redundant configuration)",
-            s.columns[c][i], s.names[c], s.q[i] * 180 / kPi, scene.name));
+            s.columns[c][i], s.names[c], s.revolute ? s.q[i] * 180 / kPi : s.q[i], scene.name));
   for (const auto& [col, rs] : s.roots)
     for (double r : rs)
       if (!std::isfinite(r))

@@ -1,6 +1,7 @@
 // Reduced parameters from kinetostatic calls of a full model (the paper's method).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "models/scene.hpp"
@@ -29,14 +30,31 @@ inline constexpr double kMaxGridDeg = 90.0;
 // Allocates nothing: call it before any work that depends on the grid.
 long check_grid_step(double step_rad);
 
+// A range of the independent coordinate for a non-periodic table (periodic=0).
+struct ExtractRange {
+  double min = 0.0, max = 0.0;     // [rad or m], min < max
+  std::string min_edge, max_edge;  // what ends it: "dead point" or "declared limit" (recorded in the table)
+};
+
+// Intervals of a range table for a grid step [rad]: a revolute range gets the fewest equal
+// intervals no longer than the step; a prismatic one as many intervals as the step makes over a
+// turn (a 10° grid: 36 intervals over the stroke), so the grid ladders of `rdyn validate` apply
+// to both. At least 4 intervals (5 points, what every interpolation takes: GSL's Akima needs 5). Throws TableError when the
+// span is not finite and positive, or makes more than kMaxTableRows points.
+long range_intervals(double span, double step_rad, bool revolute);
+
 struct ExtractOptions {
   double step_rad = 10.0 * 3.14159265358979323846 / 180.0;  // grid step (revolute) [rad]
   Method method = Method::Kinetostatic;
+  // Set: a non-periodic table over the range (range_intervals); empty: one period of a
+  // revolute coordinate that turns fully.
+  std::optional<ExtractRange> range;
 };
 
 // Samples one period of a revolute independent coordinate, starting from the grid point
 // nearest the scene's initial q and continuing from point to point (so the full model stays
-// on its assembled branch). The step must divide 360° evenly (check_grid_step, before any
+// on its assembled branch); with options.range, the range from its minimum upward instead
+// (non-periodic columns, m1 of the integrated method integrated from the minimum). The step must divide 360° evenly (check_grid_step, before any
 // allocation). Throws TableError on bad options, NumericalError when a sample is not finite.
 Samples extract_samples(KinetostaticSource& source, const models::Scene& scene, const ExtractOptions& options);
 

@@ -23,6 +23,9 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
                                  what, models::scene_hash_hex(*s.scene_hash), models::scene_hash_hex(h), scene.name));
   ReducedModel m;
   m.table = build_table(s, interp, energy_consistent_m2);
+  m.min_edge = s.min_edge;
+  m.max_edge = s.max_edge;
+  m.revolute = s.revolute;
   m.c_m1 = s.require("m1");
   m.c_m2 = s.require("m2");
   m.c_V = s.require("V");

@@ -20,6 +20,10 @@ namespace rdyn::reduced {
 
 struct ReducedModel {
   Table table;
+  // Range tables: what ends the validity domain at each edge ("dead point", "declared limit",
+  // empty when the table does not say) and the coordinate's kind, for the stop message.
+  std::string min_edge, max_edge;
+  bool revolute = true;
   std::vector<std::string> force_names;
   int c_m1 = -1, c_m2 = -1, c_V = -1, c_Q = -1;
   std::vector<int> c_me1, c_me2, c_Qx;  // per constraint force

@@ -71,6 +71,11 @@ std::string format_samples_csv(const Samples& s) {
   std::string t = fmt::format("{}scene={:016x} name={} method={} periodic={} q0={:.17g} step={:.17g} grid_deg={:.17g}\n",
                               kHeader, *s.scene_hash, token(s.scene), token(s.method), s.periodic ? 1 : 0, s.q0, s.step,
                               s.revolute ? s.step * 180.0 / kPi : s.step);
+  if (!s.periodic && (!s.min_edge.empty() || !s.max_edge.empty())) {
+    t.pop_back();
+    t += fmt::format(" edges={},{}\n", token(s.min_edge.empty() ? "unknown" : s.min_edge),
+                     token(s.max_edge.empty() ? "unknown" : s.max_edge));
+  }
   if (!s.singular_q.empty()) {
     t += "# singular:";
     for (double q : s.singular_q) t += fmt::format(" {:.17g}", q);
@@ -163,6 +168,17 @@ Samples parse_samples_csv(const std::string& text, const std::string& name) {
       } else if (k == "step") {
         s.step = number(v, "field 'step'");
         have_step = true;
+      } else if (k == "edges") {
+        const auto comma = v.find(',');
+        if (comma == std::string::npos) fail(1, "field 'edges' must be <min>,<max>");
+        for (std::string* e : {&s.min_edge, &s.max_edge}) {
+          std::string w = e == &s.min_edge ? v.substr(0, comma) : v.substr(comma + 1);
+          for (char& c : w)
+            if (c == '_') c = ' ';
+          if (w != "dead point" && w != "declared limit" && w != "unknown")
+            fail(1, "field 'edges': each edge is dead_point, declared_limit or unknown");
+          *e = w == "unknown" ? "" : w;
+        }
       } else if (k == "grid_deg") {
         grid = number(v, "field 'grid_deg'");
       } else {

@@ -37,6 +37,9 @@ struct Samples {
   double q0 = 0.0;           // first grid point [rad or m]
   double step = 0.0;         // grid step [rad or m]
   std::vector<double> q;     // grid points (periodic: the end point 2π is not repeated)
+  // Range tables (periodic = false): what ends the range at q.front() and q.back(), "dead point"
+  // or "declared limit" (metadata edges=<min>,<max>, spaces as '-'); empty when unknown.
+  std::string min_edge, max_edge;
   std::vector<std::string> names;
   std::vector<std::vector<double>> columns;  // columns[c][i]
   // Exact zeros of some ratio columns within the table's span, located on the full model
@@ -62,7 +65,7 @@ inline constexpr long kMaxTableBytes = 256L << 20;
 
 // CSV: a first comment line
 //   # rdyn-table v1 scene=<16 hex digits> name=<scene> method=<m> periodic=<0|1> q0=<q> step=<h> grid_deg=<deg>
-// (q0 and step in rad or m, %.17g), optional "# singular:" and "# roots <column>:" lines, then
+// (q0 and step in rad or m, %.17g; range tables add edges=<min>,<max>: dead-point or declared-limit), optional "# singular:" and "# roots <column>:" lines, then
 // q_deg (or q_m) and the named columns. Requires samples.scene_hash.
 // The table as text (header line with the scene hash, metadata comments, CSV).
 std::string format_samples_csv(const Samples& s);

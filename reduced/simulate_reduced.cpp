@@ -56,6 +56,23 @@ void hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point
   work = h00 * a.work + h10 * H * a.power + h01 * b.work + h11 * H * b.power;
 }
 
+// The edge of a range table's validity domain that q has crossed.
+double domain_edge(const ReducedModel& m, double q) {
+  return q < m.table.q0 ? m.table.q0 : m.table.q0 + m.table.intervals * m.table.step;
+}
+
+// A run that reaches the edge of a range table stops (exit 1), as the full model does at the
+// same edge (engine/forward_dynamics.cpp): beyond it the table has no data (a dead point, where
+// m1 → ∞, or a declared limit).
+[[noreturn]] void throw_left_domain(const ReducedModel& m, double edge, double t) {
+  const bool at_min = edge == m.table.q0;
+  const std::string& kind = at_min ? m.min_edge : m.max_edge;
+  throw models::NumericalError(fmt::format(
+      "reduced model left the validity domain at {} ({}) at t = {:.6g} s: the table's range ends there",
+      m.revolute ? fmt::format("q = {:.9g}°", edge * 180 / M_PI) : fmt::format("q = {:.9g} m", edge),
+      kind.empty() ? "edge of the table" : kind, t));
+}
+
 }  // namespace
 
 struct AdaptiveIntegrator::Impl {
@@ -288,9 +305,13 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   d.ws.q = d.y[0], d.ws.qdot = d.y[1], d.ws.work = d.y[2], d.ws.t = t;
   if (!std::isfinite(d.ws.q) || !std::isfinite(d.ws.qdot) || !std::isfinite(d.ws.work))
     throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", t));
-  if (!m.table.in_range(d.ws.q))
-    throw TableError(fmt::format("reduced model left the validity domain of its table at t = {:.6g} s (q = {:.6g})",
-                                 t, d.ws.q));
+  if (!m.table.in_range(d.ws.q)) {
+    // The edge of a range table: locate the crossing like an event (for the message), then stop.
+    const double edge = domain_edge(m, d.ws.q);
+    const auto c = d.locate([&](double q, double) { return q - edge; }, t_prev, y_prev, H, y_prev[0] - edge,
+                            d.ws.q - edge);
+    throw_left_domain(m, edge, t_prev + c.h);
+  }
   // A cut at a switch located just before q_stop may lie past q_stop too (q_stop on a switch
   // angle): that is the stop, or every later step would start beyond it and never stop.
   return which == -2 || (which >= 0 && stop_at_q && stop_before != 0.0 && (stop_before > 0) != (d.y[0] - q_stop > 0));
@@ -372,6 +393,10 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
   check_reduced_options(opt);  // before any allocation
   if (!std::isfinite(q0) || !std::isfinite(qdot0))
     throw TableError(fmt::format("reduced simulation start (q, q̇) = ({}, {}) is not finite", q0, qdot0));
+  if (!m.table.in_range(q0))
+    throw TableError(fmt::format("reduced simulation start q = {:.9g} lies outside the range [{:.9g}, {:.9g}] of its "
+                                 "table (rad or m)",
+                                 q0, m.table.q0, m.table.q0 + m.table.intervals * m.table.step));
   models::TimeSeries ts;
   ts.force_names = m.force_names;
   ts.forces.resize(m.force_names.size());
@@ -415,6 +440,10 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       if (!std::isnan(t_switch)) ++ts.stats.events;
       if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot) || !std::isfinite(ws.work))
         throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
+      if (!m.table.in_range(ws.q)) {  // edge of a range table, crossed within this step (linear estimate)
+        const double edge = domain_edge(m, ws.q);
+        throw_left_domain(m, edge, a.t + (ws.t - a.t) * (edge - a.q) / (ws.q - a.q));
+      }
       const AdaptiveIntegrator::Point b = point(ws);
       const double E = calc_energy(m, b.q, b.qdot);  // divergence guard, as for the adaptive path
       E_scale = std::max(E_scale, std::abs(E));

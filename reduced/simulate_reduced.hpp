@@ -55,7 +55,7 @@ class AdaptiveIntegrator {
   void reset(double t, double q, double qdot, double work = 0.0);
   // Advances to t_end, or until q reaches q_stop (if finite), located like an event.
   // Returns true when it stopped at q_stop. Throws NumericalError when GSL fails, on a
-  // non-finite state, or past the step or wall-time budget; TableError when q leaves a
+  // non-finite state, or past the step or wall-time budget; NumericalError ("left the validity domain at q = …") when q leaves a
   // non-periodic table.
   bool advance(double t_end, double q_stop = NAN);
   // One accepted step toward t_end (cut at an event or at q_stop). Returns true when it

@@ -82,6 +82,44 @@ Samples fourier_resample(const Samples& s, int refine) {
   return out;
 }
 
+// Not-a-knot cubic spline on a uniform grid (de Boor, A Practical Guide to Splines, ch. IV):
+// second derivatives M_i from M_{i−1} + 4 M_i + M_{i+1} = 6 (y_{i+1} − 2 y_i + y_{i−1})/h², with the
+// third derivative continuous at the second and the second-to-last points (M_0 − 2 M_1 + M_2 = 0,
+// likewise at the end), which reduces rows 1 and n−2 to 6 M_1 = rhs_1, 6 M_{n−2} = rhs_{n−2}. Its
+// error is O(h⁴) up to the ends, where GSL's natural spline (M = 0 at the ends) is O(h²).
+// Writes each interval's cubic a + b dx + c dx² + d dx³ into coef[(iv·cols + col)·4].
+void not_a_knot_coefficients(const std::vector<double>& y, double h, int col, int cols, std::vector<double>& coef) {
+  const int n = static_cast<int>(y.size());
+  std::vector<double> rhs(n, 0.0), M(n, 0.0);
+  for (int i = 1; i + 1 < n; ++i) rhs[i] = 6.0 * (y[i + 1] - 2 * y[i] + y[i - 1]) / (h * h);
+  M[1] = rhs[1] / 6.0;
+  M[n - 2] = rhs[n - 2] / 6.0;
+  // Rows 2..n−3: tridiagonal (1, 4, 1) with M_1 and M_{n−2} known (Thomas algorithm).
+  const int lo = 2, hi = n - 3;
+  if (hi >= lo) {
+    const int m = hi - lo + 1;
+    std::vector<double> cp(m), dp(m);
+    for (int k = 0; k < m; ++k) {
+      double r = rhs[lo + k];
+      if (k == 0) r -= M[1];
+      if (k == m - 1) r -= M[n - 2];
+      const double denom = 4.0 - (k > 0 ? cp[k - 1] : 0.0);
+      cp[k] = 1.0 / denom;
+      dp[k] = (r - (k > 0 ? dp[k - 1] : 0.0)) / denom;
+    }
+    for (int k = m - 1; k >= 0; --k) M[lo + k] = dp[k] - (k + 1 < m ? cp[k] * M[lo + k + 1] : 0.0);
+  }
+  M[0] = 2 * M[1] - M[2];
+  M[n - 1] = 2 * M[n - 2] - M[n - 3];
+  for (int iv = 0; iv + 1 < n; ++iv) {
+    double* cf = &coef[(static_cast<size_t>(iv) * cols + col) * 4];
+    cf[0] = y[iv];
+    cf[1] = (y[iv + 1] - y[iv]) / h - h * (2 * M[iv] + M[iv + 1]) / 6.0;
+    cf[2] = M[iv] / 2.0;
+    cf[3] = (M[iv + 1] - M[iv]) / (6.0 * h);
+  }
+}
+
 }  // namespace
 
 int Table::locate(double q, double& dx) const {
@@ -150,7 +188,9 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
       throw TableError(fmt::format("reduced table: column '{}' has {} values for {} grid points", samples.names[c],
                                    samples.columns[c].size(), npts));
   if (interp == Interpolation::Fourier) {
-    if (!samples.periodic) throw TableError("fourier interpolation needs a periodic table");
+    // A range table has no period: the trigonometric interpolant does not apply, and the
+    // not-a-knot cubic spline (the range tables' own, O(h⁴)) stands in for it.
+    if (!samples.periodic) return build_table(samples, Interpolation::CubicSpline, energy_consistent_m2);
     // Resampled at ≤ 0.25°: the cubic table's own error (∝ h⁴) then sits ~1e-11 of a
     // parameter's size, below the full-model reference's accuracy; at 1° it was a floor of
     // ~1.5e-9 that every grid from 10° to 1° hit (issue #14, measured on exp(sin q)).
@@ -186,11 +226,20 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
   std::vector<double> x(m), y(m);
   for (int i = 0; i < m; ++i) x[i] = s.q0 + i * s.step;
   std::unique_ptr<gsl_spline, decltype(&gsl_spline_free)> sp(gsl_spline_alloc(type, m), gsl_spline_free);
+  // GSL refuses (returns null) fewer points than the type needs (Akima: 5).
+  if (!sp)
+    throw TableError(fmt::format("{} interpolation needs more than the table's {} grid points",
+                                 interpolation_name(interp), n));
   std::unique_ptr<gsl_interp_accel, decltype(&gsl_interp_accel_free)> acc(gsl_interp_accel_alloc(),
                                                                          gsl_interp_accel_free);
   gsl_set_error_handler_off();
   for (int c = 0; c < t.cols; ++c) {
     for (int i = 0; i < m; ++i) y[i] = s.columns[c][i % n];
+    if (!s.periodic && interp == Interpolation::CubicSpline) {
+      // Range tables: not-a-knot ends (O(h⁴) to the edges; measured in docs/theory.md).
+      not_a_knot_coefficients(y, s.step, c, t.cols, t.coef);
+      continue;
+    }
     if (gsl_spline_init(sp.get(), x.data(), y.data(), m) != GSL_SUCCESS)
       throw TableError("GSL could not build the interpolant of column '" + s.names[c] + "'");
     // Exact cubic per interval from four values inside it (s = 0, 1/3, 2/3, 1): the

@@ -11,7 +11,7 @@
 namespace rdyn::reduced {
 
 enum class Interpolation {
-  CubicSpline,  // GSL cubic spline (periodic for a full turn, natural otherwise)
+  CubicSpline,  // cubic spline: GSL periodic for a full turn, not-a-knot ends over a range
   Akima,        // GSL Akima (periodic variant for a full turn): local, no overshoot
   Linear,       // GSL linear
   Fourier,      // periodic only: trigonometric interpolant of the samples (spectral accuracy

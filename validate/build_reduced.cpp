@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
 #include "engine/reduced_source.hpp"
 
 namespace rdyn::validate {
@@ -10,15 +11,39 @@ namespace rdyn::validate {
 Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method) {
   const auto start = std::chrono::steady_clock::now();
   engine::FullModel model(scene);
-  engine::FullKinetostaticSource source(model);
   reduced::ExtractOptions opt;
   opt.step_rad = grid_deg * 3.14159265358979323846 / 180.0;
   opt.method = method;
   Extraction e;
+  auto finish = [&](const engine::FullKinetostaticSource& source) {
+    e.extraction_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    e.calls = source.calls();
+    return e;
+  };
+  // A revolute without a declared range is first swept as a full turn (the periodic table,
+  // at no extra cost); a dead point on the way means it has a range instead.
+  const auto& ind = *scene.find_joint(scene.independent);
+  std::optional<engine::IndependentDomain> domain;
+  if (ind.type == models::JointType::Revolute && !scene.independent_range) {
+    try {
+      engine::FullKinetostaticSource source(model);
+      e.samples = reduced::extract_samples(source, scene, opt);
+      return finish(source);
+    } catch (const engine::EngineError&) {
+      domain = engine::calc_independent_domain(model);
+      if (domain->periodic) throw;  // not a dead point: the sweep's own failure
+    }
+  }
+  // The declared range or the one between the dead points (engine/independent_range.hpp).
+  if (!domain) domain = engine::calc_independent_domain(model);
+  if (!domain->unbounded_reason.empty()) throw engine::EngineError(domain->unbounded_reason);
+  opt.range = reduced::ExtractRange{domain->min, domain->max, domain->min_edge, domain->max_edge};
+  e.range = opt.range;
+  e.dead_min = domain->dead_min;
+  e.dead_max = domain->dead_max;
+  engine::FullKinetostaticSource source(model, /*wrap_turns=*/false);
   e.samples = reduced::extract_samples(source, scene, opt);
-  e.extraction_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  e.calls = source.calls();
-  return e;
+  return finish(source);
 }
 
 }  // namespace rdyn::validate

@@ -1,6 +1,8 @@
 // Reduced models extracted from the full model of a scene (engine + reduced together).
 #pragma once
 
+#include <optional>
+
 #include "models/scene.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/samples.hpp"
@@ -11,6 +13,9 @@ struct Extraction {
   reduced::Samples samples;
   double extraction_ms = 0.0;  // wall time of the kinetostatic calls [ms]
   long calls = 0;              // kinetostatic calls made
+  // Range tables: the range sampled and the dead points found (when not declared) [rad or m].
+  std::optional<reduced::ExtractRange> range;
+  std::optional<double> dead_min, dead_max;
 };
 
 // Builds the full model of the scene and samples its reduced parameters.

@@ -135,6 +135,11 @@ int run_simulate(const SimulateArgs& a) {
       samples = std::move(e.samples);
       extraction_ms = e.extraction_ms;
       run.update({{"grid_deg", a.grid_deg}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
+      if (e.range) {  // range table: its span [rad or m] and what ends it
+        run["independent_range"] = {{"min", e.range->min}, {"max", e.range->max}, {"min_edge", e.range->min_edge},
+                                    {"max_edge", e.range->max_edge}};
+        if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
+      }
     }
     const auto model = reduced::make_reduced_model(samples, scene, reduced::parse_interpolation(a.interpolation),
                                                    a.energy_consistent);
@@ -175,10 +180,21 @@ int run_extract(const ExtractArgs& a) {
   const auto e = extract_from_full(scene, a.grid_deg, method);
   out.write(reduced::format_samples_csv(e.samples));
   out.commit();
+  std::string range;  // range tables: the span and, when found, the dead points
+  if (e.range) {
+    const bool rev = e.samples.revolute;
+    const double k = rev ? 180.0 / M_PI : 1.0;
+    const char* unit = rev ? "°" : " m";
+    range = fmt::format("; range [{:.9g}, {:.9g}]{} ({} / {})", e.range->min * k, e.range->max * k, unit,
+                        e.range->min_edge, e.range->max_edge);
+    if (e.dead_min && e.dead_max)
+      range += fmt::format(", dead points at {:.9g}{} and {:.9g}{}", *e.dead_min * k, unit, *e.dead_max * k, unit);
+  }
   std::fprintf(stderr, "%s\n",
-               fmt::format("rdyn: extracted {} ({}, {}° grid, {} points) in {:.3g} ms with {} kinetostatic calls; "
+               fmt::format("rdyn: extracted {} ({}, {}° grid, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
                            "wrote {}",
-                           scene.name, a.method, a.grid_deg, e.samples.q.size(), e.extraction_ms, e.calls, a.out)
+                           scene.name, a.method, a.grid_deg, e.samples.q.size(), range, e.extraction_ms, e.calls,
+                           a.out)
                    .c_str());
   return 0;
 }

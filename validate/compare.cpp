@@ -33,8 +33,12 @@ SteadyWindow detect_steady_window(const models::TimeSeries& ref, bool rotating, 
     w.t_start = 0.0;
     w.revolutions = static_cast<int>(crossings.size());
     w.whole_run = true;
-    w.how = fmt::format("fewer than three full revolutions in {:.3g} s, so no steady cycles: compared over the whole run",
-                        T);
+    w.how = rotating ? fmt::format("fewer than three full revolutions in {:.3g} s, so no steady cycles: compared over "
+                                   "the whole run",
+                                   T)
+                     : fmt::format("the coordinate moves within a range (it does not turn): compared over "
+                                   "the whole run of {:.3g} s",
+                                   T);
     return w;
   }
   // Mean speed of revolution k (from crossing k−1 to k; the first one starts at t = 0).

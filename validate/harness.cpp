@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "engine/forward_dynamics.hpp"
+#include "engine/independent_range.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
@@ -104,8 +105,11 @@ std::string RunRecord::label() const {
 
 namespace {
 
-engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol) {
+// The domain is computed once per model, outside the timed runs.
+engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                       const engine::IndependentDomain& domain) {
   engine::ForwardOptions fo;
+  fo.domain = domain;
   fo.duration_s = v.duration_s;
   fo.output_interval_s = v.output_interval_s;
   fo.tolerance = tol;
@@ -146,6 +150,7 @@ ValidationResult describe(const models::Scene& scene) {
 void run_full_ladder(const std::string& name, engine::FullModel& full, const LadderPlan& plan, ValidationResult& v,
                      Progress& progress) {
   const long n = static_cast<long>(plan.full.size());
+  const auto domain = engine::calc_independent_domain(full);
   for (long i = 0; i < n; ++i) {
     progress.count(name + ": full-model tolerance ladder", i, n);
     RunRecord r;
@@ -153,7 +158,7 @@ void run_full_ladder(const std::string& name, engine::FullModel& full, const Lad
     r.integrator = plan.full[i].first;
     r.tolerance = plan.full[i].second;
     models::TimeSeries ts;
-    const auto fo = forward_options(v, r.integrator, r.tolerance);
+    const auto fo = forward_options(v, r.integrator, r.tolerance, domain);
     std::vector<double> walls;
     try {
       walls = time_repeats([&] { ts = engine::simulate_full(full, fo); }, plan.full_repeats);
@@ -237,9 +242,14 @@ void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
     v.dense_names.push_back("me2_" + m.force_names[k]);
   }
   v.dense_params.assign(cols.size() + 1, {});
+  // A range table: 360 equal steps over its range (deg or m), not a turn.
+  const bool range = !v.samples10.periodic;
+  const double span = range ? v.samples10.q.back() - v.samples10.q0 : 2 * M_PI;
+  const double unit = v.samples10.revolute ? 180 / M_PI : 1.0;
+  if (!v.samples10.revolute) v.dense_names[0] = "q_m";
   for (int d = 0; d <= 360; ++d) {
-    const double q = v.samples10.q0 + d * M_PI / 180;
-    v.dense_params[0].push_back(q * 180 / M_PI);
+    const double q = v.samples10.q0 + d * span / 360;
+    v.dense_params[0].push_back(q * unit);
     for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
   }
 }
@@ -273,11 +283,13 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
 }  // namespace
 
 void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
-  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  // A coordinate confined to a range (a rocker, a slider) has no revolutions to count.
+  const auto domain = engine::calc_independent_domain(full);
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute && domain.periodic;
   const std::string integrator = scene.validation.reference_integrator;
   progress.count(scene.name + ": reference (full model)", 0, 2);
   const auto t_ref = Clock::now();
-  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance));
+  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance, domain));
   v.reference_wall_s = seconds_since(t_ref);
   v.reference_run.model = "full";
   v.reference_run.integrator = integrator;
@@ -288,7 +300,7 @@ void run_reference(const models::Scene& scene, engine::FullModel& full, Validati
   fill_stats(v.reference_run, v.reference);
   v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
   progress.count(scene.name + ": reference (full model)", 1, 2);
-  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2));
+  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2, domain));
   progress.count(scene.name + ": reference (full model)", 2, 2);
   v.window = detect_steady_window(v.reference, rotating);
   v.reference_change = compare_series(v.reference, half, v.window.t_start);
@@ -343,8 +355,6 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   v.tightest_tolerance = plan.tightest_tolerance();
   // 2–3. The ladders.
   run_full_ladder(scene.name, full, plan, v, progress);
-  if (scene.find_joint(scene.independent)->type != models::JointType::Revolute)
-    throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
   run_reduced_ladder(scene, plan, v, progress);
   calc_dense_params(scene, v);
   // 4. Pareto front, matched-error speedup, recommended setting, convergence.

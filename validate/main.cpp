@@ -71,7 +71,9 @@ int main(int argc, char** argv) {
       "Extract the reduced parameters of a scene from kinetostatic calls of the full model and write a portable "
       "table: q_deg,m1,m2,me1_<f>,me2_<f>,Q_cons,V,Qx_cons_<f>,r_<joint>...,rx_<f>_<joint>...,w_<body>...");
   extract->add_option("scene", ext.scene, "Scene name or YAML file")->required();
-  extract->add_option("--grid-deg", ext.grid_deg, "Grid step [deg]; must divide 360 (default 10)");
+  extract->add_option("--grid-deg", ext.grid_deg,
+                      "Grid step [deg]; must divide 360 (default 10). Range tables: intervals of at most this "
+                      "over a revolute range, 360/step intervals over a prismatic one");
   extract->add_option("--method", ext.method, "kinetostatic, paper-sweep, integrated or direct")
       ->check(CLI::IsMember({"kinetostatic", "paper-sweep", "integrated", "direct"}));
   extract->add_option("--set", ext.sets, "Override a scalar of the scene: key.path=value (repeatable)");

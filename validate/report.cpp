@@ -98,9 +98,9 @@ std::string params_gp(const json& fig) {
   gp += fmt::format(fmt::runtime(kSvgHead), nf ? 640 : 330);
   gp += fmt::format(
       "set output 'params.svg'\nset datafile separator ','\nset grid\nset key bottom right\n"
-      "set xlabel 'q [deg]'\nset xtics 60\nset multiplot layout {},2 title 'Reduced parameters "
+      "set xlabel '{}'\n{}set multiplot layout {},2 title 'Reduced parameters "
       "(points: samples from kinetostatic calls; lines: interpolant)'\n",
-      nf ? 2 : 1);
+      names[0] == "q_m" ? "q [m]" : "q [deg]", names[0] == "q_m" ? "" : "set xtics 60\n", nf ? 2 : 1);
   for (size_t c = 1; c < names.size(); ++c) {
     const std::string unit = c <= 2 ? "kg·m^2" : "kg·m";
     gp += fmt::format(
@@ -428,9 +428,12 @@ std::string headline(const json& s) {
     first = false;
   }
   out += " of their peaks. ";
-  out += s.at("steady_window").value("whole_run", false)
-             ? "The run has no steady cycles: errors are maxima over the whole run."
-             : "Errors are maxima over the steady cycles.";
+  const auto& w = s.at("steady_window");
+  // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
+  const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
+  out += !w.value("whole_run", false) ? "Errors are maxima over the steady cycles."
+         : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
+                                      : "The run has no steady cycles: errors are maxima over the whole run.";
   return out;
 }
 

@@ -40,9 +40,10 @@ nlohmann::json figures_json(const ValidationResult& v) {
   const auto& sm = v.samples10;
   if (!sm.q.empty() && !v.dense_names.empty()) {
     std::vector<std::vector<double>> cols(v.dense_names.size());
-    for (size_t i = 0; i <= sm.q.size(); ++i) {  // the first point again at +360°
+    // A periodic table repeats its first point at +360°; a range table ends at its last point.
+    for (size_t i = 0; i < sm.q.size() + (sm.periodic ? 1 : 0); ++i) {
       const size_t k = i % sm.q.size();
-      cols[0].push_back((sm.q[k] + (i == sm.q.size() ? 2 * M_PI : 0)) * 180 / M_PI);
+      cols[0].push_back((sm.q[k] + (i == sm.q.size() ? 2 * M_PI : 0)) * (sm.revolute ? 180 / M_PI : 1.0));
       for (size_t c = 1; c < v.dense_names.size(); ++c)
         cols[c].push_back(sm.columns[sm.column(v.dense_names[c])][k]);
     }

@@ -18,6 +18,10 @@ TimeScale calc_time_scale(const models::TimeSeries& ref, bool rotating) {
     s.period_s = rev;
     s.how = fmt::format("one revolution at the reference's peak speed ({:.4g} rad/s): {:.4g} s",
                         peak, rev);
+  } else if (!rotating) {
+    s.period_s = s.duration_s;
+    s.how = fmt::format(
+        "the coordinate moves within a range (it does not turn): the run's duration, {:.4g} s", s.duration_s);
   } else {
     s.period_s = s.duration_s;
     s.how = fmt::format(

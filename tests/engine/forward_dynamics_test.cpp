@@ -271,3 +271,52 @@ TEST(ForwardDynamicsChecks, KneeAlongAndAcrossAgreeBetweenRoutes) {
 
 }  // namespace
 }  // namespace rdyn::engine
+
+namespace rdyn::engine {
+namespace {
+
+// Issue #10: a run that leaves the independent coordinate's range stops (exit 1) with the
+// edge and what ends it; one that stays inside follows its motion reversals.
+TEST(ForwardDynamicsRange, ARunThrownPastTheRangeStopsAtItsEdge) {
+  auto scene = models::load_scene("slider-crank-slider");
+  scene.initial.qdot = 3.0;  // outward, fast enough to pass s = 0.245 m
+  const FullModel model(scene);
+  ForwardOptions opt;
+  opt.duration_s = 0.2;
+  opt.output_interval_s = 0.001;
+  try {
+    simulate_full(model, opt);
+    FAIL() << "the run did not stop";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("left the validity domain at q = 0.245"), std::string::npos) << m;
+    EXPECT_NE(m.find("(dead point)"), std::string::npos) << m;
+  }
+  scene.independent_range = models::IndependentRange{0.16, 0.24};
+  const FullModel declared(scene);
+  try {
+    simulate_full(declared, opt);
+    FAIL() << "the run did not stop";
+  } catch (const models::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("q = 0.24 m (declared limit)"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ForwardDynamicsRange, ARunInsideTheRangeReversesAndKeepsItsEnergyBalance) {
+  const FullModel model(models::load_scene("slider-crank-slider"));
+  ForwardOptions opt;
+  opt.duration_s = 1.0;
+  opt.output_interval_s = 0.001;
+  const auto ts = simulate_full(model, opt);
+  int reversals = 0;
+  for (size_t i = 1; i < ts.qdot.size(); ++i) reversals += (ts.qdot[i - 1] > 0) != (ts.qdot[i] > 0) ? 1 : 0;
+  EXPECT_GE(reversals, 6);
+  // Coulomb friction 1.5 N: the work is −1.5 N × the path length travelled.
+  double path = 0;
+  for (size_t i = 1; i < ts.q.size(); ++i) path += std::abs(ts.q[i] - ts.q[i - 1]);
+  EXPECT_NEAR(ts.work.back(), -1.5 * path, 1e-3 * 1.5 * path);
+  EXPECT_GT(ts.stats.events, 5);  // the friction gates switch at the reversals
+}
+
+}  // namespace
+}  // namespace rdyn::engine

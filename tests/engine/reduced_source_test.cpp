@@ -162,3 +162,142 @@ initial: {q: 0, qdot: 0}
 
 }  // namespace
 }  // namespace rdyn::engine
+
+#include "engine/independent_range.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+// Issue #10: the slider-crank driven from its slider. Same kinetic energy as driven from the
+// crank, so m1(s) = m1_θ(θ)·(dθ/ds)² with m1_θ the crank-driven closed form (test::SliderCrank)
+// and θ(s) from s² = r² + l² ... (law of cosines: l² = r² + s² − 2rs cos θ, crank above the line).
+TEST(ReducedSourceRange, SliderDrivenSliderCrankMatchesTheClosedForm) {
+  const auto scene = models::load_scene("slider-crank-slider");
+  FullModel model(scene);
+  const auto d = calc_independent_domain(model);
+  ASSERT_FALSE(d.periodic);
+  FullKinetostaticSource src(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = 5 * M_PI / 180;  // 72 intervals over the stroke
+  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
+  const auto s = reduced::extract_samples(src, scene, opt);
+  EXPECT_FALSE(s.periodic);
+  EXPECT_FALSE(s.revolute);
+  ASSERT_EQ(s.q.size(), 73u);
+  EXPECT_DOUBLE_EQ(s.q.front(), d.min);
+  EXPECT_DOUBLE_EQ(s.q.back(), d.max);
+  const test::SliderCrank sc;
+  const int c_m1 = s.require("m1"), c_r = s.require("r_crank"), c_r_slider = s.require("r_slider");
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    const double q = s.q[i];
+    const double th = std::acos((sc.r * sc.r + q * q - sc.l * sc.l) / (2 * sc.r * q));
+    const double ds_dth = -sc.r * std::sin(th) - sc.r * sc.r * std::sin(th) * std::cos(th) /
+                                                     std::sqrt(sc.l * sc.l - sc.r * sc.r * std::sin(th) * std::sin(th));
+    EXPECT_NEAR(s.columns[c_r][i], 1 / ds_dth, 1e-9 * std::abs(1 / ds_dth)) << q;
+    EXPECT_NEAR(s.columns[c_m1][i], sc.m1(th) / (ds_dth * ds_dth), 1e-9 * sc.m1(th) / (ds_dth * ds_dth)) << q;
+    EXPECT_NEAR(s.columns[c_r_slider][i], 1.0, 1e-12);
+  }
+  // m1 grows toward the dead points (dθ/ds → ∞): at the range's edges (5 % of the stroke short
+  // of them) it is 1.5–2 times its mid-stroke value.
+  const double mid = s.columns[c_m1][36];
+  EXPECT_GT(s.columns[c_m1].front(), 1.9 * mid);
+  EXPECT_GT(s.columns[c_m1].back(), 1.5 * mid);
+}
+
+}  // namespace
+}  // namespace rdyn::engine
+
+#include "reduced/table.hpp"
+
+namespace rdyn::engine {
+namespace {
+
+// Issue #10: the crane's cylinder stroke L as the independent coordinate. The potential of
+// gravity and the gas spring in closed form, V(L) = g·Σ m_i y_i(L) + ½ k (L − L0)², gives
+// Q_cons = −dV/dL; the static equilibrium stroke, where the 4 kN pressure balances it
+// (virtual work: F = dV/dL), follows from the table and from the closed form alike.
+TEST(ReducedSourceRange, CraneGeneralizedForceAndEquilibriumStrokeMatchVirtualWork) {
+  const auto scene = models::load_scene("crane-luffing");
+  FullModel model(scene);
+  const auto d = calc_independent_domain(model);
+  ASSERT_FALSE(d.periodic);
+  EXPECT_EQ(d.min, 1.0);
+  EXPECT_EQ(d.max, 1.9);
+  EXPECT_EQ(d.max_edge, "declared limit");
+  FullKinetostaticSource src(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = 10 * M_PI / 180;
+  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
+  const auto s = reduced::extract_samples(src, scene, opt);
+  ASSERT_EQ(s.q.size(), 37u);
+
+  const double g = 9.81, Ax = 0.6, Ay = -0.4, OB = 1.5, k = 40000, L0 = 1.583;
+  auto V = [&](double L) {
+    // Boom angle φ from L² = OB² + |OA|² − 2·OB·(Ax cos φ + Ay sin φ), boom above the line OA.
+    const double R = std::hypot(Ax, Ay), delta = std::atan2(-Ay, Ax);
+    const double phi = std::acos((OB * OB + R * R - L * L) / (2 * OB * R)) - delta;
+    const double Bx = OB * std::cos(phi), By = OB * std::sin(phi);
+    const double psi = std::atan2(By - Ay, Bx - Ax);  // cylinder direction A → B
+    return g * (300 * 2.6667 * std::sin(phi) + 30 * (Ay + 0.6 * std::sin(psi)) + 15 * (By - 0.5 * std::sin(psi))) +
+           0.5 * k * (L - L0) * (L - L0);
+  };
+  auto Q = [&](double L) { return -(V(L + 1e-6) - V(L - 1e-6)) / 2e-6; };
+  const int c_Q = s.require("Q_cons"), c_V = s.require("V");
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    EXPECT_NEAR(s.columns[c_Q][i], Q(s.q[i]), 1e-6 * 1e4) << s.q[i];
+    EXPECT_NEAR(s.columns[c_V][i] - s.columns[c_V][0], V(s.q[i]) - V(s.q[0]), 1e-6 * 1e4) << s.q[i];
+  }
+  // Equilibrium stroke: Q_cons(L*) + 4000 N = 0, by bisection on the closed form and on the
+  // not-a-knot table.
+  auto bisect = [](auto f, double a, double b) {
+    for (int it = 0; it < 200 && b - a > 1e-13; ++it) {
+      const double m = 0.5 * (a + b);
+      ((f(a) > 0) == (f(m) > 0) ? a : b) = m;
+    }
+    return 0.5 * (a + b);
+  };
+  const double L_closed = bisect([&](double L) { return Q(L) + 4000; }, 1.2, 1.7);
+  const auto table = reduced::build_table(s, reduced::Interpolation::CubicSpline);
+  const int t_Q = table.column("Q_cons");
+  const double L_table = bisect([&](double L) { return table.eval(t_Q, L) + 4000; }, 1.2, 1.7);
+  EXPECT_NEAR(L_closed, 1.46, 0.01);
+  EXPECT_NEAR(L_table, L_closed, 1e-6);
+}
+
+}  // namespace
+}  // namespace rdyn::engine
+
+namespace rdyn::engine {
+namespace {
+
+// Two routes on one mechanism: the four-bar's crank turns fully, so a periodic table and a range
+// table over [−170°, 170°] (more than half a turn from the initial 30°: walked directly, not by
+// its periodic image) must agree at their common grid points.
+TEST(ReducedSourceRange, ARangeTableOfAFullTurnCrankAgreesWithThePeriodicTable) {
+  auto scene = models::load_scene("fourbar");
+  const double lo = -170 * M_PI / 180, hi = 170 * M_PI / 180;
+  scene.independent_range = models::IndependentRange{lo, hi};
+  FullModel model(scene);
+  reduced::ExtractOptions opt;
+  opt.step_rad = 10 * M_PI / 180;
+  FullKinetostaticSource per_src(model);
+  const auto per = reduced::extract_samples(per_src, scene, opt);
+  opt.range = reduced::ExtractRange{lo, hi, "declared limit", "declared limit"};
+  FullKinetostaticSource rng_src(model, false);
+  const auto rng = reduced::extract_samples(rng_src, scene, opt);
+  ASSERT_EQ(rng.q.size(), 35u);
+  int matched = 0;
+  for (size_t i = 0; i < rng.q.size(); ++i)
+    for (size_t j = 0; j < per.q.size(); ++j)
+      if (std::abs(std::remainder(rng.q[i] - per.q[j], 2 * M_PI)) < 1e-9) {
+        ++matched;
+        for (const char* c : {"m1", "m2", "V", "me1_rocker_axial", "r_rocker"})
+          EXPECT_NEAR(rng.columns[rng.require(c)][i], per.columns[per.require(c)][j],
+                      1e-10 * (1 + std::abs(per.columns[per.require(c)][j])))
+              << c << " at " << rng.q[i];
+      }
+  EXPECT_EQ(matched, 35);
+}
+
+}  // namespace
+}  // namespace rdyn::engine

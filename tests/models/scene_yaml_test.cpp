@@ -164,7 +164,7 @@ TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
         EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
         ++n;
       }
-  EXPECT_EQ(n, 11);
+  EXPECT_EQ(n, 14);
 }
 
 TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
@@ -408,6 +408,67 @@ TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
     EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << c.what << ": " << e.what();
     EXPECT_LT(seconds, 2.0) << c.what;  // a walk over 10^30 nodes would never return
   }
+}
+
+}  // namespace
+}  // namespace rdyn::models
+
+namespace rdyn::models {
+namespace {
+
+// independent_range (issue #10): degrees for a revolute (independent_range_deg) or SI
+// (independent_range, as initial.q); checked finite, ordered, around the initial q.
+TEST(SceneYaml, IndependentRangeIsReadInItsUnitAndChecked) {
+  const std::string fb = std::string(kFourbar) + "initial: {q_deg: 30}\n";
+  const Scene deg = parse_scene(fb + "independent_range_deg: [10, 120]\n", "test.yaml");
+  ASSERT_TRUE(deg.independent_range);
+  EXPECT_NEAR(deg.independent_range->min, 10 * kPi / 180, 1e-15);
+  EXPECT_NEAR(deg.independent_range->max, 120 * kPi / 180, 1e-15);
+  const Scene rad = parse_scene(fb + "independent_range: [0.1, 2.0]\n", "test.yaml");
+  EXPECT_DOUBLE_EQ(rad.independent_range->max, 2.0);
+  EXPECT_FALSE(parse_scene(fb, "test.yaml").independent_range);
+
+  struct Case {
+    std::string extra, field, words;
+  };
+  const Case cases[] = {
+      {"independent_range_deg: [120, 10]\n", "independent_range_deg", "min < max"},
+      {"independent_range: [0.2, 0.2]\n", "independent_range", "min < max"},
+      {"independent_range_deg: [40, 120]\n", "initial.q", "outside independent_range"},
+      {"independent_range_deg: [10, .nan]\n", "independent_range_deg[1]", "finite"},
+      {"independent_range_deg: [10]\n", "independent_range_deg", "pair"},
+      {"independent_range: [0.1, 2]\nindependent_range_deg: [10, 120]\n", "independent_range", "not both"},
+      {"independent_range: [0.1, 1e7]\n", "independent_range[1]", "rad"},
+  };
+  for (const auto& c : cases) {
+    const SceneError e = refusal(fb + c.extra);
+    EXPECT_EQ(e.field(), c.field) << c.extra;
+    EXPECT_NE(e.message().find(c.words), std::string::npos) << c.extra << ": " << e.what();
+    EXPECT_GT(e.line(), 0) << c.extra << ": " << e.what();
+  }
+}
+
+TEST(SceneYaml, PrismaticIndependentRangeIsInMetres) {
+  const std::string sc = R"(
+name: s
+ground_points: {O: [0, 0]}
+bodies:
+  - {name: crank, mass_kg: 0.4, inertia_kgm2: 2.0e-4, points: {B: [0.05, 0]}}
+  - {name: rod, mass_kg: 0.6, com_m: [0.08, 0], inertia_kgm2: 2.0e-3, points: {C: [0.2, 0]}}
+  - {name: slider, mass_kg: 1.5, inertia_kgm2: 1.0e-3}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: O, child: crank, guess_deg: 60}
+  - {name: rod, type: revolute, parent: crank, parent_point: B, child: rod, guess_deg: -72}
+  - {name: slider, type: prismatic, parent: ground, parent_point: O, child: slider, axis: [1, 0], guess_m: 0.21}
+loops:
+  - {name: pin, body_a: rod, point_a: C, body_b: slider, point_b: [0, 0]}
+independent: slider
+initial: {q: 0.2}
+)";
+  EXPECT_DOUBLE_EQ(parse_scene(sc + "independent_range: [0.16, 0.24]\n", "t.yaml").independent_range->min, 0.16);
+  const SceneError e = refusal(sc + "independent_range_deg: [10, 20]\n");
+  EXPECT_EQ(e.field(), "independent_range_deg");
+  EXPECT_NE(e.message().find("metres"), std::string::npos) << e.what();
 }
 
 }  // namespace

@@ -1,0 +1,51 @@
+// The validity domain of the independent coordinate: declared in the scene
+// (independent_range), a full turn of a revolute that turns fully, or found from the
+// mechanism's dead points by continuation on the full model.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "engine/full_model.hpp"
+
+namespace rdyn::engine {
+
+// A found range stops short of each dead point by this fraction of the distance between the
+// two dead points: m1 grows without bound there (like 1/distance for a slider-crank driven
+// from its slider: dθ/ds ∝ 1/√(s_dead − s)), so a table reaching the dead point cannot be
+// interpolated. 5 %: m1 at the edges of the slider-crank-slider scene is 1.5–2× its mid-stroke
+// value, 2–3× its minimum for fourbar-rocker (docs/theory.md, "Range tables").
+inline constexpr double kDeadPointMargin = 0.05;
+
+struct IndependentDomain {
+  bool periodic = false;  // a revolute turning fully, no range declared: no edges
+  double min = 0.0, max = 0.0;  // edges of the domain [rad or m] (not set when periodic)
+  std::string min_edge, max_edge;  // "dead point" or "declared limit"
+  // The dead points themselves, located to ~1e-10 by bisection [rad or m] (found ranges only).
+  std::optional<double> dead_min, dead_max;
+  bool revolute = true;
+  // Not periodic, yet no range could be found (a prismatic coordinate meeting no dead point, or
+  // only one): min = −∞, max = +∞ and this says why. The full model runs unbounded; a reduced
+  // table needs a declared independent_range (extraction refuses with this message).
+  std::string unbounded_reason;
+};
+
+// Declared range: returned as given after walking to both ends (EngineError when a dead point
+// lies inside it). Otherwise walks the full model from the scene's
+// initial q in both directions (continuation in moves of 10°, or 1/20 of the mechanism's size
+// for a prismatic coordinate, refined to 1/50 of that when a projection fails) until the loops
+// cannot close, then bisects to the dead point. A revolute that completes a turn is periodic.
+// A prismatic coordinate that meets no dead point within 40 mechanism sizes, or only one,
+// gets an unbounded domain (unbounded_reason). Throws EngineError when the initial q lies within
+// the margin of a dead point.
+IndependentDomain calc_independent_domain(const FullModel& model);
+
+// Size of the mechanism [m]: the largest distance of any point (ground points, body points,
+// centres of mass, joint locations) from its frame's origin; at least 1 mm. Sets the
+// continuation moves of a prismatic coordinate.
+double calc_length_scale(const models::Scene& scene);
+
+// "q = 12.5°" or "q = 0.2345 m".
+std::string format_coordinate(double q, bool revolute);
+
+}  // namespace rdyn::engine
