@@ -733,12 +733,14 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       s.validation.thresholds.push_back(th);
     });
     if (f.has("calibrate")) {
-      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W"});
+      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
       s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
-      s.validation.calibrate_power_W = c.num("power_W");
+      // power_W absent: mean-speed mode (the resistances stay as given).
+      s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
+      s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
       // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
       if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
-      if (!(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
+      if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
     }
     // Published values the report sets beside the calibration's (e.g. the original authors'
     // hip torque): plain text, HTML-escaped by the report.

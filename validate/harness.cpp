@@ -351,8 +351,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   analyse_runs(v);
   // 5. Calibration (scenes that declare an operating point).
   if (scene.validation.calibrate_cadence_Hz > 0) {
-    v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
-    v.calibration_options.power_w = scene.validation.calibrate_power_W;
+    v.calibration_options = calibration_options_of(scene, 0.0, 0.0, "");
     progress.note(scene.name + ": calibrating the drive load");
     v.calibration = calibrate(scene, v.calibration_options, progress);
   }

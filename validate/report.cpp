@@ -338,22 +338,30 @@ std::string verdict_table(const json& s) {
 std::string calibration_section(const json& s) {
   const auto& c = s.at("calibration");
   std::string h = "<h2>Calibration</h2>";
+  const bool with_power = c.contains("target_power_w") && c.at("target_power_w").is_number();
+  const std::string unit = c.value("load_unit", std::string("N·m"));
+  const std::string load = c.value("load", std::string());
+  const double value = c.contains("load_value") ? d(c, "load_value") : d(c, "drive_torque_Nm");
+  const double per_unit =
+      c.contains("work_per_rev_per_unit") ? d(c, "work_per_rev_per_unit") : d(c, "drive_work_per_rev_per_Nm");
   h += fmt::format(
-      "<p>With the resistance dissipating {} W at {} Hz, the drive load that holds a mean steady "
-      "rate of {} "
-      "Hz is <b>{} N·m</b> (reduced model: {} Hz; confirmed with the full model: {} Hz). Mean "
-      "power "
-      "{} W, speed fluctuation {}{}. At steady state the drive's work per revolution equals the "
-      "dissipated energy, {} J; the drive does {} J per revolution per N·m.</p>",
-      num(d(c, "target_power_w")), num(d(c, "target_cadence_hz")), num(d(c, "target_cadence_hz")),
-      num(d(c, "drive_torque_Nm"), "{:.4g}"), num(d(c, "mean_cadence_hz_reduced"), "{:.6f}"),
+      "<p>{}, the drive load {}({}) that holds a mean steady rate of {} Hz is <b>{} {}</b> (reduced model: {} Hz; "
+      "confirmed with the full model: {} Hz). Its mean power {} W, speed fluctuation {}{}. ",
+      with_power ? fmt::format("With the resistance dissipating {} W at {} Hz", num(d(c, "target_power_w")),
+                               num(d(c, "target_cadence_hz")))
+                 : std::string("With the resistances as the scene gives them"),
+      load.empty() ? std::string() : "<b>" + H(load) + "</b> ", H(c.value("load_kind", std::string("joint_torques"))),
+      num(d(c, "target_cadence_hz")), num(value, "{:.4g}"), H(unit), num(d(c, "mean_cadence_hz_reduced"), "{:.6f}"),
       num(d(c, "mean_cadence_hz_full"), "{:.6f}"), num(d(c, "mean_power_W"), "{:.4g}"),
       pct(d(c, "speed_fluctuation")),
       str(c, "force_name").empty() ? std::string()
                                    : fmt::format(", peak {} force {} N", H(str(c, "force_name")),
-                                                 num(d(c, "peak_force_N"), "{:.4g}")),
-      num(d(c, "target_power_w") / d(c, "target_cadence_hz"), "{:.4g}"),
-      num(d(c, "drive_work_per_rev_per_Nm"), "{:.4g}"));
+                                                 num(d(c, "peak_force_N"), "{:.4g}")));
+  if (with_power)
+    h += fmt::format("At steady state the drive's work per revolution equals the dissipated energy, {} J; ",
+                     num(d(c, "target_power_w") / d(c, "target_cadence_hz"), "{:.4g}"));
+  h += fmt::format("at the target rate the load does {} J per revolution per {}.</p>", num(per_unit, "{:.4g}"),
+                   H(unit));
   for (const auto& cv : c.value("compare", json::array())) {
     const double ours = d(cv, "rdyn_value"), theirs = d(cv, "value");
     h += fmt::format("<p><b>{}</b>: rdyn {} {}, {} {} {}", H(str(cv, "quantity")),
@@ -362,7 +370,7 @@ std::string calibration_section(const json& s) {
                      num(theirs, "{:.4g}"), H(str(cv, "unit")));
     if (std::isfinite(ours) && std::isfinite(theirs) && theirs != 0)
       h += fmt::format(" ({:+.3g} %)", 100 * (ours - theirs) / theirs);
-    if (str(cv, "quantity") == "drive_torque_Nm" && theirs > 0)
+    if (str(cv, "quantity") == "drive_torque_Nm" && theirs > 0 && with_power)
       h += "; the published value would do " +
            num(d(c, "target_power_w") / d(c, "target_cadence_hz") / theirs, "{:.4g}") +
            " J per revolution per N·m to balance the same energy";

@@ -75,16 +75,23 @@ nlohmann::json figures_json(const ValidationResult& v) {
 // compares it to.
 nlohmann::json calibration_json(const ValidationResult& v) {
   const auto& c = *v.calibration;
+  const double power = v.calibration_options.power_w;
   nlohmann::json j = {{"target_cadence_hz", v.calibration_options.cadence_hz},
-                      {"target_power_w", v.calibration_options.power_w},
-                      {"drive_torque_Nm", num(c.torque_Nm)},
+                      {"target_power_w", power > 0 ? num(power) : nlohmann::json(nullptr)},
+                      {"load", c.load},
+                      {"load_kind", c.load_kind},
+                      {"load_value", num(c.load_value)},
+                      {"load_unit", c.load_unit},
+                      {"drive_torque_Nm", num(c.torque_Nm)},  // null unless joint torques (N·m)
+                      {"work_per_rev_per_unit", num(c.work_per_rev_per_unit)},
                       {"mean_cadence_hz_reduced", num(c.mean_cadence_hz_reduced)},
                       {"mean_cadence_hz_full", num(c.mean_cadence_hz_full)},
                       {"mean_power_W", num(c.mean_power_w)},
                       {"force_name", c.force_name},
                       {"peak_force_N", num(c.peak_force_N)},
                       {"speed_fluctuation", num(c.speed_fluctuation)},
-                      {"drive_work_per_rev_per_Nm", num(c.drive_work_per_rev_per_Nm)}};
+                      {"drive_work_per_rev_per_Nm",
+                       std::isfinite(c.torque_Nm) ? num(c.work_per_rev_per_unit) : nlohmann::json(nullptr)}};
   nlohmann::json cmp = nlohmann::json::array();
   for (const auto& cv : v.compare)
     cmp.push_back({{"quantity", cv.quantity},

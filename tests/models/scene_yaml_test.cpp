@@ -278,6 +278,9 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
        "validation.calibrate.cadence_Hz"},
       {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 1.0e6}}",
        "validation.calibrate.power_W"},
+      // A given power of 0 would silently mean mean-speed mode: leave the key out for that.
+      {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 0}}",
+       "validation.calibrate.power_W"},
       {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}",
        "validation.reference_tolerance"},
   };
@@ -287,6 +290,18 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
     EXPECT_EQ(e.field(), c.field) << e.what();
     EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
   }
+}
+
+// validation.calibrate: power_W is optional (mean-speed mode), load names the drive load.
+TEST(SceneYaml, CalibrateBlockNamesItsLoadAndMayOmitThePower) {
+  const Scene b = load_scene("bicycle");
+  EXPECT_EQ(b.validation.calibrate_power_W, 125.0);
+  EXPECT_EQ(b.validation.calibrate_load, "");
+  const Scene s = load_scene(
+      "slider-crank", {parse_override("validation.calibrate.cadence_Hz=3"), parse_override("validation.calibrate.load=motor")});
+  EXPECT_EQ(s.validation.calibrate_cadence_Hz, 3.0);
+  EXPECT_EQ(s.validation.calibrate_power_W, 0.0);
+  EXPECT_EQ(s.validation.calibrate_load, "motor");
 }
 
 TEST(SceneYaml, AGearCouplingAJointToItselfIsRefused) {

@@ -75,7 +75,7 @@ TEST(Report, TheScenesComparisonComesFromTheSummary) {
   auto v = test::synthetic_validation();
   CalibrationResult c;
   c.torque_Nm = 60.0;
-  c.drive_work_per_rev_per_Nm = 125.0 / 60.0;
+  c.work_per_rev_per_unit = 125.0 / 60.0;
   v.calibration = c;
   v.calibration_options.cadence_hz = 1.0;
   v.calibration_options.power_w = 125.0;
