@@ -281,6 +281,15 @@ std::string svg_or_note(const std::map<std::string, std::string>& figures,
   return it->second.substr(at);
 }
 
+// What the errors were taken over, in words: the steady revolutions, or the whole run when
+// the reference has no steady cycles (a transient, a rocking mechanism).
+std::string compared_over(const json& s) {
+  const auto& w = s.at("steady_window");
+  if (w.value("whole_run", false)) return "over the whole run";
+  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
+                     num(d(w, "t_start_s"), "{:.3g}"));
+}
+
 // The first screen: one row per quantity.
 std::string verdict_table(const json& s) {
   const json& rec = s.at("recommended_reduced");
@@ -292,9 +301,8 @@ std::string verdict_table(const json& s) {
     h += fmt::format(
         "<p class=warn>No reduced run reached the target of {} on the speed and on {}.</p>",
         pct(d(s, "matched_error_target")), H(str(s, "headline_quantity")));
-  h += "<table><tr><th>quantity</th><th>error at the recommended "
-       "setting</th><th>limit</th><th>judged on</th>"
-       "<th>error there</th><th></th></tr>";
+  h += "<table><tr><th>quantity</th><th>max error " + H(compared_over(s)) +
+       " at the recommended setting</th><th>limit</th><th>judged on</th><th>error there</th><th></th></tr>";
   for (const auto& v : s.at("verdicts")) {
     const bool pass = v.value("pass", false), decides = v.value("decides", false);
     // Only the scene's thresholds pass or fail; the target is shown for information.
@@ -320,16 +328,16 @@ std::string verdict_table(const json& s) {
   if (s.contains("error_budget")) {
     const auto& b = s.at("error_budget");
     h += fmt::format(
-        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak): reference {} "
-        "(its change when its "
+        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak, on output rows "
+        "computed as accurately as the integrator's steps): reference {} (its change when its "
         "tolerance is halved), table {} ({}: grid and interpolation, integrated at the tightest "
-        "tolerance), "
-        "integration {} (what the setting's integrator and its output interpolation add). "
-        "Contributions are maxima, "
-        "so they bound rather than sum.</p>",
+        "tolerance), integration {} (what the setting's integrator adds). Output interpolation {}: "
+        "what quintic-Hermite rows between steps, as the timed run writes them, differ from "
+        "those rows (not in the total). Contributions are maxima, so they bound rather than "
+        "sum.</p>",
         H(str(b, "quantity")), pct(d(b, "total")), pct(d(b, "reference")), pct(d(b, "table")),
         H(str(b, "table_run").empty() ? "no tight run at that grid" : str(b, "table_run")),
-        pct(d(b, "integration")));
+        pct(d(b, "integration")), pct(d(b, "output_interpolation")));
   }
   return h;
 }
@@ -438,7 +446,7 @@ std::string headline(const json& s) {
   out += " of their peaks. ";
   out += s.at("steady_window").value("whole_run", false)
              ? "The run has no steady cycles: errors are maxima over the whole run."
-             : "Errors are maxima over the steady cycles.";
+             : "Errors are maxima " + compared_over(s) + " (after the start-up transient).";
   return out;
 }
 
@@ -493,7 +501,9 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
        (s.contains("figures") && s.at("figures").contains("params_samples")
             ? svg_or_note(figures, "params")
             : "<p>No table in this summary.</p>");
-  h += "<h2>2. Full and reduced model over the last periods</h2>" +
+  h += std::string(s.at("steady_window").value("whole_run", false)
+                       ? "<h2>2. Full and reduced model toward the end of the run</h2>"
+                       : "<h2>2. Full and reduced model over the last periods</h2>") +
        svg_or_note(figures, "timeseries");
   h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto");
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");

@@ -129,6 +129,10 @@ nlohmann::json run_json(const RunRecord& r) {
     j["interpolation"] = r.interpolation;
     j["energy_consistent_m2"] = r.energy_consistent;
     if (r.integrator == "rk4-fixed") j["fixed_step_s"] = r.fixed_step_s;
+    nlohmann::json oi = nlohmann::json::object();
+    for (const auto& e : r.output_interpolation.signals) oi[e.name] = num(e.max_rel);
+    j["output_interpolation_max_rel"] = oi;  // Hermite rows of the timed run vs the compared rows
+    j["compared_run_wall_s"] = num(r.compared_run_wall_s);
   }
   j.update(comparison_json(r.errors));
   return j;
@@ -198,7 +202,8 @@ nlohmann::json summary_json(const ValidationResult& v) {
     j["error_budget"] = {
         {"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
         {"table", num(v.budget->table)},   {"integration", num(v.budget->integration)},
-        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run}};
+        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run},
+        {"output_interpolation", num(v.budget->output_interpolation)}};
   nlohmann::json conv = nlohmann::json::array();
   for (const auto& s : v.convergence) {
     nlohmann::json pts = nlohmann::json::array();

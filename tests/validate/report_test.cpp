@@ -102,6 +102,24 @@ TEST(Report, ShortRunsAreNotExtrapolatedPerSecond) {
   EXPECT_NE(headline(summary_json(v)).find("per simulated second"), std::string::npos);
 }
 
+// Headline and verdict table say what was compared: the steady revolutions, or the whole run
+// (never "steady cycles" for a run that has none).
+TEST(Report, WordingSaysWhatWasCompared) {
+  auto v = test::synthetic_validation();  // compared over the whole run
+  std::string html = render_html(summary_json(v), {});
+  const std::string first = html.substr(0, html.find("<h2>1."));
+  EXPECT_NE(first.find("max error over the whole run at the recommended setting"), std::string::npos) << first;
+  EXPECT_EQ(first.find("over the steady"), std::string::npos) << first;
+  EXPECT_NE(html.find("toward the end of the run"), std::string::npos);
+  v.window = {1.25, 7, false, "from the second revolution"};
+  html = render_html(summary_json(v), {});
+  EXPECT_NE(html.find("max error over the 7 steady revolutions from t = 1.25 s"), std::string::npos);
+  EXPECT_NE(headline(summary_json(v)).find("Errors are maxima over the 7 steady revolutions from t = 1.25 s"),
+            std::string::npos);
+  EXPECT_EQ(html.find("whole run"), std::string::npos);
+  EXPECT_NE(html.find("over the last periods"), std::string::npos);
+}
+
 // `rdyn report SUMMARY --out DIR`: the same report from the saved summary; a file that is not
 // a summary is bad input (exit 2, the file named, nothing written), never an internal error.
 TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
