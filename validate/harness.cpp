@@ -353,7 +353,8 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   // 2–3. The ladders.
   run_full_ladder(scene.name, full, plan, v, progress);
   if (scene.find_joint(scene.independent)->type != models::JointType::Revolute)
-    throw reduced::TableError("the reduced ladder needs a revolute independent coordinate turning fully");
+    throw models::SceneError(scene.source_file, 0, "independent",
+                             "the reduced ladder needs a revolute independent coordinate turning fully");
   run_reduced_ladder(scene, plan, v, progress);
   calc_dense_params(scene, v);
   // 4. Pareto front, matched-error speedup, recommended setting, convergence.

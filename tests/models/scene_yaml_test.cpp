@@ -226,6 +226,27 @@ TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
   EXPECT_EQ(refusal(y).line(), line_in(y, "'a b'"));
 }
 
+// Issue #9 leftovers: a body list item that is not a name, a load type that is not a word,
+// and a nonzero number too small for a double all name their field (yaml-cpp alone said
+// "bad conversion", and 1e-400 was read as 0).
+TEST(SceneYaml, MalformedItemsAndUnderflowingNumbersNameTheField) {
+  const std::string fb = kFourbar;
+  std::string y = fb + "outputs: {bodies: [crank, {a: 1}]}\n";
+  EXPECT_EQ(refusal(y).field(), "outputs.bodies[1]");
+  EXPECT_EQ(refusal(y).line(), line_in(y, "outputs:"));
+  y = with(fb, "{type: resistance,", "{type: [resistance],");
+  EXPECT_EQ(refusal(y).field(), "loads[0].type");
+  y = fb + "gravity: {enabled: true, g_m_s2: [0, 1e-400]}\n";
+  EXPECT_EQ(refusal(y).field(), "gravity.g_m_s2[1]");
+  EXPECT_NE(std::string(refusal(y).what()).find("'1e-400' is too small"), std::string::npos) << refusal(y).what();
+  y = fb + "gravity: {enabled: true, g_m_s2: [0, -2.5e-320]}\n";  // a denormal: digits lost
+  EXPECT_EQ(refusal(y).field(), "gravity.g_m_s2[1]");
+  // Zero written small is still zero; ordinary small numbers are fine.
+  EXPECT_EQ(parse_scene(fb + "gravity: {enabled: true, g_m_s2: [0.0e-400, -1e-300]}\n", "t.yaml").gravity.g_m_s2.x, 0.0);
+  // Through --set too.
+  EXPECT_EQ(refusal(fb, {parse_override("initial.qdot=3e-400")}).field(), "--set initial.qdot");
+}
+
 TEST(SceneYaml, DuplicateNamesWithinAKindAreRefused) {
   const std::string fb = kFourbar;
   std::string y =
