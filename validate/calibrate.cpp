@@ -19,8 +19,8 @@ namespace rdyn::validate {
 namespace {
 
 // Acceptance of a calibration (relative cadence error). Reduced: the steady cycle is solved
-// to 1e-12 and the torque to 1e-10 N·m, so 1e-6 is met with a wide margin by any genuine
-// root. Full: the reduced table's own error (≈ 1e-5 of the speed at 10°, docs/theory.md) and
+// to 1e-12 and the load value to 1e-10 relative, so 1e-6 is met with a wide margin by any
+// genuine root. Full: the reduced table's own error (≈ 1e-5 of the speed at 10°, docs/theory.md) and
 // the 5 s window's quasi-steady drift keep the full model within 1e-4; 1 % is the user-level
 // target (issue #13: "holds 1 Hz within 1 %").
 constexpr double kReducedCadenceTolerance = 1e-6;

@@ -135,8 +135,8 @@ int main(int argc, char** argv) {
   SweepArgs sw;
   auto* sweep = app.add_subcommand(
       "sweep",
-      "Population sweep: calibrate the drive torque of many cases with the reduced model, in parallel threads. "
-      "One CSV row per case: the varied parameters, the calibrated drive torque, the peak of the first constraint "
+      "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
+      "One CSV row per case: the varied parameters, the calibrated drive load, the peak of the first constraint "
       "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
       "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
   sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
@@ -148,7 +148,9 @@ int main(int argc, char** argv) {
   sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
   sweep->add_option("--threads", sw.threads, "Worker threads (default: hardware threads)");
   sweep->add_option("--cadence-hz", sw.cadence_hz, "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
-  sweep->add_option("--power-w", sw.power_w, "Calibration power [W] (default: the scene's validation.calibrate)");
+  sweep->add_option("--power-w", sw.power_w,
+                    "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as "
+                    "given)");
   sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load");
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
 
