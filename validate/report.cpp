@@ -290,6 +290,18 @@ std::string compared_over(const json& s) {
                      num(d(w, "t_start_s"), "{:.3g}"));
 }
 
+// The cost of the accurate rows the errors are read from: an untimed second run of the
+// recommended setting (one extra single step of its method per output row).
+std::string row_cost(const json& s) {
+  const json& rec = s.at("recommended_reduced");
+  const double timed = d(rec, "wall_s"), rows = d(rec, "compared_run_wall_s");
+  if (!(timed > 0) || !(rows > 0)) return "";
+  return fmt::format(
+      "The accurate rows come from an untimed second run of that setting (one extra single step "
+      "per output row): {} against {} for the timed run, {}× (one run, noisy).",
+      secs(rows), secs(timed), num(rows / timed, "{:.2g}"));
+}
+
 // The first screen: one row per quantity.
 std::string verdict_table(const json& s) {
   const json& rec = s.at("recommended_reduced");
@@ -334,10 +346,10 @@ std::string verdict_table(const json& s) {
         "tolerance), integration {} (what the setting's integrator adds). Output interpolation {}: "
         "what quintic-Hermite rows between steps, as the timed run writes them, differ from "
         "those rows (not in the total). Contributions are maxima, so they bound rather than "
-        "sum.</p>",
+        "sum. {}</p>",
         H(str(b, "quantity")), pct(d(b, "total")), pct(d(b, "reference")), pct(d(b, "table")),
         H(str(b, "table_run").empty() ? "no tight run at that grid" : str(b, "table_run")),
-        pct(d(b, "integration")), pct(d(b, "output_interpolation")));
+        pct(d(b, "integration")), pct(d(b, "output_interpolation")), row_cost(s));
   }
   return h;
 }

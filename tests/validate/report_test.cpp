@@ -104,6 +104,19 @@ TEST(Report, ShortRunsAreNotExtrapolatedPerSecond) {
 
 // Headline and verdict table say what was compared: the steady revolutions, or the whole run
 // (never "steady cycles" for a run that has none).
+// The error budget separates output interpolation from the total and states what the
+// accurate rows cost (an untimed second run), from the summary alone.
+TEST(Report, ErrorBudgetNamesOutputInterpolationAndItsCost) {
+  auto s = summary_json(test::synthetic_validation());
+  s["error_budget"] = {{"quantity", "F"}, {"reference", 1e-9}, {"table", 2e-4},      {"integration", 3e-4},
+                       {"total", 5e-4},  {"table_run", "t"},    {"output_interpolation", 2.5e-5}};
+  s["recommended_reduced"]["wall_s"] = 0.002;
+  s["recommended_reduced"]["compared_run_wall_s"] = 0.005;
+  const std::string html = render_html(s, {});
+  EXPECT_NE(html.find("Output interpolation 0.0025 %"), std::string::npos) << html;
+  EXPECT_NE(html.find("2.5×"), std::string::npos) << html;
+}
+
 TEST(Report, WordingSaysWhatWasCompared) {
   auto v = test::synthetic_validation();  // compared over the whole run
   std::string html = render_html(summary_json(v), {});
