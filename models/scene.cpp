@@ -404,7 +404,7 @@ void check_scene(const Scene& s) {
       fail("validation.calibrate.cadence_Hz",
            fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz,
                        v.calibrate_cadence_Hz));
-    if (!(v.calibrate_power_W > 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
+    if (!(v.calibrate_power_W >= 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
       fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
                                                        limits::kMaxPower_W, v.calibrate_power_W));
   }

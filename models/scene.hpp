@@ -243,9 +243,11 @@ struct Validation {
   double reference_tolerance = 1e-10;  // full-model reference accuracy (halved to show convergence)
   std::string reference_integrator = "rkmerson";  // rkmerson | rk3 | cpodes
   std::vector<Threshold> thresholds;
-  // Calibrate the drive torque so the resistance dissipates power_W at cadence_Hz (0: off).
+  // Calibrate a drive load so q turns at a mean cadence_Hz (0: off); with power_W > 0 the one
+  // resistance first dissipates power_W at cadence_Hz, with 0 the resistances stay as given.
   double calibrate_cadence_Hz = 0.0;
   double calibrate_power_W = 0.0;
+  std::string calibrate_load;  // a joint_torque or motor name; empty: every joint torque together
   std::string note;  // why the scene is hard / what it shows (reports quote it)
   std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -216,6 +217,7 @@ class Fields {
       : node_(node), path_(std::move(path)), ctx_(ctx), allowed_(std::move(allowed)) {
     if (!node_.IsMap()) fail_at(node_, path_, "expected a mapping of keys to values");
     for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) fail_at(kv.first, path_, "a key must be a plain name, not a list or mapping");
       const std::string key = kv.first.as<std::string>();
       if (std::find(allowed_.begin(), allowed_.end(), key) != allowed_.end()) continue;
       std::string best;
@@ -295,6 +297,15 @@ class Fields {
       fail_at(n, field, fmt::format("expected a number, got '{}'", text.substr(0, 40)));
     if (!std::isfinite(v))
       fail_at(n, field, fmt::format("must be finite, got '{}'", text.substr(0, 40)));
+    // A nonzero literal below the smallest normal double (2.2e-308) would be read as 0 or a
+    // denormal that has lost its digits: refuse it instead of silently changing the value.
+    if (std::abs(v) < std::numeric_limits<double>::min()) {
+      const std::string mantissa = text.substr(0, text.find_first_of("eE"));
+      if (mantissa.find_first_of("123456789") != std::string::npos)
+        fail_at(n, field,
+                fmt::format("'{}' is too small to represent (below 2.2e-308 in magnitude); write 0 if zero is meant",
+                            text.substr(0, 40)));
+    }
     return v;
   }
   Vec2 to_vec2(const YAML::Node& n, const std::string& field) const {
@@ -465,9 +476,11 @@ void read_mechanism(const Fields& top, Scene& s) {
   if (top.has("ground_points")) {
     const YAML::Node gp = top.raw("ground_points");
     if (!gp.IsMap()) top.fail("ground_points", "expected a mapping name: [x, y]");
-    for (const auto& kv : gp)
+    for (const auto& kv : gp) {
+      if (!kv.first.IsScalar()) top.fail("ground_points", "a point's name must be plain text");
       s.ground_points[kv.first.as<std::string>()] =
           top.to_vec2(kv.second, "ground_points." + kv.first.as<std::string>());
+    }
   }
   for_each_item(top, "bodies", [&](const YAML::Node& n, const std::string& path) {
     Fields f(n, path, top.ctx(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"});
@@ -481,9 +494,11 @@ void read_mechanism(const Fields& top, Scene& s) {
     if (f.has("points")) {
       const YAML::Node pts = f.raw("points");
       if (!pts.IsMap()) f.fail("points", "expected a mapping name: [x, y]");
-      for (const auto& kv : pts)
+      for (const auto& kv : pts) {
+        if (!kv.first.IsScalar()) f.fail("points", "a point's name must be plain text");
         b.points[kv.first.as<std::string>()] =
             f.to_vec2(kv.second, f.join("points." + kv.first.as<std::string>()));
+      }
     }
     s.bodies.push_back(b);
   });
@@ -574,6 +589,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
   for_each_item(top, "loads", [&](const YAML::Node& n, const std::string& path) {
     if (!n.IsMap() || !n["type"])
       throw SceneError(top.file(), line_of(n), path + ".type", "missing required field");
+    if (!n["type"].IsScalar()) top.ctx().fail(n["type"], path + ".type", "expected a load type");
     const std::string type = n["type"].as<std::string>();
     if (n["name"] && (!n["name"].IsScalar() || !is_valid_name(n["name"].Scalar())))
       top.ctx().fail(
@@ -728,7 +744,11 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     if (f.has("bodies")) {
       const YAML::Node b = f.raw("bodies");
       if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
-      for (const auto& item : b) s.outputs.bodies.push_back(item.as<std::string>());
+      for (size_t i = 0; i < b.size(); ++i) {
+        // A body name, not a mapping or a list (yaml-cpp would only say "bad conversion").
+        if (!b[i].IsScalar()) f.fail_at(b[i], fmt::format("outputs.bodies[{}]", i), "expected a body name");
+        s.outputs.bodies.push_back(b[i].as<std::string>());
+      }
     }
   }
   if (top.has("simulation")) {
@@ -757,12 +777,14 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       s.validation.thresholds.push_back(th);
     });
     if (f.has("calibrate")) {
-      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W"});
+      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
       s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
-      s.validation.calibrate_power_W = c.num("power_W");
+      // power_W absent: mean-speed mode (the resistances stay as given).
+      s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
+      s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
       // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
       if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
-      if (!(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
+      if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
     }
     // Published values the report sets beside the calibration's (e.g. the original authors'
     // hip torque): plain text, HTML-escaped by the report.

@@ -178,33 +178,6 @@ double calc_energy(const ReducedModel& m, double q, double qdot) {
   return 0.5 * m.table.eval(m.c_m1, q) * qdot * qdot + m.table.eval(m.c_V, q);
 }
 
-void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, double q, double qdot, double qddot,
-                            double* forces) {
-  const auto& T = m.table;
-  for (size_t k = 0; k < m.c_me1.size(); ++k) {
-    // Q_x,k of the applied loads along x_k, by virtual power with q̇ = 0, ẋ_k = 1; the
-    // velocity-dependent loads see the actual joint rates r_j·q̇.
-    double Qx = T.eval(m.c_Qx[k], q);
-    for (size_t i = 0; i < m.torques.size(); ++i) {
-      const auto& t = m.torques[i];
-      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += ws.torque_value[i] * T.eval(t.c_rx[k], q);
-    }
-    for (const auto& mo : m.motors)
-      Qx += mo.stall * (1.0 - T.eval(mo.c_r, q) * qdot / mo.no_load_speed) * T.eval(mo.c_rx[k], q);
-    for (const auto& b : m.brakes)
-      Qx += models::resistance_torque(b.law, b.coefficient, T.eval(b.c_w, q) * qdot) * T.eval(b.c_wx[k], q);
-    // me1 q̈ + me2 q̇² = F_E + Q_x
-    forces[k] = T.eval(m.c_me1[k], q) * qddot + T.eval(m.c_me2[k], q) * qdot * qdot - Qx;
-  }
-}
-
-double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot,
-                    double* forces) {
-  double* v = ws.scratch_out.data();
-  m.table.eval_cols(q, m.out_cols.data(), static_cast<int>(m.out_cols.size()), v);
-  return outputs_from(m, ws, v, qdot, qddot, forces);
-}
-
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces) {
   double* v = ws.scratch_rec.data();

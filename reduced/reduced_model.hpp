@@ -100,15 +100,12 @@ double calc_switching(const ReducedModel& m, int gate, double q, double qdot);
 // would produce, as the full model does).
 void init_gates(const ReducedModel& m, ReducedWorkspace& ws);
 
-// Kinetic + potential energy and the constraint forces F_E,k at (q, q̇, q̈) [J], [N].
+// Kinetic + potential energy ½ m1 q̇² + V at (q, q̇) [J].
 double calc_energy(const ReducedModel& m, double q, double qdot);
-void calc_constraint_forces(const ReducedModel& m, const ReducedWorkspace& ws, double q, double qdot,
-                            double qddot, double* forces);
-// Both at once with one fused table lookup (allocation-free).
-double calc_outputs(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot,
-                    double* forces);
-// Everything an output sample needs — q̈, non-conservative power, energy and constraint
-// forces — from one table lookup. Returns the energy.
+// Everything an output sample needs — q̈, non-conservative power, energy and the constraint
+// forces F_E,k = me1_k q̈ + me2_k q̇² − Q_x,k [N] — from one fused table lookup
+// (allocation-free). Returns the energy. The one implementation of the constraint-force
+// algebra: simulate_reduced's rows and the runtime's outputs both come from it.
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces);
 

@@ -209,6 +209,11 @@ long AdaptiveIntegrator::rejected() const { return static_cast<long>(impl_->evol
 long AdaptiveIntegrator::events() const { return impl_->events; }
 double AdaptiveIntegrator::smallest_step() const { return std::isfinite(impl_->smallest) ? impl_->smallest : 0.0; }
 const AdaptiveIntegrator::Point& AdaptiveIntegrator::step_start() const { return impl_->start; }
+void AdaptiveIntegrator::calc_within_step(double t, double y[3]) {
+  const Point& a = impl_->start;
+  const double y0[3] = {a.q, a.qdot, a.work};
+  impl_->probe_step(a.t, y0, t - a.t, y);
+}
 const AdaptiveIntegrator::Point& AdaptiveIntegrator::step_end() const { return impl_->end; }
 
 void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
@@ -423,8 +428,10 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
     long i = 1;
     AdaptiveIntegrator::Point a = point(ws);
     std::vector<char> before(ws.gate_on.size());
+    ReducedWorkspace at_start(m), sub(m);  // step_outputs: the step's start, and a row's sub-step
     while (i <= n) {
       std::copy(ws.gate_on.begin(), ws.gate_on.end(), before.begin());
+      if (opt.step_outputs) at_start = ws;
       // Budgets (the step count was checked against the duration; this also catches a time
       // that stops advancing in floating point). The clock is read every 64 steps.
       if (ts.stats.steps_taken >= opt.max_steps)
@@ -458,6 +465,16 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       for (; i <= n && t_out(i) <= b.t + 1e-12; ++i) {
         const double s = (t_out(i) - a.t) / (b.t - a.t);
         double q, v, w;
+        if (opt.step_outputs && t_out(i) < b.t) {
+          // One RK4 step of the row's length from the step's start (switches located as in
+          // the step itself), with the gates that hold at the row's time.
+          sub = at_start;
+          step_fixed_rk4(m, sub, t_out(i) - a.t);
+          ws.gate_on.swap(sub.gate_on);
+          record(m, ws, t_out(i), sub.q, sub.qdot, sub.work, ts, f);
+          ws.gate_on.swap(sub.gate_on);
+          continue;
+        }
         if (!std::isnan(t_switch)) q = a.q + s * (b.q - a.q), v = a.qdot + s * (b.qdot - a.qdot), w = a.work + s * (b.work - a.work);
         else hermite(a, b, s, q, v, w);
         if (t_out(i) < t_switch) ws.gate_on.swap(before);
@@ -493,8 +510,15 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
             b.t, E - E0 - b.work, E, E0));
       for (; i <= n && t_out(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
         double q, v, w;
-        if (b.t - a.t <= 0) q = b.q, v = b.qdot, w = b.work;
-        else hermite(a, b, std::min(1.0, (t_out(i) - a.t) / (b.t - a.t)), q, v, w);
+        if (b.t - a.t <= 0 || t_out(i) >= b.t) {
+          q = b.q, v = b.qdot, w = b.work;
+        } else if (opt.step_outputs) {
+          double y[3];
+          integ.calc_within_step(t_out(i), y);
+          q = y[0], v = y[1], w = y[2];
+        } else {
+          hermite(a, b, (t_out(i) - a.t) / (b.t - a.t), q, v, w);
+        }
         record(m, ws, t_out(i), q, v, w, ts, f);
       }
     }

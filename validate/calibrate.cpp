@@ -20,19 +20,105 @@ namespace rdyn::validate {
 namespace {
 
 // Acceptance of a calibration (relative cadence error). Reduced: the steady cycle is solved
-// to 1e-12 and the torque to 1e-10 N·m, so 1e-6 is met with a wide margin by any genuine
-// root. Full: the reduced table's own error (≈ 1e-5 of the speed at 10°, docs/theory.md) and
+// to 1e-12 and the load value to 1e-10 relative, so 1e-6 is met with a wide margin by any
+// genuine root. Full: the reduced table's own error (≈ 1e-5 of the speed at 10°, docs/theory.md) and
 // the 5 s window's quasi-steady drift keep the full model within 1e-4; 1 % is the user-level
 // target (issue #13: "holds 1 Hz within 1 %").
 constexpr double kReducedCadenceTolerance = 1e-6;
 constexpr double kFullCadenceTolerance = 1e-2;
 
-// The scene with its one resistance dissipating P at cadence F and every drive torque set
-// to ±T (signs kept).
-models::Scene with_loads(models::Scene s, double T, double coefficient) {
-  for (auto& t : s.joint_torques) t.value = (t.value < 0 ? -1.0 : 1.0) * T;
-  s.resistances[0].coefficient = coefficient;
+// The load being calibrated: one joint torque, one motor's stall torque, or every joint
+// torque together. Each entry is applied as sign·T with T ≥ 0 the calibrated magnitude.
+struct Entry {
+  bool motor = false;
+  size_t index = 0;    // into scene.joint_torques or scene.motors (same order in the reduced model)
+  double sign = 1.0;   // the scene value's sign (a motor's: its no-load speed's)
+};
+struct Selection {
+  std::vector<Entry> entries;
+  std::string name, kind, unit;
+};
+
+const char* unit_of(const models::Scene& s, const std::string& joint) {
+  const auto* j = s.find_joint(joint);
+  return j && j->type == models::JointType::Prismatic ? "N" : "N·m";
+}
+
+// Which load `opt.load` names (empty: every joint torque). Throws SceneError naming
+// opt.load_field for an unknown load or one that is not a drive load.
+Selection select_load(const models::Scene& scene, const CalibrationOptions& opt) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, 0, field, msg);
+  };
+  auto candidates = [&] {
+    std::string c;
+    for (const auto& t : scene.joint_torques) c += (c.empty() ? "" : ", ") + t.name;
+    for (const auto& m : scene.motors) c += (c.empty() ? "" : ", ") + m.name;
+    return c.empty() ? std::string("the scene has none") : "the scene has " + c;
+  };
+  Selection sel;
+  if (opt.load.empty()) {
+    if (scene.joint_torques.empty())
+      fail("validation.calibrate.load",
+           "name the load to calibrate (validation.calibrate.load or --load): without a name every joint "
+           "torque is scaled together, and the scene has no joint torque (" + candidates() + ")");
+    std::string units;
+    for (size_t i = 0; i < scene.joint_torques.size(); ++i) {
+      const auto& t = scene.joint_torques[i];
+      sel.entries.push_back({false, i, t.value < 0 ? -1.0 : 1.0});
+      sel.name += (sel.name.empty() ? "" : "+") + t.name;
+      const std::string u = unit_of(scene, t.joint);
+      if (units.empty()) units = u;
+      else if (units != u) units = "N·m|N";
+    }
+    sel.kind = "joint_torques";
+    sel.unit = units;
+    return sel;
+  }
+  if (!models::is_valid_name(opt.load)) fail(opt.load_field, models::invalid_name_message(opt.load));
+  sel.name = opt.load;
+  for (size_t i = 0; i < scene.joint_torques.size(); ++i)
+    if (scene.joint_torques[i].name == opt.load) {
+      const auto& t = scene.joint_torques[i];
+      sel.entries.push_back({false, i, t.value < 0 ? -1.0 : 1.0});
+      sel.unit = unit_of(scene, t.joint);
+      sel.kind = sel.unit == "N" ? "joint_force" : "joint_torque";
+      return sel;
+    }
+  for (size_t i = 0; i < scene.motors.size(); ++i)
+    if (scene.motors[i].name == opt.load) {
+      const auto& m = scene.motors[i];
+      // The stall torque keeps the no-load speed's sign (check_scene: same signs).
+      sel.entries.push_back({true, i, m.no_load_speed < 0 ? -1.0 : 1.0});
+      sel.unit = unit_of(scene, m.joint);
+      sel.kind = sel.unit == "N" ? "motor_stall_force" : "motor_stall_torque";
+      return sel;
+    }
+  for (const auto& r : scene.resistances)
+    if (r.name == opt.load)
+      fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque or a "
+                           "motor (" + candidates() + "); the resistance follows from --power-w");
+  for (const auto& sp : scene.springs)
+    if (sp.name == opt.load)
+      fail(opt.load_field, "'" + opt.load + "' is a spring, which does no net work per revolution: calibrate adjusts "
+                           "a joint_torque or a motor (" + candidates() + ")");
+  fail(opt.load_field, "no joint_torque or motor named '" + opt.load + "' (" + candidates() + ")");
+  return sel;
+}
+
+// The selected load set to magnitude T (signs kept) in a scene, and with a power the one
+// resistance's coefficient (NaN: unchanged).
+models::Scene with_load(models::Scene s, const Selection& sel, double T, double coefficient) {
+  for (const auto& e : sel.entries)
+    (e.motor ? s.motors[e.index].stall_torque : s.joint_torques[e.index].value) = e.sign * T;
+  if (std::isfinite(coefficient)) s.resistances[0].coefficient = coefficient;
   return s;
+}
+
+// The same in the reduced model (its torques and motors are the scene's, in order).
+void set_load(reduced::ReducedModel& m, const Selection& sel, double T) {
+  for (const auto& e : sel.entries)
+    (e.motor ? m.motors[e.index].stall : m.torques[e.index].value) = e.sign * T;
 }
 
 struct Cycle {
@@ -64,29 +150,55 @@ Cycle steady_cycle(const reduced::ReducedModel& m, double q_s, double v_guess, d
 
 struct RootContext {
   reduced::ReducedModel* m;
+  const Selection* sel;
   double q_s, v_guess, target_hz, tol;
   int* evals;
 };
 
 double cadence_error(double T, void* p) {
   auto* c = static_cast<RootContext*>(p);
-  for (auto& t : c->m->torques) t.value = (t.value < 0 ? -1.0 : 1.0) * T;
+  set_load(*c->m, *c->sel, T);
   const Cycle cy = steady_cycle(*c->m, c->q_s, c->v_guess, c->tol, *c->evals);
   return (cy.ok ? 1.0 / cy.period : 0.0) - c->target_hz;
 }
 
 }  // namespace
 
+CalibrationOptions calibration_options_of(const models::Scene& scene, double cadence_hz, double power_w,
+                                          const std::string& load) {
+  CalibrationOptions o;
+  const auto& v = scene.validation;
+  o.cadence_hz = cadence_hz > 0 ? cadence_hz : v.calibrate_cadence_Hz;
+  o.power_w = power_w > 0 ? power_w : v.calibrate_power_W;
+  o.load = !load.empty() ? load : v.calibrate_load;
+  o.load_field = !load.empty() ? "--load" : "validation.calibrate.load";
+  return o;
+}
+
+std::string load_value_column(const models::Scene& scene, const CalibrationOptions& opt) {
+  const Selection sel = select_load(scene, opt);
+  const bool joint = sel.kind.rfind("joint", 0) == 0;
+  if (sel.unit == "N·m") return joint ? "drive_torque_Nm" : sel.kind + "_Nm";
+  if (sel.unit == "N") return sel.kind == "joint_torques" ? "drive_force_N" : sel.kind + "_N";
+  return "drive_load";
+}
+
 void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw models::SceneError(scene.source_file, 0, field, msg);
   };
-  if (scene.joint_torques.empty()) fail("loads", "calibration needs at least one joint torque to scale");
-  if (scene.resistances.size() != 1) fail("loads", "calibration needs exactly one resistance");
-  if (!(opt.cadence_hz > 0) || !(opt.power_w > 0)) fail("--cadence-hz/--power-w", "must be positive");
-  const auto& res = scene.resistances[0];
-  if (!models::fixed_speed_ratio(scene, res.body))
-    fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
+  if (!(opt.cadence_hz > 0)) fail("--cadence-hz", "must be positive");
+  if (!(opt.power_w >= 0)) fail("--power-w", "must be positive");
+  select_load(scene, opt);
+  if (opt.power_w > 0) {
+    if (scene.resistances.size() != 1)
+      fail("loads", fmt::format("a power to dissipate needs exactly one resistance (the scene has {}); without "
+                                "--power-w the resistances stay as given and only the load changes",
+                                scene.resistances.size()));
+    const auto& res = scene.resistances[0];
+    if (!models::fixed_speed_ratio(scene, res.body))
+      fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
+  }
   const engine::FullModel model(scene);
   const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
 }
@@ -97,82 +209,138 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     throw models::SceneError(scene.source_file, 0, field, msg);
   };
   check_calibratable(scene, opt);
-  const auto& res = scene.resistances[0];
-  const auto ratio = models::fixed_speed_ratio(scene, res.body);
+  const Selection sel = select_load(scene, opt);
+  const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
   CalibrationResult r;
-  const double omega_b = std::abs(*ratio) * 2 * M_PI * opt.cadence_hz;
-  r.resistance_coefficient = opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
+  r.load = sel.name;
+  r.load_kind = sel.kind;
+  r.load_unit = sel.unit;
+  r.resistance_coefficient = NAN;  // mean-speed mode: the resistances stay as given
+  if (opt.power_w > 0) {
+    const auto& res = scene.resistances[0];
+    const double omega_b = std::abs(*models::fixed_speed_ratio(scene, res.body)) * 2 * M_PI * opt.cadence_hz;
+    r.resistance_coefficient = opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
+  }
 
   // The table does not depend on load values: extract once.
   progress.note("calibrate: extracting the reduced table");
   const auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
-  models::Scene s1 = with_loads(scene, 1.0, r.resistance_coefficient);
-  auto m = reduced::make_reduced_model(e.samples, s1, reduced::parse_interpolation(opt.interpolation));
+  auto m = reduced::make_reduced_model(e.samples, with_load(scene, sel, 1.0, r.resistance_coefficient),
+                                       reduced::parse_interpolation(opt.interpolation));
 
-  // First guess from the energy balance per revolution at constant cadence: drive work
-  // T·Σ∫ r_j [gate] dq equals the dissipation ∫ −T_b(w q̇) w dq.
+  // First guess from the energy balance per revolution at the constant target rate: the
+  // load's work T·W_unit balances the work of every other non-conservative load, W_other
+  // (springs and gravity do none over a revolution). Both are linear in the load values:
+  // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
   const int n = 3600;
   const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
-  double W_unit = 0.0, E_diss = 0.0;
+  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0);
+  for (const auto& en : sel.entries) (en.motor ? selected_motor : selected_torque)[en.index] = 1;
+  double W_unit = 0.0, W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
   for (int i = 0; i < n; ++i) {
     const double q = scene.initial.q + (i + 0.5) * dq;
-    for (const auto& t : m.torques) {
+    for (size_t k = 0; k < m.torques.size(); ++k) {
+      const auto& t = m.torques[k];
       const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-      if (on) W_unit += (t.value < 0 ? -1.0 : 1.0) * m.table.eval(t.c_r, q) * dq;
+      const double r_j = m.table.eval(t.c_r, q);
+      if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
+      if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
+      if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq;
     }
-    const auto& b = m.brakes[0];
-    const double w = m.table.eval(b.c_w, q);
-    E_diss += -models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
+    for (size_t k = 0; k < m.motors.size(); ++k) {
+      const auto& mo = m.motors[k];
+      const double r_j = m.table.eval(mo.c_r, q);
+      const double w = mo.stall * (1.0 - r_j * qd / mo.no_load_speed) * r_j * dq;
+      if (selected_motor[k]) {
+        W_unit += w;
+        W_scale += std::abs(r_j) * dq;
+        max_motor_rate = std::max(max_motor_rate, r_j * qd / mo.no_load_speed);
+      } else {
+        W_other += w;
+        W_other_scale += std::abs(w);
+      }
+    }
+    for (const auto& b : m.brakes) {
+      const double w = m.table.eval(b.c_w, q);
+      const double wb = models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
+      W_other += wb;
+      W_other_scale += std::abs(wb);
+    }
   }
-  if (!(W_unit > 0)) fail("loads", "the drive torques do no net work per revolution at this cadence");
-  r.drive_work_per_rev_per_Nm = W_unit;
-  r.initial_guess_Nm = E_diss / W_unit;
+  r.work_per_rev_per_unit = W_unit;
+  if (!(std::abs(W_unit) > 1e-9 * W_scale) && sel.kind.rfind("motor", 0) != 0)
+    fail(load_field, fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
+                                 "mean speed: calibrate a load that drives the mechanism",
+                                 sel.name, W_unit, sel.unit));
+  if (!(W_unit > 0)) {
+    if (sel.kind.rfind("motor", 0) == 0)
+      fail(load_field,
+           fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load speed "
+                       "{:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall torque of "
+                       "the no-load speed's sign holds the target (lower the target or raise the no-load speed)",
+                       sel.name, opt.cadence_hz, max_motor_rate, scene.motors[sel.entries[0].index].no_load_speed,
+                       W_unit, sel.unit));
+    fail(load_field, fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
+                                 "per {}): give it the opposite sign",
+                                 sel.name, W_unit, sel.unit));
+  }
+  // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
+  // returns its work over a revolution).
+  if (!(W_other < -1e-9 * W_other_scale) || W_other == 0.0)
+    fail(load_field, fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
+                                 "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
+                                 "validation.calibrate.power_W) or a resistance",
+                                 opt.cadence_hz, W_other, sel.name));
+  r.initial_guess = -W_other / W_unit;
 
-  // Brent (GSL) on the torque: mean steady cadence = F.
+  // Brent (GSL) on the load's magnitude: mean steady cadence = F.
   int evals = 0;
-  RootContext ctx{&m, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
+  RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
   gsl_function fn{cadence_error, &ctx};
-  double lo = 0.8 * r.initial_guess_Nm, hi = 1.25 * r.initial_guess_Nm;
+  double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
   double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
   for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
-  for (int i = 0; i < 20 && fhi < 0; ++i) hi *= 1.4, fhi = cadence_error(hi, &ctx);
+  for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
+    hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
   if (!(flo <= 0 && fhi >= 0))
-    throw reduced::TableError(fmt::format("no drive torque between {:.4g} and {:.4g} N·m holds {} Hz", lo, hi,
-                                          opt.cadence_hz));
+    throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
+                                             sel.name, lo, hi, sel.unit, opt.cadence_hz));
   gsl_set_error_handler_off();
   std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
       gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
   gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
-  double T = r.initial_guess_Nm;
+  double T = r.initial_guess;
   for (int it = 0; it < 100; ++it) {
     gsl_root_fsolver_iterate(solver.get());
     T = gsl_root_fsolver_root(solver.get());
-    progress.count("calibrate: torque search", it + 1, it + 1);
+    progress.count("calibrate: load search", it + 1, it + 1);
     if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
-                               1e-10) == GSL_SUCCESS)
+                               1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
       break;
   }
   progress.note("");
-  r.torque_Nm = T;
-  for (auto& t : m.torques) t.value = (t.value < 0 ? -1.0 : 1.0) * T;
+  const double sign = sel.entries[0].sign;
+  r.load_value = sel.kind == "joint_torques" ? T : sign * T;
+  r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;
+  set_load(m, sel, T);
   const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
   if (!cy.ok)
-    throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the torque found "
-                                             "({:.6g} N·m)", T));
+    throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
+                                             "({:.6g} {})", r.load_value, sel.unit));
   r.evaluations = evals;
   r.steady_q = scene.initial.q;
   r.steady_qdot = cy.speed;
   r.mean_cadence_hz_reduced = 1.0 / cy.period;
-  r.mean_power_w = T * W_unit / cy.period;
-  // The result must meet its own target (issue #9): the root finder converges to 1e-10 N·m,
-  // so the reduced cadence is off by far less than kReducedCadenceTolerance unless the
-  // bracket held a discontinuity (a stall) instead of a root.
+  // The result must meet its own target (issue #9): the root finder converges to 1e-10
+  // relative, so the reduced cadence is off by far less than kReducedCadenceTolerance unless
+  // the bracket held a discontinuity (a stall) instead of a root.
   const double miss_reduced = std::abs(r.mean_cadence_hz_reduced - opt.cadence_hz) / opt.cadence_hz;
   if (!(miss_reduced <= kReducedCadenceTolerance))
     throw models::NumericalError(fmt::format(
-        "calibration missed its target: the reduced model's steady cadence is {:.6g} Hz at {:.6g} N·m, target {:g} Hz "
-        "(off by {:.3g} %, allowed {:g} %)",
-        r.mean_cadence_hz_reduced, T, opt.cadence_hz, 100 * miss_reduced, 100 * kReducedCadenceTolerance));
+        "calibration missed its target: the reduced model's steady cadence is {:.6g} Hz at {} = {:.6g} {}, target "
+        "{:g} Hz (off by {:.3g} %, allowed {:g} %)",
+        r.mean_cadence_hz_reduced, sel.name, r.load_value, sel.unit, opt.cadence_hz, 100 * miss_reduced,
+        100 * kReducedCadenceTolerance));
 
   // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
   auto fluct = [](const std::vector<double>& v, size_t from) {
@@ -185,6 +353,27 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     r.force_name = scene.outputs.constraint_forces[0].name;
     r.peak_force_N = cy.detail.peak_force_N[0];
   }
+  if (sel.entries[0].motor) {
+    // A motor's power depends on the speed: trapezoid rule over the periodic cycle samples
+    // (spectrally accurate for a smooth periodic integrand).
+    const auto& mo = m.motors[sel.entries[0].index];
+    reduced::ReducedOptions ro;
+    ro.duration_s = cy.period;
+    ro.output_interval_s = cy.period / 1440;
+    ro.tolerance = opt.tolerance;
+    const auto cyc = reduced::simulate_reduced(m, r.steady_q, r.steady_qdot, ro);
+    double E = 0.0;
+    for (size_t i = 0; i + 1 < cyc.t.size(); ++i) {
+      auto p = [&](size_t k) {
+        const double u = m.table.eval(mo.c_r, cyc.q[k]) * cyc.qdot[k];
+        return mo.stall * (1.0 - u / mo.no_load_speed) * u;
+      };
+      E += 0.5 * (p(i) + p(i + 1)) * (cyc.t[i + 1] - cyc.t[i]);
+    }
+    r.mean_power_w = E / cy.period;
+  } else {
+    r.mean_power_w = T * W_unit / cy.period;  // a position-dependent load: its work per revolution is exact
+  }
 
   // Confirmation with the full model from the same point of the steady cycle.
   r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
@@ -193,7 +382,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     return r;
   }
   progress.note("calibrate: confirming with the full model");
-  models::Scene sf = with_loads(scene, T, r.resistance_coefficient);
+  models::Scene sf = with_load(scene, sel, T, r.resistance_coefficient);
   sf.initial.q = r.steady_q;
   sf.initial.qdot = r.steady_qdot;
   engine::FullModel full(sf);
@@ -214,33 +403,64 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   const double miss_full = std::abs(r.mean_cadence_hz_full - opt.cadence_hz) / opt.cadence_hz;
   if (!(miss_full <= kFullCadenceTolerance))
     throw models::NumericalError(fmt::format(
-        "calibration not confirmed: the full model at {:.6g} N·m holds a mean cadence of {:.6g} Hz, target {:g} Hz "
-        "(off by {:.3g} %, allowed {:g} %)",
-        T, r.mean_cadence_hz_full, opt.cadence_hz, 100 * miss_full, 100 * kFullCadenceTolerance));
+        "calibration not confirmed: the full model at {} = {:.6g} {} holds a mean cadence of {:.6g} Hz, target {:g} "
+        "Hz (off by {:.3g} %, allowed {:g} %)",
+        sel.name, r.load_value, sel.unit, r.mean_cadence_hz_full, opt.cadence_hz, 100 * miss_full,
+        100 * kFullCadenceTolerance));
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
+}
+
+namespace {
+
+// The YAML key holding the value of load entry `e` (empty: not a key of the text, i.e. made
+// by the bicycle_leg generator).
+std::string value_key(const std::string& text, const models::Scene& scene, const Entry& e) {
+  const std::string base = "loads." + (e.motor ? scene.motors[e.index].name : scene.joint_torques[e.index].name) + ".";
+  for (const char* k : e.motor ? std::vector<const char*>{"stall_torque_Nm", "stall_force_N"}
+                               : std::vector<const char*>{"torque_Nm", "force_N"})
+    if (models::scene_yaml_has(text, base + k)) return base + k;
+  return "";
+}
+
+}  // namespace
+
+void check_writable(const std::string& text, const models::Scene& scene, const CalibrationOptions& opt) {
+  const Selection sel = select_load(scene, opt);
+  if (opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg")) return;  // hip_torque_Nm
+  for (const auto& e : sel.entries)
+    if (value_key(text, scene, e).empty())
+      throw models::SceneError(scene.source_file, 0, "--write-scene",
+                               "'" + sel.name + "' is made by the scene's generator, not written in its loads: "
+                               "only the generator's own drive value (every joint torque, no --load) can be written");
 }
 
 std::string calibrated_scene_yaml(const std::string& source, const std::string& text,
                                   const std::vector<models::Override>& base, const models::Scene& scene,
                                   const CalibrationOptions& opt, const CalibrationResult& r) {
+  check_writable(text, scene, opt);
+  const Selection sel = select_load(scene, opt);
+  const double T = std::abs(r.load_value);
   std::vector<models::Override> o = base;
   auto num = [](double v) { return fmt::format("{:.12g}", v); };
-  if (models::scene_yaml_has(text, "bicycle_leg")) {
-    o.push_back({"bicycle_leg.hip_torque_Nm", num(r.torque_Nm)});
-    o.push_back({"bicycle_leg.resistance.power_W", num(opt.power_w)});
-    o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
+  const bool generated = opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg");
+  if (generated) {
+    o.push_back({"bicycle_leg.hip_torque_Nm", num(T)});
   } else {
-    for (const auto& t : scene.joint_torques) {
-      const std::string key = models::scene_yaml_has(text, "loads." + t.name + ".force_N") ? "force_N" : "torque_Nm";
-      o.push_back({"loads." + t.name + "." + key, num((t.value < 0 ? -1 : 1) * r.torque_Nm)});
-    }
-    const auto& res = scene.resistances[0];
-    if (models::scene_yaml_has(text, "loads." + res.name + ".dissipates")) {
-      o.push_back({"loads." + res.name + ".dissipates.power_W", num(opt.power_w)});
-      o.push_back({"loads." + res.name + ".dissipates.cadence_Hz", num(opt.cadence_hz)});
+    for (const auto& e : sel.entries) o.push_back({value_key(text, scene, e), num(e.sign * T)});
+  }
+  if (opt.power_w > 0) {
+    if (models::scene_yaml_has(text, "bicycle_leg")) {
+      o.push_back({"bicycle_leg.resistance.power_W", num(opt.power_w)});
+      o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
     } else {
-      o.push_back({"loads." + res.name + ".coefficient", num(r.resistance_coefficient)});
+      const auto& res = scene.resistances[0];
+      if (models::scene_yaml_has(text, "loads." + res.name + ".dissipates")) {
+        o.push_back({"loads." + res.name + ".dissipates.power_W", num(opt.power_w)});
+        o.push_back({"loads." + res.name + ".dissipates.cadence_Hz", num(opt.cadence_hz)});
+      } else {
+        o.push_back({"loads." + res.name + ".coefficient", num(r.resistance_coefficient)});
+      }
     }
   }
   o.push_back({"initial.q", fmt::format("{:.17g}", r.steady_q)});
@@ -251,11 +471,15 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   // with a newline must not add keys to the scene).
   std::string from;
   for (char c : source) from += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+  const std::string point =
+      opt.power_w > 0 ? fmt::format("with the resistance dissipating {:.6g} W at {:.6g} Hz", opt.power_w, opt.cadence_hz)
+                      : std::string("with the resistances as given");
   return fmt::format(
-      "# Calibrated by `rdyn calibrate` from {}: drive torque {:.6g} N·m holds a mean cadence of {:.6g} Hz\n"
-      "# (reduced) / {:.6g} Hz (full) with the resistance dissipating {:.6g} W at {:.6g} Hz. The initial\n"
+      "# Calibrated by `rdyn calibrate` from {}: {} ({}) = {:.6g} {} holds a mean cadence of {:.6g} Hz\n"
+      "# (reduced) / {:.6g} Hz (full) {}. The initial\n"
       "# conditions are a point of the steady cycle.\n{}",
-      from, r.torque_Nm, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, opt.power_w, opt.cadence_hz, body);
+      from, r.load, r.load_kind, r.load_value, r.load_unit, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, point,
+      body);
 }
 
 }  // namespace rdyn::validate

@@ -1,6 +1,10 @@
-// Calibration: the resistance dissipates P watts at cadence F; find the constant drive
-// torque that holds the mean steady cadence at F — with the reduced model, confirmed with the
-// full model (GSL Brent instead of iterating by hand).
+// Calibration of one drive load to an operating point: find the value of a named load (a joint
+// torque, a prismatic joint's force, or a motor's stall torque with its no-load speed kept) —
+// or of every joint torque together, signs kept — that holds the mean steady rate of the
+// independent coordinate at F revolutions per second. Two operating points: with a power P the
+// scene's one resistance is first set to dissipate P at F (c = P/ωⁿ); without, the resistances
+// stay as given. Solved on the reduced model (GSL Brent on the load value), confirmed with the
+// full model.
 #pragma once
 
 #include <string>
@@ -13,8 +17,10 @@
 namespace rdyn::validate {
 
 struct CalibrationOptions {
-  double cadence_hz = 1.0;
-  double power_w = 125.0;
+  double cadence_hz = 1.0;  // target mean rate of q [rev/s]
+  double power_w = 0.0;     // 0: mean speed only (resistances as given); > 0: the resistance dissipates it at F
+  std::string load;         // a joint_torque or motor name; empty: every joint torque together
+  std::string load_field = "--load";  // where `load` came from (named in refusals)
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
   double tolerance = 1e-10;    // reduced integrator
@@ -22,38 +28,64 @@ struct CalibrationOptions {
 };
 
 struct CalibrationResult {
-  double torque_Nm = 0.0;               // drive torque magnitude (each gated/ungated joint torque)
-  double initial_guess_Nm = 0.0;        // from the energy balance per revolution
-  double resistance_coefficient = 0.0;  // c0, c1 or c2 of the scene's resistance
+  std::string load;       // the load's name; every joint torque: their names joined by '+'
+  std::string load_kind;  // joint_torque | joint_force | motor_stall_torque | motor_stall_force | joint_torques
+  std::string load_unit;  // N·m or N
+  double load_value = 0.0;  // calibrated value, signed (joint_torques: the magnitude each gets, signs kept)
+  double torque_Nm = 0.0;   // = |load_value| for joint torques on revolute joints, NaN for other kinds
+  double initial_guess = 0.0;           // from the energy balance per revolution [load unit]
+  double resistance_coefficient = 0.0;  // c0, c1 or c2 of the scene's resistance (NaN: mean-speed mode, unchanged)
   double mean_cadence_hz_reduced = 0.0;
   double mean_cadence_hz_full = 0.0;     // NaN when the full-model check was skipped
-  double mean_power_w = 0.0;            // mean power of the drive = dissipated power (steady)
+  double mean_power_w = 0.0;            // mean power of the calibrated load over the steady cycle (reduced)
   std::string force_name;               // first requested constraint force (empty if none)
   double peak_force_N = 0.0;            // max |F| over the steady cycle (reduced)
   double peak_force_full_N = 0.0;
   double speed_fluctuation = 0.0;       // (max − min)/mean of q̇ over the steady cycle (reduced)
   double speed_fluctuation_full = 0.0;
-  double drive_work_per_rev_per_Nm = 0.0;  // Σ ∫ r_j·gate dq: the gated joints' swing [rad]
+  // Work of the load per revolution per unit of its value at the constant target rate [J per
+  // N·m or N]: Σ ∫ r_j·gate dq (joint torques: exact, the gated joints' swing in rad or stroke
+  // in m), ∫ (1 − r q̇/ω0) r dq (motors).
+  double work_per_rev_per_unit = 0.0;
   double steady_q = 0.0, steady_qdot = 0.0;  // a point of the steady cycle (initial conditions)
   int evaluations = 0;                  // steady cycles computed
   double wall_time_s = 0.0;
 };
 
-// Checks that `scene` can be calibrated at all (a drive torque to scale, exactly one resistance
-// turning at a fixed ratio to q, positive cadence and power) and that it assembles; throws
-// models::SceneError / engine::EngineError (bad input) otherwise. Cheap: sweeps call it on the
-// base scene before any case runs.
+// The options for `scene`: each of cadence_hz, power_w (0: not given) and load (empty: not
+// given) from the command line, else from the scene's validation.calibrate block (cadence_Hz,
+// power_W, load; a missing power means mean-speed mode). cadence_hz stays 0 when neither
+// gives it. load_field names where the load came from.
+CalibrationOptions calibration_options_of(const models::Scene& scene, double cadence_hz, double power_w,
+                                          const std::string& load);
+
+// The CSV column of the calibrated value in a sweep: drive_torque_Nm for joint torques on
+// revolute joints (the column's name before loads were named), else <kind>_<unit>
+// (joint_force_N, motor_stall_torque_Nm, motor_stall_force_N, drive_force_N, drive_load).
+std::string load_value_column(const models::Scene& scene, const CalibrationOptions& opt);
+
+// Checks that `scene` can be calibrated at all and that it assembles; throws models::SceneError
+// (naming opt.load_field, "loads" or the option) / engine::EngineError (bad input) otherwise:
+// an unknown load or one that is not a joint torque or motor; no joint torque when no load is
+// named; with a power, not exactly one resistance turning at a fixed ratio to q. Cheap: sweeps
+// call it on the base scene before any case runs. Refusals that need the table (a load doing
+// no net work per revolution, a motor whose joint would turn beyond its no-load speed) come
+// from calibrate().
 void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt);
 
-// Throws as check_calibratable, and models::NumericalError when no torque reaches F or the
-// result misses its target.
+// Throws as check_calibratable, and models::NumericalError when no value reaches F or the
+// result misses its target (reduced 1e-6, full 1 % of F).
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress);
 
-// The scene's YAML rewritten with the calibrated torque, resistance and steady initial
-// conditions (for --write-scene). `source`, `text` and `base` are how the scene was loaded
+// The scene's YAML rewritten with the calibrated load value (and, with a power, the
+// resistance) and steady initial conditions (for --write-scene). Throws SceneError when the
+// load's value is not a key of the text (a named load made by the bicycle_leg generator);
+// check_writable tells before any work. `source`, `text` and `base` are how the scene was loaded
 // (the text read once: a scene given as /dev/stdin cannot be read twice).
 std::string calibrated_scene_yaml(const std::string& source, const std::string& text,
                                   const std::vector<models::Override>& base, const models::Scene& scene,
                                   const CalibrationOptions& opt, const CalibrationResult& r);
+
+void check_writable(const std::string& text, const models::Scene& scene, const CalibrationOptions& opt);
 
 }  // namespace rdyn::validate

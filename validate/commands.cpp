@@ -201,41 +201,52 @@ int run_extract(const ExtractArgs& a) {
 
 int run_calibrate(const CalibrateArgs& a) {
   const auto base = overrides_of(a.sets);
-  require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
-  require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
+  if (a.cadence_given) require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
+  if (a.power_given) require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
   require_grid("--grid-deg", a.grid_deg);
   const std::string text = models::read_scene_text(a.scene);  // once: the scene may be a stream
   const models::Scene scene = models::parse_scene(text, models::resolve_scene_path(a.scene), base);
-  std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
-  if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
-  CalibrationOptions opt;
-  opt.cadence_hz = a.cadence_hz;
-  opt.power_w = a.power_w;
+  CalibrationOptions opt = calibration_options_of(scene, a.cadence_given ? a.cadence_hz : 0.0,
+                                                  a.power_given ? a.power_w : 0.0, a.load);
+  if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
   opt.grid_deg = a.grid_deg;
   opt.interpolation = a.interpolation;
+  if (!a.write_scene.empty()) check_writable(text, scene, opt);
+  std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
+  if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
   Progress progress;
   const auto r = calibrate(scene, opt, progress);
+  auto number_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const bool joint_torque = std::isfinite(r.torque_Nm);
   nlohmann::json j = {
       {"scene", scene.name},
-      {"target_cadence_hz", a.cadence_hz},
-      {"target_power_w", a.power_w},
-      {"drive_torque_Nm", r.torque_Nm},
-      {"initial_guess_Nm", r.initial_guess_Nm},
-      {"resistance_coefficient", r.resistance_coefficient},
+      {"target_cadence_hz", opt.cadence_hz},
+      {"target_power_w", opt.power_w > 0 ? nlohmann::json(opt.power_w) : nlohmann::json(nullptr)},
+      {"load", r.load},
+      {"load_kind", r.load_kind},
+      {"load_value", r.load_value},
+      {"load_unit", r.load_unit},
+      {"initial_guess", r.initial_guess},
+      {"resistance_coefficient", number_or_null(r.resistance_coefficient)},
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
-      {"mean_cadence_hz_full", r.mean_cadence_hz_full},
+      {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
       {"mean_power_w", r.mean_power_w},
       {"peak_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
-      {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_full_N)},
+      {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : number_or_null(r.peak_force_full_N)},
       {"force_name", r.force_name},
       {"speed_fluctuation", r.speed_fluctuation},
-      {"speed_fluctuation_full", r.speed_fluctuation_full},
-      {"drive_work_per_rev_per_Nm", r.drive_work_per_rev_per_Nm},
+      {"speed_fluctuation_full", number_or_null(r.speed_fluctuation_full)},
+      {"work_per_rev_per_unit", r.work_per_rev_per_unit},
       {"steady_q", r.steady_q},
       {"steady_qdot", r.steady_qdot},
       {"steady_cycles_computed", r.evaluations},
       {"wall_time_s", r.wall_time_s},
   };
+  if (joint_torque) {  // the keys of joint-torque calibrations before loads were named (compatibility)
+    j["drive_torque_Nm"] = r.torque_Nm;
+    j["initial_guess_Nm"] = r.initial_guess;
+    j["drive_work_per_rev_per_Nm"] = r.work_per_rev_per_unit;
+  }
   if (out) {
     out->write(calibrated_scene_yaml(a.scene, text, base, scene, opt, r));
     out->commit();
@@ -303,6 +314,7 @@ int run_sweep_command(const SweepArgs& a) {
   o.sets = a.sets;
   o.cadence_hz = a.cadence_hz;
   o.power_w = a.power_w;
+  o.load = a.load;
   o.threads = a.threads;
   o.grid_deg = a.grid_deg;
   require_grid("--grid-deg", a.grid_deg);

@@ -51,8 +51,12 @@ int run_extract(const ExtractArgs& args);
 
 struct CalibrateArgs {
   std::string scene;
+  // Given on the command line, else the scene's validation.calibrate, else 1 Hz / no power
+  // (mean-speed mode: the resistances stay as given).
   double cadence_hz = 1.0;
-  double power_w = 125.0;
+  double power_w = 0.0;
+  bool cadence_given = false, power_given = false;
+  std::string load;  // --load: a joint_torque or motor; empty: validation.calibrate.load, else every joint torque
   std::vector<std::string> sets;
   std::string write_scene;  // optional output YAML
   bool force = false;
@@ -88,6 +92,7 @@ struct SweepArgs {
   std::string shard = "0/1";
   int threads = 0;
   double cadence_hz = 0.0, power_w = 0.0;
+  std::string load;  // --load, as for calibrate
   double grid_deg = 10.0;
   bool force = false;
 };

@@ -202,17 +202,25 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
         r.integrator = integrator;
         r.tolerance = tol;
         r.fixed_step_s = h;
-        const auto ro = reduced_options(v, integrator, tol, h);
-        models::TimeSeries ts;
+        auto ro = reduced_options(v, integrator, tol, h);
+        models::TimeSeries timed, ts;
         std::vector<double> walls;
         try {
-          walls = time_repeats([&] { ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro); },
-                               plan.reduced_repeats);
+          // Timed as a user runs it (rows by Hermite between steps); compared on rows as
+          // accurate as the steps (one extra single step per row, untimed), so the errors are
+          // the model's and the integrator's, and the interpolation's share is measured apart.
+          walls = time_repeats(
+              [&] { timed = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro); },
+              plan.reduced_repeats);
+          ro.step_outputs = true;
+          ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
         } catch (const std::runtime_error& e) {  // TableError (validity domain) or NumericalError
           record_stopped(r, e.what(), v);
           return;
         }
         finish_run(r, walls, ts, v);
+        r.compared_run_wall_s = ts.stats.wall_time_s;
+        r.output_interpolation = compare_series(ts, timed, v.window.t_start);
         v.runs.push_back(r);
         if (grid == 10 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
             tol == plan.tightest_tolerance()) {
@@ -268,8 +276,9 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
       r.interpolation = interp;
       r.integrator = "rk8pd";
       r.tolerance = v.tightest_tolerance;
-      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot,
-                                                reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0));
+      auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);
+      ro.step_outputs = true;  // compared rows as accurate as the steps, as in the ladder
+      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
       r.errors = compare_series(v.reference, ts, v.window.t_start);
       tr = judge_threshold_on(th, r);
     }
@@ -361,8 +370,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   analyse_runs(v);
   // 5. Calibration (scenes that declare an operating point).
   if (scene.validation.calibrate_cadence_Hz > 0) {
-    v.calibration_options.cadence_hz = scene.validation.calibrate_cadence_Hz;
-    v.calibration_options.power_w = scene.validation.calibrate_power_W;
+    v.calibration_options = calibration_options_of(scene, 0.0, 0.0, "");
     progress.note(scene.name + ": calibrating the drive load");
     v.calibration = calibrate(scene, v.calibration_options, progress);
   }

@@ -83,13 +83,23 @@ int main(int argc, char** argv) {
   CalibrateArgs cal;
   auto* calibrate = app.add_subcommand(
       "calibrate",
-      "Set the scene's resistance to dissipate P watts at cadence F, then find (GSL Brent) the constant drive "
-      "torque that holds the mean steady cadence at F with the reduced model, confirmed with the full model. "
-      "Prints JSON on standard output (drive_torque_Nm, mean_cadence_hz_reduced, mean_cadence_hz_full, "
-      "mean_power_w, force_name and its peak_force_N, speed_fluctuation, ...); progress goes to standard error.");
+      "Find (GSL Brent) the value of a drive load -- a joint torque or force, or a motor's stall torque with its "
+      "no-load speed kept (--load), or every joint torque together -- that holds the mean steady rate of the "
+      "independent coordinate at F rev/s with the reduced model, confirmed with the full model. With --power-w "
+      "the scene's one resistance is first set to dissipate P watts at F; without, the resistances stay as given. "
+      "Prints JSON on standard output (load, load_kind, load_value, load_unit, drive_torque_Nm for joint torques, "
+      "mean_cadence_hz_reduced, mean_cadence_hz_full, mean_power_w, force_name and its peak_force_N, "
+      "speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
-  calibrate->add_option("--cadence-hz", cal.cadence_hz, "Target cadence [Hz] (default 1)");
-  calibrate->add_option("--power-w", cal.power_w, "Power the resistance dissipates at that cadence [W] (default 125)");
+  auto* cal_cadence_opt = calibrate->add_option(
+      "--cadence-hz", cal.cadence_hz, "Target mean rate [rev/s] (default: the scene's validation.calibrate, else 1)");
+  auto* cal_power_opt = calibrate->add_option(
+      "--power-w", cal.power_w,
+      "Power the resistance dissipates at that cadence [W] (default: the scene's validation.calibrate; none: the "
+      "resistances stay as given)");
+  calibrate->add_option("--load", cal.load,
+                        "The joint_torque or motor to adjust (default: the scene's validation.calibrate.load, else "
+                        "every joint torque together)");
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
   calibrate->add_flag("--force", cal.force, kForceHelpFile);
   calibrate->add_option("--set", cal.sets, "Override a scalar of the scene: key.path=value (repeatable)");
@@ -127,8 +137,8 @@ int main(int argc, char** argv) {
   SweepArgs sw;
   auto* sweep = app.add_subcommand(
       "sweep",
-      "Population sweep: calibrate the drive torque of many cases with the reduced model, in parallel threads. "
-      "One CSV row per case: the varied parameters, the calibrated drive torque, the peak of the first constraint "
+      "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
+      "One CSV row per case: the varied parameters, the calibrated drive load, the peak of the first constraint "
       "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
       "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
   sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
@@ -140,7 +150,10 @@ int main(int argc, char** argv) {
   sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
   sweep->add_option("--threads", sw.threads, "Worker threads (default: hardware threads)");
   sweep->add_option("--cadence-hz", sw.cadence_hz, "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
-  sweep->add_option("--power-w", sw.power_w, "Calibration power [W] (default: the scene's validation.calibrate)");
+  sweep->add_option("--power-w", sw.power_w,
+                    "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as "
+                    "given)");
+  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load");
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
 
   try {
@@ -155,6 +168,8 @@ int main(int argc, char** argv) {
   }
 
   if (duration_opt->count()) sim.duration = duration;
+  cal.cadence_given = cal_cadence_opt->count() > 0;
+  cal.power_given = cal_power_opt->count() > 0;
   if (dt_out_opt->count()) sim.dt_out = dt_out;
   if (tolerance_opt->count()) sim.tolerance = tolerance;
   try {

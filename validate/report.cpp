@@ -281,6 +281,27 @@ std::string svg_or_note(const std::map<std::string, std::string>& figures,
   return it->second.substr(at);
 }
 
+// What the errors were taken over, in words: the steady revolutions, or the whole run when
+// the reference has no steady cycles (a transient, a rocking mechanism).
+std::string compared_over(const json& s) {
+  const auto& w = s.at("steady_window");
+  if (w.value("whole_run", false)) return "over the whole run";
+  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
+                     num(d(w, "t_start_s"), "{:.3g}"));
+}
+
+// The cost of the accurate rows the errors are read from: an untimed second run of the
+// recommended setting (one extra single step of its method per output row).
+std::string row_cost(const json& s) {
+  const json& rec = s.at("recommended_reduced");
+  const double timed = d(rec, "wall_s"), rows = d(rec, "compared_run_wall_s");
+  if (!(timed > 0) || !(rows > 0)) return "";
+  return fmt::format(
+      "The accurate rows come from an untimed second run of that setting (one extra single step "
+      "per output row): {} against {} for the timed run, {}× (one run, noisy).",
+      secs(rows), secs(timed), num(rows / timed, "{:.2g}"));
+}
+
 // The first screen: one row per quantity.
 std::string verdict_table(const json& s) {
   const json& rec = s.at("recommended_reduced");
@@ -292,9 +313,8 @@ std::string verdict_table(const json& s) {
     h += fmt::format(
         "<p class=warn>No reduced run reached the target of {} on the speed and on {}.</p>",
         pct(d(s, "matched_error_target")), H(str(s, "headline_quantity")));
-  h += "<table><tr><th>quantity</th><th>error at the recommended "
-       "setting</th><th>limit</th><th>judged on</th>"
-       "<th>error there</th><th></th></tr>";
+  h += "<table><tr><th>quantity</th><th>max error " + H(compared_over(s)) +
+       " at the recommended setting</th><th>limit</th><th>judged on</th><th>error there</th><th></th></tr>";
   for (const auto& v : s.at("verdicts")) {
     const bool pass = v.value("pass", false), decides = v.value("decides", false);
     // Only the scene's thresholds pass or fail; the target is shown for information.
@@ -320,16 +340,16 @@ std::string verdict_table(const json& s) {
   if (s.contains("error_budget")) {
     const auto& b = s.at("error_budget");
     h += fmt::format(
-        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak): reference {} "
-        "(its change when its "
+        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak, on output rows "
+        "computed as accurately as the integrator's steps): reference {} (its change when its "
         "tolerance is halved), table {} ({}: grid and interpolation, integrated at the tightest "
-        "tolerance), "
-        "integration {} (what the setting's integrator and its output interpolation add). "
-        "Contributions are maxima, "
-        "so they bound rather than sum.</p>",
+        "tolerance), integration {} (what the setting's integrator adds). Output interpolation {}: "
+        "what quintic-Hermite rows between steps, as the timed run writes them, differ from "
+        "those rows (not in the total). Contributions are maxima, so they bound rather than "
+        "sum. {}</p>",
         H(str(b, "quantity")), pct(d(b, "total")), pct(d(b, "reference")), pct(d(b, "table")),
         H(str(b, "table_run").empty() ? "no tight run at that grid" : str(b, "table_run")),
-        pct(d(b, "integration")));
+        pct(d(b, "integration")), pct(d(b, "output_interpolation")), row_cost(s));
   }
   return h;
 }
@@ -338,22 +358,30 @@ std::string verdict_table(const json& s) {
 std::string calibration_section(const json& s) {
   const auto& c = s.at("calibration");
   std::string h = "<h2>Calibration</h2>";
+  const bool with_power = c.contains("target_power_w") && c.at("target_power_w").is_number();
+  const std::string unit = c.value("load_unit", std::string("N·m"));
+  const std::string load = c.value("load", std::string());
+  const double value = c.contains("load_value") ? d(c, "load_value") : d(c, "drive_torque_Nm");
+  const double per_unit =
+      c.contains("work_per_rev_per_unit") ? d(c, "work_per_rev_per_unit") : d(c, "drive_work_per_rev_per_Nm");
   h += fmt::format(
-      "<p>With the resistance dissipating {} W at {} Hz, the drive load that holds a mean steady "
-      "rate of {} "
-      "Hz is <b>{} N·m</b> (reduced model: {} Hz; confirmed with the full model: {} Hz). Mean "
-      "power "
-      "{} W, speed fluctuation {}{}. At steady state the drive's work per revolution equals the "
-      "dissipated energy, {} J; the drive does {} J per revolution per N·m.</p>",
-      num(d(c, "target_power_w")), num(d(c, "target_cadence_hz")), num(d(c, "target_cadence_hz")),
-      num(d(c, "drive_torque_Nm"), "{:.4g}"), num(d(c, "mean_cadence_hz_reduced"), "{:.6f}"),
+      "<p>{}, the drive load {}({}) that holds a mean steady rate of {} Hz is <b>{} {}</b> (reduced model: {} Hz; "
+      "confirmed with the full model: {} Hz). Its mean power {} W, speed fluctuation {}{}. ",
+      with_power ? fmt::format("With the resistance dissipating {} W at {} Hz", num(d(c, "target_power_w")),
+                               num(d(c, "target_cadence_hz")))
+                 : std::string("With the resistances as the scene gives them"),
+      load.empty() ? std::string() : "<b>" + H(load) + "</b> ", H(c.value("load_kind", std::string("joint_torques"))),
+      num(d(c, "target_cadence_hz")), num(value, "{:.4g}"), H(unit), num(d(c, "mean_cadence_hz_reduced"), "{:.6f}"),
       num(d(c, "mean_cadence_hz_full"), "{:.6f}"), num(d(c, "mean_power_W"), "{:.4g}"),
       pct(d(c, "speed_fluctuation")),
       str(c, "force_name").empty() ? std::string()
                                    : fmt::format(", peak {} force {} N", H(str(c, "force_name")),
-                                                 num(d(c, "peak_force_N"), "{:.4g}")),
-      num(d(c, "target_power_w") / d(c, "target_cadence_hz"), "{:.4g}"),
-      num(d(c, "drive_work_per_rev_per_Nm"), "{:.4g}"));
+                                                 num(d(c, "peak_force_N"), "{:.4g}")));
+  if (with_power)
+    h += fmt::format("At steady state the drive's work per revolution equals the dissipated energy, {} J; ",
+                     num(d(c, "target_power_w") / d(c, "target_cadence_hz"), "{:.4g}"));
+  h += fmt::format("at the target rate the load does {} J per revolution per {}.</p>", num(per_unit, "{:.4g}"),
+                   H(unit));
   for (const auto& cv : c.value("compare", json::array())) {
     const double ours = d(cv, "rdyn_value"), theirs = d(cv, "value");
     h += fmt::format("<p><b>{}</b>: rdyn {} {}, {} {} {}", H(str(cv, "quantity")),
@@ -362,7 +390,7 @@ std::string calibration_section(const json& s) {
                      num(theirs, "{:.4g}"), H(str(cv, "unit")));
     if (std::isfinite(ours) && std::isfinite(theirs) && theirs != 0)
       h += fmt::format(" ({:+.3g} %)", 100 * (ours - theirs) / theirs);
-    if (str(cv, "quantity") == "drive_torque_Nm" && theirs > 0)
+    if (str(cv, "quantity") == "drive_torque_Nm" && theirs > 0 && with_power)
       h += "; the published value would do " +
            num(d(c, "target_power_w") / d(c, "target_cadence_hz") / theirs, "{:.4g}") +
            " J per revolution per N·m to balance the same energy";
@@ -431,7 +459,7 @@ std::string headline(const json& s) {
   const auto& w = s.at("steady_window");
   // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
   const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
-  out += !w.value("whole_run", false) ? "Errors are maxima over the steady cycles."
+  out += !w.value("whole_run", false) ? "Errors are maxima " + compared_over(s) + " (after the start-up transient)."
          : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
                                       : "The run has no steady cycles: errors are maxima over the whole run.";
   return out;
@@ -488,7 +516,9 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
        (s.contains("figures") && s.at("figures").contains("params_samples")
             ? svg_or_note(figures, "params")
             : "<p>No table in this summary.</p>");
-  h += "<h2>2. Full and reduced model over the last periods</h2>" +
+  h += std::string(s.at("steady_window").value("whole_run", false)
+                       ? "<h2>2. Full and reduced model toward the end of the run</h2>"
+                       : "<h2>2. Full and reduced model over the last periods</h2>") +
        svg_or_note(figures, "timeseries");
   h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto");
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");

@@ -28,7 +28,12 @@ struct RunRecord {
   double energy_residual_rel = 0.0;       // max|E − E0 − W| / max|E|
   double cycles = 0.0;                    // revolutions of the independent coordinate in the run
   double energy_drift_per_cycle_J = 0.0;  // |E − E0 − W| at the end / cycles
-  Comparison errors;
+  Comparison errors;  // reduced: its rows by single steps from the step starts (step_outputs)
+  // Reduced adaptive and fixed-step runs: the timed run's quintic-Hermite rows against those
+  // rows (relative to their peak): what output interpolation between steps adds; empty for
+  // full runs.
+  Comparison output_interpolation;
+  double compared_run_wall_s = 0.0;  // reduced: wall time of the (untimed) run with step_outputs [s]
   bool pareto = false;
   std::string failure;  // why the run stopped (empty when it completed)
   std::string label() const;

@@ -76,16 +76,23 @@ nlohmann::json figures_json(const ValidationResult& v) {
 // compares it to.
 nlohmann::json calibration_json(const ValidationResult& v) {
   const auto& c = *v.calibration;
+  const double power = v.calibration_options.power_w;
   nlohmann::json j = {{"target_cadence_hz", v.calibration_options.cadence_hz},
-                      {"target_power_w", v.calibration_options.power_w},
-                      {"drive_torque_Nm", num(c.torque_Nm)},
+                      {"target_power_w", power > 0 ? num(power) : nlohmann::json(nullptr)},
+                      {"load", c.load},
+                      {"load_kind", c.load_kind},
+                      {"load_value", num(c.load_value)},
+                      {"load_unit", c.load_unit},
+                      {"drive_torque_Nm", num(c.torque_Nm)},  // null unless joint torques (N·m)
+                      {"work_per_rev_per_unit", num(c.work_per_rev_per_unit)},
                       {"mean_cadence_hz_reduced", num(c.mean_cadence_hz_reduced)},
                       {"mean_cadence_hz_full", num(c.mean_cadence_hz_full)},
                       {"mean_power_W", num(c.mean_power_w)},
                       {"force_name", c.force_name},
                       {"peak_force_N", num(c.peak_force_N)},
                       {"speed_fluctuation", num(c.speed_fluctuation)},
-                      {"drive_work_per_rev_per_Nm", num(c.drive_work_per_rev_per_Nm)}};
+                      {"drive_work_per_rev_per_Nm",
+                       std::isfinite(c.torque_Nm) ? num(c.work_per_rev_per_unit) : nlohmann::json(nullptr)}};
   nlohmann::json cmp = nlohmann::json::array();
   for (const auto& cv : v.compare)
     cmp.push_back({{"quantity", cv.quantity},
@@ -123,6 +130,10 @@ nlohmann::json run_json(const RunRecord& r) {
     j["interpolation"] = r.interpolation;
     j["energy_consistent_m2"] = r.energy_consistent;
     if (r.integrator == "rk4-fixed") j["fixed_step_s"] = r.fixed_step_s;
+    nlohmann::json oi = nlohmann::json::object();
+    for (const auto& e : r.output_interpolation.signals) oi[e.name] = num(e.max_rel);
+    j["output_interpolation_max_rel"] = oi;  // Hermite rows of the timed run vs the compared rows
+    j["compared_run_wall_s"] = num(r.compared_run_wall_s);
   }
   j.update(comparison_json(r.errors));
   return j;
@@ -192,7 +203,8 @@ nlohmann::json summary_json(const ValidationResult& v) {
     j["error_budget"] = {
         {"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
         {"table", num(v.budget->table)},   {"integration", num(v.budget->integration)},
-        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run}};
+        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run},
+        {"output_interpolation", num(v.budget->output_interpolation)}};
   nlohmann::json conv = nlohmann::json::array();
   for (const auto& s : v.convergence) {
     nlohmann::json pts = nlohmann::json::array();

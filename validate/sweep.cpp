@@ -40,14 +40,13 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   for (const auto& s : opt.sets) fixed.push_back(models::parse_override(s));
   // The base scene must load (fails early, before any thread starts).
   const models::Scene base = models::load_scene(opt.scene, fixed);
-  CalibrationOptions copt;
-  copt.cadence_hz = opt.cadence_hz > 0 ? opt.cadence_hz : base.validation.calibrate_cadence_Hz;
-  copt.power_w = opt.power_w > 0 ? opt.power_w : base.validation.calibrate_power_W;
+  // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
+  CalibrationOptions copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
   copt.grid_deg = opt.grid_deg;
   copt.full_check_s = 0.0;  // reduced model only: this is what sweeps are for
-  if (!(copt.cadence_hz > 0) || !(copt.power_w > 0))
-    throw models::SceneError(base.source_file, 0, "--cadence-hz/--power-w",
-                             "give them, or a validation.calibrate block in the scene");
+  if (!(copt.cadence_hz > 0))
+    throw models::SceneError(base.source_file, 0, "--cadence-hz",
+                             "give it, or a validation.calibrate block in the scene");
   check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
   // Every axis at both ends of its range on the base scene: unknown keys and values out of
   // range fail here, before any thread starts.
@@ -78,6 +77,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   std::mutex progress_mutex;
   Progress progress(show_progress);
   const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
+  const std::string value_column = load_value_column(base, copt);
   auto work = [&] {
     Progress quiet(false);
     for (long k; (k = next.fetch_add(1)) < n;) {
@@ -97,7 +97,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
         const auto r = calibrate(scene, copt, quiet);
         // No constraint force requested: an empty field, never NaN.
         const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
-        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.torque_Nm,
+        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
                           r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
       } catch (const std::exception& e) {
         row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
@@ -119,7 +119,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   if (opt.shard == 0) {
     csv = "case";
     for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
-    csv += fmt::format(",status,drive_torque_Nm,mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n",
+    csv += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n", value_column,
                        force.empty() ? "constraint" : force);
   }
   for (const auto& r : rows) csv += r + "\n";

@@ -1,5 +1,5 @@
 // Population sweeps: many reduced-model cases in parallel threads, one CSV row per case
-// (parameters, calibrated drive torque, peak constraint force, speed fluctuation), shardable
+// (parameters, calibrated drive load, peak constraint force, speed fluctuation), shardable
 // across machines (Slurm job arrays, GNU parallel): `--shard i/N` runs the i-th of N
 // contiguous blocks of cases, and the shards' CSVs concatenate (only shard 0 writes the header).
 #pragma once
@@ -23,6 +23,7 @@ struct SweepOptions {
   std::vector<SweepAxis> axes;
   double cadence_hz = 0.0;  // 0: the scene's validation.calibrate
   double power_w = 0.0;
+  std::string load;         // empty: the scene's validation.calibrate.load, else every joint torque
   int shard = 0, shards = 1;
   int threads = 0;          // 0: hardware threads
   double grid_deg = 10.0;

@@ -57,6 +57,8 @@ ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>
   b.total = run.error_of(q);
   b.table = NAN;
   b.integration = NAN;
+  const SignalError* oi = run.output_interpolation.find(q);
+  b.output_interpolation = oi ? oi->max_rel : NAN;
   for (const auto& r : runs)
     if (r.model == "reduced" && r.failure.empty() && std::abs(r.grid_deg - run.grid_deg) < 1e-9 &&
         r.interpolation == run.interpolation && r.energy_consistent == run.energy_consistent &&

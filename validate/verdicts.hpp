@@ -41,10 +41,13 @@ std::vector<Baseline> calc_baselines(const RunRecord& recommended, const RunReco
 
 // Where the error of `quantity` at a reduced setting comes from (each relative to the peak):
 // the reference's own accuracy (its change when its tolerance is halved), the table (the same
-// grid and interpolation integrated at the tightest tolerance), and the integration (what the
-// setting's integrator adds to that: |its error − the table's|).
+// grid and interpolation integrated at the tightest tolerance), the integration (what the
+// setting's integrator adds to that: |its error − the table's|), all measured on rows as
+// accurate as the integrator's steps; and the output interpolation (what quintic-Hermite rows
+// between steps, as a timed run writes them, add: their largest difference from those rows).
 struct ErrorBudget {
   double reference = 0.0, table = 0.0, integration = 0.0, total = 0.0;
+  double output_interpolation = 0.0;  // NaN when the run has no Hermite rows measured
   std::string table_run;  // empty when the ladder has no tight run at that grid
 };
 ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs,

@@ -16,14 +16,61 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-TEST(BicycleLeg, SegmentMassesFollowDeLeva) {
+double norm2(Vec2 v) { return std::hypot(v.x, v.y); }
+
+// The generated leg against de Leva (1996), Table 4, males: the bicycle's subject is de Leva's
+// reference male (1.741 m, 73.0 kg), so segment lengths come out as the table's millimetres.
+TEST(BicycleLeg, SegmentsFollowDeLevaTable4) {
   const Scene s = load_scene("bicycle");
-  const auto f = de_leva_1996("male");
-  EXPECT_NEAR(s.find_body("thigh_r")->mass_kg, 0.1416 * 73.0, 1e-12);
-  EXPECT_NEAR(s.find_body("shank_r")->mass_kg, (0.0433 + 0.0137) * 73.0, 1e-12);
-  // Thigh length 422.2 mm of 1741 mm stature; the knee sits at its end.
-  EXPECT_NEAR(s.find_body("thigh_r")->points.at("knee").x, f.thigh.length * 1.741, 1e-12);
-  EXPECT_NEAR(s.find_body("shank_r")->points.at("ankle").x, 0.434, 1e-12);
+  const Body& thigh = *s.find_body("thigh_r");
+  const Body& shank = *s.find_body("shank_r");  // shank + foot, ankle locked
+  const double L_t = thigh.points.at("knee").x;
+  EXPECT_NEAR(L_t, 0.4222, 1e-12);                             // thigh 422.2 mm (hip → knee centre)
+  EXPECT_NEAR(norm2(shank.points.at("ankle")), 0.4340, 1e-12);  // shank 434.0 mm (knee → malleolus)
+  EXPECT_NEAR(thigh.com_m.x / L_t, 0.4095, 1e-12);              // thigh CoM 40.95 % from the hip
+  EXPECT_NEAR(std::sqrt(thigh.inertia_kgm2 / thigh.mass_kg) / L_t, 0.329, 1e-12);  // r_gyr 32.9 %
+  // One leg weighs thigh + shank + foot = 14.16 + 4.33 + 1.37 = 19.86 % of the body.
+  EXPECT_NEAR((thigh.mass_kg + shank.mass_kg) / 73.0, 0.1986, 1e-12);
+  EXPECT_EQ(s.find_body("thigh_l")->mass_kg, thigh.mass_kg);  // both legs alike
+  // The locked foot adds its own inertia and a parallel-axis term: the composite's inertia
+  // exceeds the two segments' centroidal ones (shank r_gyr 25.5 % of 434 mm, foot 25.7 % of
+  // 258.1 mm heel–toe).
+  const double own = 0.0433 * 73.0 * std::pow(0.255 * 0.434, 2) + 0.0137 * 73.0 * std::pow(0.257 * 0.2581, 2);
+  EXPECT_GT(shank.inertia_kgm2, own * 1.01);
+}
+
+// Scaling: segment lengths follow stature and masses follow body mass, each alone.
+TEST(BicycleLeg, SegmentsScaleWithStatureAndMass) {
+  const Scene ref = load_scene("bicycle");
+  const Scene big = load_scene("bicycle", {parse_override("bicycle_leg.subject.height_m=1.85"),
+                                           parse_override("bicycle_leg.subject.mass_kg=90")});
+  const double kh = 1.85 / 1.741, km = 90.0 / 73.0;
+  const Body &t0 = *ref.find_body("thigh_r"), &t1 = *big.find_body("thigh_r");
+  EXPECT_NEAR(t1.points.at("knee").x, kh * t0.points.at("knee").x, 1e-12);
+  EXPECT_NEAR(t1.mass_kg, km * t0.mass_kg, 1e-12);
+  EXPECT_NEAR(t1.inertia_kgm2, km * kh * kh * t0.inertia_kgm2, 1e-12);  // m (ρ L)²
+  EXPECT_NEAR(norm2(big.find_body("shank_r")->points.at("ankle")),
+              kh * norm2(ref.find_body("shank_r")->points.at("ankle")), 1e-12);
+  EXPECT_NEAR(big.find_body("shank_r")->mass_kg, km * ref.find_body("shank_r")->mass_kg, 1e-12);
+}
+
+// The leg closes at the pedal over the whole crank circle: the hip–pedal distance stays
+// between the leg's shortest and longest reach, and at the farthest pedal position (on the
+// hip–bottom-bracket line) the knee is flexed by the requested 30°.
+TEST(BicycleLeg, TheLegReachesThePedalAllRoundAndExtendsTo30Degrees) {
+  const Scene s = load_scene("bicycle");
+  const Vec2 H = s.ground_points.at("hip"), B = s.ground_points.at("bottom_bracket");
+  const double L_t = s.find_body("thigh_r")->points.at("knee").x;
+  const Vec2 p = s.find_body("shank_r")->points.at("pedal");  // in the shank frame (knee at 0)
+  const double L_kp = norm2(p), D = norm2({H.x - B.x, H.y - B.y}), Lc = 0.170;
+  EXPECT_LE(D + Lc, L_t + L_kp);                 // reaches the farthest pedal position
+  EXPECT_GE(D - Lc, std::abs(L_t - L_kp));       // folds enough for the nearest
+  // Full extension: thigh along x, shank turned by the flexion φ; the pedal at distance D + Lc.
+  auto reach = [&](double phi) {
+    return norm2({L_t + std::cos(phi) * p.x - std::sin(phi) * p.y, std::sin(phi) * p.x + std::cos(phi) * p.y});
+  };
+  const double phi = 30 * kPi / 180;
+  EXPECT_NEAR(std::min(std::abs(reach(phi) - (D + Lc)), std::abs(reach(-phi) - (D + Lc))), 0.0, 1e-9);
 }
 
 TEST(BicycleLeg, SaddleHeightGivesRequestedKneeFlexionAtExtension) {
@@ -55,13 +102,25 @@ TEST(BicycleLeg, OneLegHasOneLoopAndOneTorque) {
   EXPECT_EQ(static_cast<int>(s.joints.size()) - 2 * 1 - 1, 1);
 }
 
-TEST(BicycleLeg, RoadEquivalentFlywheel) {
-  BicycleLegParams p;
-  Scene s;
-  make_bicycle_leg(p, s);
-  // (m_rider + m_bike) r² + 2 I_wheel
-  EXPECT_NEAR(s.find_body("flywheel")->inertia_kgm2, (73.0 + 9.0) * 0.335 * 0.335 + 2 * 0.09,
-              1e-12);
+// Road-equivalent flywheel: ½ I ω² must hold the kinetic energy of rider and bike moving at
+// v = ω r plus the two wheels spinning at ω. Checked by its derivatives, from generated
+// scenes: dI/d(bike mass) = r², dI/d(wheel inertia) = 2 (two wheels), and the rider's share
+// m r² when bike and wheels are (nearly) weightless.
+TEST(BicycleLeg, RoadEquivalentFlywheelHoldsTheRoadKineticEnergy) {
+  auto inertia = [](double bike_kg, double wheel_kgm2, double radius_m) {
+    BicycleLegParams p;
+    p.bike_mass_kg = bike_kg, p.wheel_inertia_kgm2 = wheel_kgm2, p.wheel_radius_m = radius_m;
+    Scene s;
+    make_bicycle_leg(p, s);
+    return s.find_body("flywheel")->inertia_kgm2;
+  };
+  const double r = 0.335;
+  EXPECT_NEAR(inertia(19.0, 0.09, r) - inertia(9.0, 0.09, r), 10.0 * r * r, 1e-12);
+  EXPECT_NEAR(inertia(9.0, 0.29, r) - inertia(9.0, 0.09, r), 2 * 0.2, 1e-12);
+  EXPECT_NEAR(inertia(1e-9, 1e-12, r), 73.0 * r * r, 1e-6);
+  // Energy at 5 rad/s of the wheel: ½ I ω² = ½ (m + m_bike) (ω r)² + 2 · ½ I_w ω².
+  const double w = 5.0;
+  EXPECT_NEAR(0.5 * inertia(9.0, 0.09, r) * w * w, 0.5 * 82.0 * std::pow(w * r, 2) + 0.09 * w * w, 1e-9);
 }
 
 // The field make_bicycle_leg refuses after `edit`, and its message; empty when it builds.

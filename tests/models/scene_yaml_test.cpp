@@ -226,6 +226,27 @@ TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
   EXPECT_EQ(refusal(y).line(), line_in(y, "'a b'"));
 }
 
+// Issue #9 leftovers: a body list item that is not a name, a load type that is not a word,
+// and a nonzero number too small for a double all name their field (yaml-cpp alone said
+// "bad conversion", and 1e-400 was read as 0).
+TEST(SceneYaml, MalformedItemsAndUnderflowingNumbersNameTheField) {
+  const std::string fb = kFourbar;
+  std::string y = fb + "outputs: {bodies: [crank, {a: 1}]}\n";
+  EXPECT_EQ(refusal(y).field(), "outputs.bodies[1]");
+  EXPECT_EQ(refusal(y).line(), line_in(y, "outputs:"));
+  y = with(fb, "{type: resistance,", "{type: [resistance],");
+  EXPECT_EQ(refusal(y).field(), "loads[0].type");
+  y = fb + "gravity: {enabled: true, g_m_s2: [0, 1e-400]}\n";
+  EXPECT_EQ(refusal(y).field(), "gravity.g_m_s2[1]");
+  EXPECT_NE(std::string(refusal(y).what()).find("'1e-400' is too small"), std::string::npos) << refusal(y).what();
+  y = fb + "gravity: {enabled: true, g_m_s2: [0, -2.5e-320]}\n";  // a denormal: digits lost
+  EXPECT_EQ(refusal(y).field(), "gravity.g_m_s2[1]");
+  // Zero written small is still zero; ordinary small numbers are fine.
+  EXPECT_EQ(parse_scene(fb + "gravity: {enabled: true, g_m_s2: [0.0e-400, -1e-300]}\n", "t.yaml").gravity.g_m_s2.x, 0.0);
+  // Through --set too.
+  EXPECT_EQ(refusal(fb, {parse_override("initial.qdot=3e-400")}).field(), "--set initial.qdot");
+}
+
 TEST(SceneYaml, DuplicateNamesWithinAKindAreRefused) {
   const std::string fb = kFourbar;
   std::string y =
@@ -278,6 +299,9 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
        "validation.calibrate.cadence_Hz"},
       {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 1.0e6}}",
        "validation.calibrate.power_W"},
+      // A given power of 0 would silently mean mean-speed mode: leave the key out for that.
+      {"gravity: {enabled: true}", "validation: {calibrate: {cadence_Hz: 1, power_W: 0}}",
+       "validation.calibrate.power_W"},
       {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}",
        "validation.reference_tolerance"},
   };
@@ -287,6 +311,18 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
     EXPECT_EQ(e.field(), c.field) << e.what();
     EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
   }
+}
+
+// validation.calibrate: power_W is optional (mean-speed mode), load names the drive load.
+TEST(SceneYaml, CalibrateBlockNamesItsLoadAndMayOmitThePower) {
+  const Scene b = load_scene("bicycle");
+  EXPECT_EQ(b.validation.calibrate_power_W, 125.0);
+  EXPECT_EQ(b.validation.calibrate_load, "");
+  const Scene s = load_scene(
+      "slider-crank", {parse_override("validation.calibrate.cadence_Hz=3"), parse_override("validation.calibrate.load=motor")});
+  EXPECT_EQ(s.validation.calibrate_cadence_Hz, 3.0);
+  EXPECT_EQ(s.validation.calibrate_power_W, 0.0);
+  EXPECT_EQ(s.validation.calibrate_load, "motor");
 }
 
 TEST(SceneYaml, AGearCouplingAJointToItselfIsRefused) {

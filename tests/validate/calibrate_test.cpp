@@ -1,15 +1,36 @@
-// Calibration: the torque it finds holds the cadence in both models, and obeys the
-// energy balance per revolution.
+// Calibration: the load value it finds holds the cadence in both models, matches closed forms
+// (a flywheel against viscous resistance; a gated cylinder force), obeys the energy balance per
+// revolution, and refusals name the field.
 #include "validate/calibrate.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/table.hpp"
 
 namespace rdyn::validate {
 namespace {
+
+// The bicycle's whole-drive calibration (every joint torque, no load named) is unchanged by
+// named loads: 64.6859 N·m, as `rdyn calibrate bicycle --cadence-hz 1 --power-w 125` printed
+// before (64.68592225570332).
+TEST(Calibrate, BicycleKeepsItsTorqueWithoutANamedLoad) {
+  const auto scene = models::load_scene("bicycle");
+  CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+  EXPECT_EQ(opt.cadence_hz, 1.0);  // from its validation.calibrate block
+  EXPECT_EQ(opt.power_w, 125.0);
+  opt.full_check_s = 0;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_NEAR(r.torque_Nm, 64.68592225570332, 1e-6);
+  EXPECT_EQ(r.load_value, r.torque_Nm);
+  EXPECT_EQ(r.load, "hip_torque_r+hip_torque_l");
+  EXPECT_EQ(r.load_kind, "joint_torques");
+  EXPECT_EQ(r.load_unit, "N·m");
+}
 
 TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   const auto scene = models::load_scene("bicycle");
@@ -23,10 +44,10 @@ TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   EXPECT_NEAR(r.mean_cadence_hz_full, 1.0, 1e-3);
   EXPECT_NEAR(r.mean_power_w, 125.0, 0.01);
   // Steady state: hip work per revolution T·Σ Δθ_thigh = 125 J (P / f).
-  EXPECT_NEAR(r.torque_Nm * r.drive_work_per_rev_per_Nm, 125.0, 0.01);
+  EXPECT_NEAR(r.torque_Nm * r.work_per_rev_per_unit, 125.0, 0.01);
   // Two thighs, each descending through a realistic swing (40°–70°).
-  EXPECT_GT(r.drive_work_per_rev_per_Nm / 2, 40 * M_PI / 180);
-  EXPECT_LT(r.drive_work_per_rev_per_Nm / 2, 70 * M_PI / 180);
+  EXPECT_GT(r.work_per_rev_per_unit / 2, 40 * M_PI / 180);
+  EXPECT_LT(r.work_per_rev_per_unit / 2, 70 * M_PI / 180);
 }
 
 TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {
@@ -41,6 +62,171 @@ TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {
   opt.power_w = 200;
   const double t200 = calibrate(scene, opt, quiet).torque_Nm;
   EXPECT_NEAR(t200 / t100, 2.0, 2e-3);
+}
+
+// A flywheel (one body on one revolute joint, no loop) against a viscous resistance c: m1 is
+// constant and the speed does not fluctuate, so a constant torque T holds ω exactly when
+// T = c·ω, and a motor τ = s(1 − ω/ω0) when s = c·ω/(1 − ω/ω0).
+std::string flywheel_yaml(const std::string& loads) {
+  return "name: flywheel\n"
+         "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05}]\n"
+         "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
+         "independent: wheel\n"
+         "loads:\n"
+         "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n" +
+         loads +
+         "initial: {q_deg: 0, qdot: 5.0}\n"
+         "simulation: {duration_s: 2, output_interval_s: 0.01, tolerance: 1.0e-9}\n";
+}
+
+TEST(Calibrate, FlywheelTorqueEqualsDampingTimesSpeed) {
+  const auto scene = models::parse_scene(
+      flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 2.0, 0.0, "drive");
+  opt.full_check_s = 1.5;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  const double omega = 2 * M_PI * 2.0;
+  EXPECT_NEAR(r.load_value, 0.02 * omega, 1e-9 * 0.02 * omega);
+  EXPECT_EQ(r.load, "drive");
+  EXPECT_EQ(r.load_kind, "joint_torque");
+  EXPECT_EQ(r.load_unit, "N·m");
+  EXPECT_NEAR(r.mean_cadence_hz_full, 2.0, 1e-6);
+  EXPECT_NEAR(r.mean_power_w, 0.02 * omega * omega, 1e-8);  // T·ω = c·ω²
+  EXPECT_TRUE(std::isnan(r.resistance_coefficient));     // mean-speed mode: unchanged
+
+  // With a power: c = P/ω², T = P/ω.
+  opt.power_w = 40.0;
+  const auto p = calibrate(scene, opt, quiet);
+  EXPECT_NEAR(p.resistance_coefficient, 40.0 / (omega * omega), 1e-12);
+  EXPECT_NEAR(p.load_value, 40.0 / omega, 1e-8);
+  EXPECT_NEAR(p.mean_power_w, 40.0, 1e-6);
+}
+
+TEST(Calibrate, FlywheelMotorStallTorqueKeepsItsNoLoadSpeed) {
+  const auto scene = models::parse_scene(
+      flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"),
+      "flywheel.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 2.0, 0.0, "motor");
+  opt.full_check_s = 1.5;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  const double omega = 2 * M_PI * 2.0, s = 0.02 * omega / (1 - omega / 30.0);
+  EXPECT_NEAR(r.load_value, s, 1e-9 * s);
+  EXPECT_EQ(r.load_kind, "motor_stall_torque");
+  EXPECT_TRUE(std::isnan(r.torque_Nm));  // no drive_torque_Nm for a motor
+  EXPECT_NEAR(r.mean_cadence_hz_full, 2.0, 1e-6);
+  EXPECT_NEAR(r.mean_power_w, 0.02 * omega * omega, 1e-6);  // the motor's power = the dissipation
+
+  // A target at the motor's no-load speed or beyond it is bad input, naming the field.
+  opt.cadence_hz = 30.0 / (2 * M_PI) * 1.01;
+  try {
+    calibrate(scene, opt, quiet);
+    FAIL() << "a target beyond the no-load speed was accepted";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "--load");
+    EXPECT_NE(e.message().find("no-load speed"), std::string::npos) << e.what();
+  }
+}
+
+// A cylinder: a force on a prismatic joint, on only while the slider moves one way, against
+// a viscous resistance on a heavy crank. The gated force does F·stroke per revolution
+// (stroke = 2 × crank radius); the crank barely fluctuates, so the steady balance is
+// F·2r ≈ c·ω·2π.
+TEST(Calibrate, CylinderForceDoesForceTimesStrokePerRevolution) {
+  const std::string yaml =
+      "name: cylinder\n"
+      "bodies:\n"
+      "  - {name: crank, mass_kg: 1.0, inertia_kgm2: 20.0, points: {B: [0.05, 0]}}\n"
+      "  - {name: rod, mass_kg: 0.5, com_m: [0.1, 0], inertia_kgm2: 2.0e-3, points: {C: [0.2, 0]}}\n"
+      "  - {name: slider, mass_kg: 1.0, inertia_kgm2: 1.0e-3}\n"
+      "joints:\n"
+      "  - {name: crank, type: revolute, parent: ground, parent_point: [0, 0], child: crank, guess_deg: 30}\n"
+      "  - {name: rod, type: revolute, parent: crank, parent_point: B, child: rod, guess_deg: -37.18}\n"
+      "  - {name: slider, type: prismatic, parent: ground, parent_point: [0, 0], child: slider, axis: [1, 0], "
+      "guess_m: 0.2417}\n"
+      "loops: [{name: pin, body_a: rod, point_a: C, body_b: slider, point_b: [0, 0]}]\n"
+      "independent: crank\n"
+      "loads:\n"
+      "  - {type: joint_torque, name: cylinder, joint: slider, force_N: -10, active_when: {joint: slider, rate: "
+      "negative}}\n"
+      "  - {type: resistance, name: drag, body: crank, law: viscous, coefficient: 0.01}\n"
+      "initial: {q_deg: 30, qdot: 6.0}\n"
+      "simulation: {duration_s: 2, output_interval_s: 0.01, tolerance: 1.0e-9}\n";
+  const auto scene = models::parse_scene(yaml, "cylinder.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 1.0, 0.0, "cylinder");
+  opt.full_check_s = 2.0;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_EQ(r.load_kind, "joint_force");
+  EXPECT_EQ(r.load_unit, "N");
+  EXPECT_LT(r.load_value, 0);  // the sign the scene gives it
+  EXPECT_NEAR(r.work_per_rev_per_unit, 0.1, 1e-3 * 0.1);  // stroke 2 × 0.05 m
+  const double omega = 2 * M_PI;
+  EXPECT_NEAR(-r.load_value * 0.1, 0.01 * omega * 2 * M_PI, 1e-3 * 0.01 * omega * 2 * M_PI);
+  EXPECT_NEAR(r.mean_cadence_hz_full, 1.0, 1e-3);
+}
+
+// Refusals are bad input (SceneError) naming the field: an unknown load, a load that is not a
+// drive, a load that does no net work per revolution, no joint torque and no load named.
+TEST(Calibrate, RefusalsNameTheField) {
+  Progress quiet(false);
+  auto field_of = [&](const models::Scene& scene, CalibrationOptions opt) {
+    opt.full_check_s = 0;
+    try {
+      calibrate(scene, opt, quiet);
+    } catch (const models::SceneError& e) {
+      return e.field() + ": " + e.message();
+    }
+    return std::string("accepted");
+  };
+  const auto fw = models::parse_scene(
+      flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
+  std::string f = field_of(fw, calibration_options_of(fw, 1.0, 0.0, "nope"));
+  EXPECT_EQ(f.rfind("--load: no joint_torque or motor named 'nope' (the scene has drive)", 0), 0u) << f;
+  f = field_of(fw, calibration_options_of(fw, 1.0, 0.0, "drag"));
+  EXPECT_EQ(f.rfind("--load: 'drag' is a resistance", 0), 0u) << f;
+  // From the scene's own block, the field is the scene's.
+  auto named = fw;
+  named.validation.calibrate_cadence_Hz = 1.0;
+  named.validation.calibrate_load = "nope";
+  f = field_of(named, calibration_options_of(named, 0.0, 0.0, ""));
+  EXPECT_EQ(f.rfind("validation.calibrate.load: no joint_torque", 0), 0u) << f;
+  // A constant force on the slider of a slider-crank does no net work per revolution.
+  const auto sc = models::load_scene("slider-crank");
+  f = field_of(sc, calibration_options_of(sc, 1.0, 0.0, "piston_load"));
+  EXPECT_EQ(f.rfind("--load: 'piston_load' does no net work per revolution", 0), 0u) << f;
+  // Nothing dissipates in the slider-crank: its motor cannot hold a mean speed.
+  f = field_of(sc, calibration_options_of(sc, 1.0, 0.0, "motor"));
+  EXPECT_EQ(f.rfind("--load: nothing dissipates energy", 0), 0u) << f;
+  // No load named and no joint torque to scale.
+  const auto fb = models::load_scene("fourbar");
+  f = field_of(fb, calibration_options_of(fb, 1.0, 0.0, ""));
+  EXPECT_EQ(f.rfind("validation.calibrate.load: name the load", 0), 0u) << f;
+}
+
+// --write-scene writes the adjusted value of the named load (and nothing of the resistance in
+// mean-speed mode); the written scene holds the rate.
+TEST(Calibrate, WrittenSceneCarriesTheLoadValue) {
+  const std::string text =
+      flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n");
+  const auto scene = models::parse_scene(text, "flywheel.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 2.0, 0.0, "motor");
+  opt.full_check_s = 0;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  const std::string out = calibrated_scene_yaml("flywheel.yaml", text, {}, scene, opt, r);
+  const auto back = models::parse_scene(out, "back.yaml");
+  ASSERT_EQ(back.motors.size(), 1u);
+  EXPECT_NEAR(back.motors[0].stall_torque, r.load_value, 1e-9 * r.load_value);
+  EXPECT_EQ(back.motors[0].no_load_speed, 30.0);
+  EXPECT_EQ(back.resistances[0].coefficient, 0.02);
+  EXPECT_NEAR(back.initial.qdot, 2 * M_PI * 2.0, 1e-9);
+  // A named load made by a generator cannot be written.
+  const auto bike = models::load_scene("bicycle");
+  EXPECT_THROW(check_writable(models::read_scene_text("bicycle"), bike, calibration_options_of(bike, 0, 0, "hip_torque_r")),
+               models::SceneError);
+  EXPECT_NO_THROW(check_writable(models::read_scene_text("bicycle"), bike, calibration_options_of(bike, 0, 0, "")));
 }
 
 }  // namespace

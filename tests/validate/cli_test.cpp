@@ -225,3 +225,37 @@ TEST_F(Cli, EveryCommandRefusesBadInputWithoutOutput) {
 }
 
 }  // namespace
+
+// calibrate --load: JSON names the load, its kind, unit and value; refusals are exit 2 naming
+// the field (an unknown load, a motor asked to run beyond its no-load speed).
+TEST_F(Cli, CalibrateNamedLoad) {
+  const std::string scene = write("fw.yaml",
+                                  "name: flywheel\n"
+                                  "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05}]\n"
+                                  "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], "
+                                  "child: wheel}]\n"
+                                  "independent: wheel\n"
+                                  "loads:\n"
+                                  "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n"
+                                  "  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, "
+                                  "no_load_speed_rad_s: 30}\n"
+                                  "initial: {q_deg: 0, qdot: 5.0}\n");
+  CliRun r = rdyn("calibrate " + scene + " --load motor --cadence-hz 2 2>/dev/null");
+  ASSERT_EQ(r.status, 0) << r.output;
+  // s = c·ω/(1 − ω/ω0) at ω = 4π rad/s: 0.4324872...
+  EXPECT_NE(r.output.find("\"load\": \"motor\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"load_kind\": \"motor_stall_torque\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"load_unit\": \"N·m\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"load_value\": 0.43248724"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("drive_torque_Nm"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"target_power_w\": null"), std::string::npos) << r.output;
+  r = rdyn("calibrate " + scene + " --load nope");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("field '--load': no joint_torque or motor named 'nope'"), std::string::npos) << r.output;
+  r = rdyn("calibrate " + scene + " --load motor --cadence-hz 5");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("field '--load': motor 'motor' cannot hold 5 Hz"), std::string::npos) << r.output;
+  r = rdyn("calibrate " + scene);  // no joint torque to scale and no load named
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("field 'validation.calibrate.load'"), std::string::npos) << r.output;
+}

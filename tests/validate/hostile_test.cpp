@@ -9,6 +9,7 @@
 #include <map>
 #include <regex>
 #include <set>
+#include <tuple>
 
 #include "tests/validate/run_rdyn.hpp"
 
@@ -549,6 +550,21 @@ void found_later(std::vector<Case>& cs) {
                   const RdynRun again = run_rdyn({"simulate", "cal.yaml", "--duration", "0.1", "--out", "o"}, d);
                   EXPECT_EQ(again.status, 0) << again.err;  // the written scene loads: nothing was injected
                 }});
+  // Named drive loads (issue #14): a bad --load or validation.calibrate.load is bad input naming
+  // its field, and --write-scene leaves nothing behind.
+  for (const auto& [tag, load, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"unknown", "nope", "field '--load': no joint_torque or motor named 'nope'"},
+           {"resistance", "flywheel_resistance", "is a resistance"},
+           {"bad_name", "a\nb", "field '--load'"},
+           {"generated_write", "hip_torque_r", "field '--write-scene'"}})
+    cs.push_back({"calibrate_load_" + tag, {"calibrate", "bicycle", "--load", load, "--write-scene", "cal.yaml"}, 2,
+                  message, {}, nullptr, "cal.yaml"});
+  cs.push_back({"sweep_load_unknown",
+                {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=60:70:2", "--load", "nope", "--out", "w.csv"},
+                2, "field '--load'", {}, nullptr, "w.csv"});
+  cs.push_back({"calibrate_load_in_scene_unknown", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
+                "field 'validation.calibrate.load': no joint_torque or motor named 'ghost'",
+                {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ghost}}\n"}}, nullptr, "cal.yaml"});
   for (const std::string reserved : {"summary.json", "index.html"})
     cs.push_back({"suite_name_" + reserved.substr(0, reserved.find('.')), {"validate", "--suite", "s", "--out", "o"}, 2,
                   "suite's own output", {{"s/" + reserved + ".yaml", scene_text("fourbar")}}, nullptr, "o"});

@@ -75,7 +75,7 @@ TEST(Report, TheScenesComparisonComesFromTheSummary) {
   auto v = test::synthetic_validation();
   CalibrationResult c;
   c.torque_Nm = 60.0;
-  c.drive_work_per_rev_per_Nm = 125.0 / 60.0;
+  c.work_per_rev_per_unit = 125.0 / 60.0;
   v.calibration = c;
   v.calibration_options.cadence_hz = 1.0;
   v.calibration_options.power_w = 125.0;
@@ -100,6 +100,37 @@ TEST(Report, ShortRunsAreNotExtrapolatedPerSecond) {
   EXPECT_NE(h.find("whole run"), std::string::npos) << h;
   v.duration_s = 2.0;
   EXPECT_NE(headline(summary_json(v)).find("per simulated second"), std::string::npos);
+}
+
+// Headline and verdict table say what was compared: the steady revolutions, or the whole run
+// (never "steady cycles" for a run that has none).
+// The error budget separates output interpolation from the total and states what the
+// accurate rows cost (an untimed second run), from the summary alone.
+TEST(Report, ErrorBudgetNamesOutputInterpolationAndItsCost) {
+  auto s = summary_json(test::synthetic_validation());
+  s["error_budget"] = {{"quantity", "F"}, {"reference", 1e-9}, {"table", 2e-4},      {"integration", 3e-4},
+                       {"total", 5e-4},  {"table_run", "t"},    {"output_interpolation", 2.5e-5}};
+  s["recommended_reduced"]["wall_s"] = 0.002;
+  s["recommended_reduced"]["compared_run_wall_s"] = 0.005;
+  const std::string html = render_html(s, {});
+  EXPECT_NE(html.find("Output interpolation 0.0025 %"), std::string::npos) << html;
+  EXPECT_NE(html.find("2.5×"), std::string::npos) << html;
+}
+
+TEST(Report, WordingSaysWhatWasCompared) {
+  auto v = test::synthetic_validation();  // compared over the whole run
+  std::string html = render_html(summary_json(v), {});
+  const std::string first = html.substr(0, html.find("<h2>1."));
+  EXPECT_NE(first.find("max error over the whole run at the recommended setting"), std::string::npos) << first;
+  EXPECT_EQ(first.find("over the steady"), std::string::npos) << first;
+  EXPECT_NE(html.find("toward the end of the run"), std::string::npos);
+  v.window = {1.25, 7, false, "from the second revolution"};
+  html = render_html(summary_json(v), {});
+  EXPECT_NE(html.find("max error over the 7 steady revolutions from t = 1.25 s"), std::string::npos);
+  EXPECT_NE(headline(summary_json(v)).find("Errors are maxima over the 7 steady revolutions from t = 1.25 s"),
+            std::string::npos);
+  EXPECT_EQ(html.find("whole run"), std::string::npos);
+  EXPECT_NE(html.find("over the last periods"), std::string::npos);
 }
 
 // `rdyn report SUMMARY --out DIR`: the same report from the saved summary; a file that is not

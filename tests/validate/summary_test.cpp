@@ -44,7 +44,7 @@ TEST(Summary, CalibrationUnderNeutralNamesWithTheScenesComparison) {
   auto v = test::synthetic_validation();
   CalibrationResult c;
   c.torque_Nm = 60.0;
-  c.drive_work_per_rev_per_Nm = 2.0;
+  c.work_per_rev_per_unit = 2.0;
   c.mean_cadence_hz_full = NAN;  // full-model check skipped
   v.calibration = c;
   v.calibration_options.cadence_hz = 1.0;

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -116,6 +118,41 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
   const auto lines = r.csv.substr(r.csv.find('\n') + 1);
   EXPECT_EQ(lines.find("0,0.3,ok,"), 0u) << r.csv;                 // the first case calibrates
   EXPECT_NE(lines.find("1,3,error,,,,,,"), std::string::npos) << r.csv;  // the second names its loop
+}
+
+// A named load through the sweep: a flywheel's motor against viscous drag c, calibrated to a
+// mean speed (no power): each row holds s = c·ω/(1 − ω/ω0) in a column named for the load's kind.
+TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
+  namespace fs = std::filesystem;
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_motor_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(scene) << "name: flywheel\n"
+                          "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05}]\n"
+                          "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
+                          "independent: wheel\n"
+                          "loads:\n"
+                          "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n"
+                          "  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"
+                          "initial: {q_deg: 0, qdot: 5.0}\n";
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 2.0;
+  o.load = "motor";
+  o.axes = {parse_sweep_axis("loads.drag.coefficient=0.01:0.03:3")};
+  o.threads = 1;
+  const SweepResult r = run_sweep(o, false);
+  fs::remove(scene);
+  ASSERT_EQ(r.failed, 0) << r.csv;
+  std::istringstream lines(r.csv);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line.find("case,loads.drag.coefficient,status,motor_stall_torque_Nm,"), 0u) << line;
+  const double w = 2 * M_PI * 2.0;
+  for (double c : {0.01, 0.02, 0.03}) {
+    ASSERT_TRUE(std::getline(lines, line));
+    double s = 0;
+    ASSERT_EQ(std::sscanf(line.substr(line.find(",ok,") + 4).c_str(), "%lf", &s), 1) << line;
+    EXPECT_NEAR(s, c * w / (1 - w / 30.0), 1e-8) << line;
+  }
 }
 
 }  // namespace

@@ -69,6 +69,13 @@ TEST(Verdicts, ErrorBudgetSeparatesTableAndIntegration) {
   EXPECT_EQ(b.table_run, tight.label());
   // No tight run at that grid: the table share is unknown, not zero.
   EXPECT_TRUE(std::isnan(calc_error_budget(fast, {other_grid}, 1e-9, "F", 1e-10).table));
+  // Output interpolation is measured on the run itself, apart from the total; unknown when
+  // the run has no Hermite rows compared.
+  EXPECT_TRUE(std::isnan(b.output_interpolation));
+  fast.output_interpolation.signals = {{"qdot", 1.0, 7e-9, 1e-9}, {"F", 1.0, 3e-6, 1e-6}};
+  const auto c = calc_error_budget(fast, {tight, fast}, 1e-9, "F", 1e-10);
+  EXPECT_DOUBLE_EQ(c.output_interpolation, 3e-6);
+  EXPECT_DOUBLE_EQ(c.total, 5e-4);
 }
 
 }  // namespace
