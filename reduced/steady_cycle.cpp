@@ -130,8 +130,7 @@ void find_extremes(const std::vector<double>& a, const std::vector<double>& b, i
 void quantities_at(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, std::vector<double>& forces,
                    double* out) {
   double qdd, p;
-  calc_acceleration(m, ws, q, qdot, qdd, p);
-  calc_constraint_forces(m, ws, q, qdot, qdd, forces.data());
+  calc_sample(m, ws, q, qdot, qdd, p, forces.data());  // the path simulate_reduced's outputs take
   out[0] = std::abs(qdot);
   out[1] = -std::abs(qdot);
   for (size_t k = 0; k < forces.size(); ++k) out[2 + k] = std::abs(forces[k]);
