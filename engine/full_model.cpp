@@ -225,6 +225,13 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
 
 }  // namespace
 
+void calc_mobility_count(const FullModel::Impl& m, const State& s, int& mobilities, int& rows, int& rank) {
+  const Mobility mob = calc_mobility(m, s);
+  mobilities = mob.mobilities;
+  rows = mob.rows;
+  rank = mob.rank;
+}
+
 FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     : scene(s), options(o), matter(system), forces(system) {
   const size_t nj = scene.joints.size(), nb = scene.bodies.size();
