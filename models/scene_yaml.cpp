@@ -525,13 +525,25 @@ void read_mechanism(const Fields& top, Scene& s) {
     s.joints.push_back(j);
   });
   for_each_item(top, "loops", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b"});
+    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b", "branch"});
     Loop l;
     l.name = f.name("name");
     l.body_a = f.str("body_a");
     l.body_b = f.str("body_b");
     l.point_a = read_point(f, "point_a", l.body_a, s);
     l.point_b = read_point(f, "point_b", l.body_b, s);
+    if (f.has("branch")) {  // {joint, sign: positive|negative} (or +1 / -1)
+      Fields b(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"});
+      BranchSign br{b.str("joint"), +1};
+      if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
+      if (br.joint == top.str_or("independent", ""))
+        b.fail("joint", "the independent coordinate is set by `initial`, not by assembly: name another joint");
+      const std::string sign = b.str("sign");
+      if (sign == "positive" || sign == "+1" || sign == "1") br.sign = +1;
+      else if (sign == "negative" || sign == "-1") br.sign = -1;
+      else b.fail("sign", "expected positive or negative (or +1, -1)");
+      l.branch = br;
+    }
     s.loops.push_back(l);
   });
   for_each_item(top, "gears", [&](const YAML::Node& n, const std::string& path) {

@@ -20,6 +20,7 @@
 #include "validate/calibrate.hpp"
 #include "validate/escape.hpp"
 #include "validate/harness.hpp"
+#include "validate/inspect.hpp"
 #include "validate/report.hpp"
 #include "validate/summary.hpp"
 #include "validate/sweep.hpp"
@@ -112,6 +113,11 @@ int run_simulate(const SimulateArgs& a) {
 
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
                         {"duration_s", duration},  {"output_interval_s", dt_out}};
+  {  // The assembled configuration (every joint coordinate at t = 0), with its warnings.
+    const auto assembly = engine::calc_assembly(engine::FullModel(scene));
+    for (const auto& w : assembly.warnings) std::fprintf(stderr, "rdyn: warning: %s\n", w.c_str());
+    run["assembly"] = assembly_json(assembly);
+  }
   models::TimeSeries ts;
   if (a.model == "full") {
     engine::FullModelOptions mo;

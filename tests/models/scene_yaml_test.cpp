@@ -410,5 +410,28 @@ TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
   }
 }
 
+
+TEST(SceneYaml, LoopBranchNamesAJointAndASign) {
+  const auto scene = load_scene("fourbar", {{"loops.C.branch.joint", "rocker"}, {"loops.C.branch.sign", "-1"}});
+  ASSERT_TRUE(scene.loops[0].branch.has_value());
+  EXPECT_EQ(scene.loops[0].branch->joint, "rocker");
+  EXPECT_EQ(scene.loops[0].branch->sign, -1);
+  EXPECT_FALSE(load_scene("fourbar").loops[0].branch.has_value());
+  auto msg = [](std::vector<Override> o) {
+    try {
+      load_scene("fourbar", o);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto unknown = msg({{"loops.C.branch.joint", "rockr"}, {"loops.C.branch.sign", "positive"}});
+  EXPECT_NE(unknown.find("unknown joint 'rockr'"), std::string::npos) << unknown;
+  const auto sign = msg({{"loops.C.branch.joint", "rocker"}, {"loops.C.branch.sign", "up"}});
+  EXPECT_NE(sign.find("expected positive or negative"), std::string::npos) << sign;
+  const auto indep = msg({{"loops.C.branch.joint", "crank"}, {"loops.C.branch.sign", "positive"}});
+  EXPECT_NE(indep.find("independent coordinate is set by `initial`"), std::string::npos) << indep;
+}
+
 }  // namespace
 }  // namespace rdyn::models

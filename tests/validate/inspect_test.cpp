@@ -85,4 +85,29 @@ TEST(InspectCli, FarGuessesWarnOnStandardError) {
   EXPECT_EQ(j["warnings"].size(), 1u);
 }
 
+
+TEST(InspectCli, SimulateRecordsTheAssemblyInRunJson) {
+  const auto out = fs::temp_directory_path() / ("rdyn_inspect_run_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const CliRun r = rdyn("simulate fourbar --duration 0.01 --out " + out.string() +
+                        " --set joints.coupler.guess_deg=60");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: joint 'coupler' assembled at"), std::string::npos) << r.err;
+  std::ifstream in(out / "run.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["assembly"]["crank"]["q_deg"].get<double>(), 30.0, 1e-9);
+  EXPECT_NEAR(j["assembly"]["rocker"]["q_deg"].get<double>(), 90.27, 0.01);
+  EXPECT_NEAR(j["assembly"]["coupler"]["q_deg"].get<double>(), 4.85, 0.01);
+  fs::remove_all(out);
+}
+
+TEST(InspectCli, NamedBranchRefusesGuessesOfTheOtherOne) {
+  const CliRun r = rdyn(
+      "simulate fourbar --duration 0.01 --out /tmp/never-written-rdyn --set loops.C.branch.joint=rocker --set "
+      "loops.C.branch.sign=positive --set joints.rocker.guess_deg=-110 --set joints.coupler.guess_deg=-84.5");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("loop 'C' assembled on the other branch"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/tmp/never-written-rdyn"));
+}
+
 }  // namespace
