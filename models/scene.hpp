@@ -204,6 +204,14 @@ struct ConstraintForceRequest {
 struct Outputs {
   std::vector<ConstraintForceRequest> constraint_forces;
   std::vector<std::string> bodies;  // bodies whose own motion is requested
+  // Joints whose motion is output (columns q_<j>, qdot_<j>, qddot_<j>; "all" in YAML: every
+  // joint, in scene order).
+  std::vector<std::string> joints;
+  // Joints and loops whose reaction is output: R_<n>_x, R_<n>_y (the joint's force on its child,
+  // the loop's force of body_a on body_b, ground frame [N]); prismatic joints add R_<n>_normal
+  // [N] and R_<n>_M [N·m] ("all": every joint, then every loop).
+  std::vector<std::string> reactions;
+  bool shaking = false;  // shaking_x, shaking_y [N], shaking_M [N·m]: the mechanism's load on the ground
 };
 
 struct Initial {

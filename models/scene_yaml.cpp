@@ -693,7 +693,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
   }
   if (top.has("outputs")) {
-    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies"});
+    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies", "joints", "reactions", "shaking"});
     for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
       Fields c(n, path, ctx, {"name", "joint", "direction"});
       ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
@@ -718,6 +718,38 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
       for (const auto& item : b) s.outputs.bodies.push_back(item.as<std::string>());
     }
+    // `all` or a list of names; each name known (joints; for reactions, joints or loops).
+    auto names_or_all = [&](const std::string& key, bool loops_too) {
+      std::vector<std::string> out;
+      const YAML::Node n = f.raw(key);
+      const std::string what = loops_too ? "joint or loop" : "joint";
+      if (n.IsScalar() && n.Scalar() == "all") {
+        for (const auto& j : s.joints) out.push_back(j.name);
+        if (loops_too)
+          for (const auto& l : s.loops) out.push_back(l.name);
+      } else if (n.IsSequence()) {
+        for (const auto& item : n) {
+          const std::string name = item.IsScalar() ? item.Scalar() : "";
+          const bool loop = loops_too && std::any_of(s.loops.begin(), s.loops.end(),
+                                                     [&](const Loop& l) { return l.name == name; });
+          if (!s.find_joint(name) && !loop)
+            f.fail_at(item, f.join(key), "unknown " + what + " '" + name.substr(0, 64) + "'");
+          if (std::find(out.begin(), out.end(), name) != out.end())
+            f.fail_at(item, f.join(key), "'" + name + "' is listed twice");
+          out.push_back(name);
+        }
+      } else {
+        f.fail(key, "expected all or a list of " + what + " names");
+      }
+      for (const auto& name : out)  // R_<name> must say which one it is
+        if (loops_too && s.find_joint(name) &&
+            std::any_of(s.loops.begin(), s.loops.end(), [&](const Loop& l) { return l.name == name; }))
+          f.fail(key, "'" + name + "' names both a joint and a loop: rename one");
+      return out;
+    };
+    if (f.has("joints")) s.outputs.joints = names_or_all("joints", false);
+    if (f.has("reactions")) s.outputs.reactions = names_or_all("reactions", true);
+    s.outputs.shaking = f.flag_or("shaking", false);
   }
   if (top.has("simulation")) {
     Fields f(top.raw("simulation"), "simulation", ctx,

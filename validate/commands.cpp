@@ -14,6 +14,7 @@
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
@@ -131,6 +132,9 @@ int run_simulate(const SimulateArgs& a) {
                 {"simbody_bodies", model.num_simbody_bodies()},
                 {"max_loop_gap_m", ts.stats.max_constraint_error}});
   } else {
+    if (reduced::wants_joint_outputs(scene))
+      throw ArgumentError("outputs.joints, outputs.reactions and outputs.shaking are computed by the full model only "
+                          "(--model full)");
     reduced::Samples samples;
     double extraction_ms = 0.0;
     if (!a.table.empty()) {

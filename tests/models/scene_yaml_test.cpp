@@ -433,5 +433,27 @@ TEST(SceneYaml, LoopBranchNamesAJointAndASign) {
   EXPECT_NE(indep.find("independent coordinate is set by `initial`"), std::string::npos) << indep;
 }
 
+
+TEST(SceneYaml, JointOutputsAllOrNames) {
+  const auto all = load_scene("fourbar", {{"outputs.joints", "all"}, {"outputs.reactions", "all"},
+                                          {"outputs.shaking", "true"}});
+  EXPECT_EQ(all.outputs.joints, (std::vector<std::string>{"crank", "coupler", "rocker"}));
+  EXPECT_EQ(all.outputs.reactions, (std::vector<std::string>{"crank", "coupler", "rocker", "C"}));  // joints, loops
+  EXPECT_TRUE(all.outputs.shaking);
+  const std::string yaml = read_scene_text("fourbar") + "\n";
+  const auto listed = parse_scene(
+      std::string(yaml).replace(yaml.find("outputs:\n"), 9, "outputs:\n  joints: [rocker]\n  reactions: [C, crank]\n"),
+      "t.yaml");
+  EXPECT_EQ(listed.outputs.joints, (std::vector<std::string>{"rocker"}));
+  EXPECT_EQ(listed.outputs.reactions, (std::vector<std::string>{"C", "crank"}));
+  const std::string bad = std::string(yaml).replace(yaml.find("outputs:\n"), 9, "outputs:\n  reactions: [crank, D]\n");
+  const auto e = refusal(bad);
+  EXPECT_EQ(e.field(), "outputs.reactions");
+  EXPECT_NE(e.message().find("unknown joint or loop 'D'"), std::string::npos) << e.what();
+  EXPECT_GT(e.line(), 0);
+  EXPECT_NE(error_of(yaml, {{"outputs.joints", "some"}}).find("expected all or a list of joint names"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace rdyn::models
