@@ -269,10 +269,10 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   // this keeps a scene built in code from reaching Simbody with a dangling handle).
   for (const auto& c : scene.outputs.constraint_forces) {
     const int j = scene.joint_index(c.joint);
-    if (j < 0 || scene.joints[j].type != JointType::Revolute || j == independent ||
-        !(std::hypot(c.direction.x, c.direction.y) > 0))
-      throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint other than the independent "
-                                    "one and a non-zero direction",
+    // The independent joint is accepted here (its pin is prescribed, the sliders after it carry
+    // the child): the reduced model's reaction lines (reduced/joint_outputs.hpp) use it.
+    if (j < 0 || scene.joints[j].type != JointType::Revolute || !(std::hypot(c.direction.x, c.direction.y) > 0))
+      throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint and a non-zero direction",
                                     scene.source_file, c.name));
   }
   actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
