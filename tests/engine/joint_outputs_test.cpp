@@ -78,6 +78,21 @@ TEST(JointOutputs, FourBarReactionsSatisfyNewtonEulerForEveryBody) {
   EXPECT_LT(worst, 1e-6 * scale);
 }
 
+TEST(JointOutputs, FourBarShakingMomentIsTheGroundReactionsMoment) {
+  // The ground holds the mechanism at A (0, 0) and D (0.3, 0) and takes the reaction of the
+  // crank's viscous bearing (c = 1e-3 N·m·s, torque −c ω on the crank): the mechanism's moment on
+  // the ground about O is −(r_A × R_crank + r_D × R_rocker + (−c ω)).
+  const FullRun r = simulate("fourbar", {});
+  double worst = 0, scale = 0;
+  for (size_t i = 0; i < r.ts.t.size(); ++i) {
+    const double expected = -(0.3 * r.at("R_rocker_y", i) - 1e-3 * r.at("qdot_crank", i));
+    worst = std::max(worst, std::abs(r.at("shaking_M", i) - expected));
+    scale = std::max(scale, std::abs(expected));
+  }
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-6 * scale);
+}
+
 TEST(JointOutputs, ReactionsDoNotDependOnTheConstraintForceRoute) {
   const FullRun a = simulate("fourbar", {}, ConstraintForceRoute::Actuator);
   const FullRun b = simulate("fourbar", {}, ConstraintForceRoute::Reaction);
