@@ -53,6 +53,34 @@ std::pair<std::string, int> loop_balance_body(const models::Scene& s, const mode
                                l.name));
 }
 
+// A prismatic joint's reaction by Newton–Euler of its child C: C's other joints are revolute
+// children (their reaction lines are known), each loop on C is solved from its other body, and
+// no spring, resistance or torque-type load on a child joint acts on C (the moment balance
+// about the child point would need them). Throws TableError naming what is missing.
+void check_prismatic_balance(const models::Scene& s, const models::Joint& jt) {
+  const std::string& c = jt.child;
+  auto refuse = [&](const std::string& why) {
+    throw TableError(fmt::format("the reduced model cannot give the reaction of prismatic joint '{}': its child '{}' {} "
+                                 "(use --model full)",
+                                 jt.name, c, why));
+  };
+  for (const auto& j : s.joints) {
+    if (j.parent != c) continue;
+    if (j.type != models::JointType::Revolute) refuse("carries a prismatic joint '" + j.name + "'");
+    for (const auto& t : s.joint_torques)
+      if (t.joint == j.name) refuse("takes the reaction of the torque on joint '" + j.name + "'");
+    for (const auto& m : s.motors)
+      if (m.joint == j.name) refuse("takes the reaction of the motor on joint '" + j.name + "'");
+  }
+  for (const auto& sp : s.springs)
+    if (sp.body_a == c || sp.body_b == c) refuse("carries spring '" + sp.name + "'");
+  for (const auto& r : s.resistances)
+    if (r.body == c) refuse("carries resistance '" + r.name + "'");
+  for (const auto& l : s.loops)
+    if ((l.body_a == c || l.body_b == c) && loop_balance_body(s, l).first == c)
+      refuse("is the only body that can balance loop '" + l.name + "'");
+}
+
 struct Kin {  // one body at one sample: angle, rates, origin and its acceleration (ground)
   double th = 0, w = 0, al = 0, x = 0, y = 0, ax = 0, ay = 0;
 };
@@ -91,20 +119,25 @@ models::Scene with_reaction_requests(const models::Scene& scene) {
     if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
   };
   for (const auto& name : scene.outputs.reactions) {
-    if (const auto* j = scene.find_joint(name)) {
-      if (j->type != models::JointType::Revolute)
-        throw TableError(fmt::format("the reduced model does not give the reaction of prismatic joint '{}' yet "
-                                     "(use --model full)",
-                                     name));
-      need(name);
-      continue;
-    }
-    for (const auto& l : scene.loops) {
-      if (l.name != name) continue;
+    auto need_loop = [&](const models::Loop& l) {
       const auto body = loop_balance_body(scene, l).first;
       for (const auto& j : scene.joints)
         if (j.child == body || j.parent == body) need(j.name);
+    };
+    if (const auto* j = scene.find_joint(name)) {
+      if (j->type == models::JointType::Revolute) {
+        need(name);
+        continue;
+      }
+      check_prismatic_balance(scene, *j);
+      for (const auto& k : scene.joints)
+        if (k.parent == j->child) need(k.name);
+      for (const auto& l : scene.loops)
+        if (l.body_a == j->child || l.body_b == j->child) need_loop(l);
+      continue;
     }
+    for (const auto& l : scene.loops)
+      if (l.name == name) need_loop(l);
   }
   for (const auto& j : joints) {
     for (char axis : {'x', 'y'}) {
@@ -222,24 +255,71 @@ void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::Ti
       ts.columns[c++][i] = uj[j];
       ts.columns[c++][i] = aj[j];
     }
+    // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
+    // R_parent + Σ(−R_children) + F_loop + m g = m a_c.
+    auto loop_force = [&](const models::Loop& l, double& Rx, double& Ry) {
+      const auto [bname, sign] = loop_balance_body(s, l);
+      const int b = s.body_index(bname);
+      const double m_b = s.bodies[b].mass_kg;
+      double Fx = m_b * (cax[b] - gx), Fy = m_b * (cay[b] - gy);
+      for (const auto& j : s.joints) {
+        double jx, jy;
+        if (j.child == bname) R_of(j.name, i, jx, jy), Fx -= jx, Fy -= jy;
+        if (j.parent == bname) R_of(j.name, i, jx, jy), Fx += jx, Fy += jy;
+      }
+      Rx = sign * Fx, Ry = sign * Fy;
+    };
     for (const auto& name : s.outputs.reactions) {
       double Rx = 0, Ry = 0;
-      if (s.find_joint(name)) {
+      const auto* jt = s.find_joint(name);
+      if (jt && jt->type == models::JointType::Revolute) {
         R_of(name, i, Rx, Ry);
-      } else {
-        const models::Loop* l = nullptr;
-        for (const auto& o : s.loops) l = o.name == name ? &o : l;
-        const auto [bname, sign] = loop_balance_body(s, *l);
-        const int b = s.body_index(bname);
-        const double m_b = s.bodies[b].mass_kg;
-        // Newton–Euler of B: R_parent + Σ(−R_children) + F_loop + m g = m a_c.
-        double Fx = m_b * (cax[b] - gx), Fy = m_b * (cay[b] - gy);
-        for (const auto& j : s.joints) {
-          double jx, jy;
-          if (j.child == bname) R_of(j.name, i, jx, jy), Fx -= jx, Fy -= jy;
-          if (j.parent == bname) R_of(j.name, i, jx, jy), Fx += jx, Fy += jy;
+      } else if (jt) {
+        // Prismatic: Newton–Euler of the child C about the joint's child point P:
+        // R = m (a_c − g) − Σ F_loops on C + Σ R_children; M = I α + (r_c − P) × m (a_c − g)
+        // − Σ (r_k − P) × F_k over the other forces on C.
+        const int b = s.body_index(jt->child);
+        const auto& bd = s.bodies[b];
+        const Kin& C = body[b];
+        const double cC = std::cos(C.th), sC = std::sin(C.th);
+        auto at = [&](models::Vec2 p, double& x, double& y) {
+          x = C.x + cC * p.x - sC * p.y, y = C.y + sC * p.x + cC * p.y;
+        };
+        double Px, Py;
+        at(jt->child_point, Px, Py);
+        const double mx = bd.mass_kg * (cax[b] - gx), my = bd.mass_kg * (cay[b] - gy);
+        Rx = mx, Ry = my;
+        double M = bd.inertia_kgm2 * C.al + (cx[b] - Px) * my - (cy[b] - Py) * mx;
+        auto other = [&](double x, double y, double fx, double fy) {  // another force on C at (x, y)
+          Rx -= fx, Ry -= fy;
+          M -= (x - Px) * fy - (y - Py) * fx;
+        };
+        for (const auto& k : s.joints)
+          if (k.parent == jt->child) {
+            double kx, ky, x, y;
+            R_of(k.name, i, kx, ky);
+            at(k.parent_point, x, y);
+            other(x, y, -kx, -ky);
+          }
+        for (const auto& l : s.loops) {
+          if (l.body_a != jt->child && l.body_b != jt->child) continue;
+          double fx, fy, x, y;
+          loop_force(l, fx, fy);
+          const bool on_b = l.body_b == jt->child;
+          at(on_b ? l.point_b : l.point_a, x, y);
+          other(x, y, on_b ? fx : -fx, on_b ? fy : -fy);
         }
-        Rx = sign * Fx, Ry = sign * Fy;
+        ts.columns[c++][i] = Rx;
+        ts.columns[c++][i] = Ry;
+        const Kin P = jt->parent == models::kGround ? Kin{} : body[s.body_index(jt->parent)];
+        const double ux = std::cos(P.th) * jt->axis.x - std::sin(P.th) * jt->axis.y;
+        const double uy = std::sin(P.th) * jt->axis.x + std::cos(P.th) * jt->axis.y;
+        ts.columns[c++][i] = -uy * Rx + ux * Ry;
+        ts.columns[c++][i] = M;
+        continue;
+      } else {
+        for (const auto& l : s.loops)
+          if (l.name == name) loop_force(l, Rx, Ry);
       }
       ts.columns[c++][i] = Rx;
       ts.columns[c++][i] = Ry;
