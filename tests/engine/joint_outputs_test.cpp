@@ -136,5 +136,21 @@ TEST(JointOutputs, SliderCrankPinForcesInClosedForm) {
   }
 }
 
+
+TEST(JointOutputs, ConstraintForceOnTheIndependentJointMatchesItsReaction) {
+  // A request on the crank (the independent joint) along the crank: the actuator route's slider
+  // multiplier equals Simbody's reaction projected on the crank's direction.
+  const std::vector<models::Override> sets{{"outputs.constraint_forces.rocker_axial.joint", "crank"},
+                                           {"outputs.constraint_forces.rocker_axial.direction", "B"}};
+  const FullRun a = simulate("fourbar", sets, ConstraintForceRoute::Actuator);
+  double peak = 0;
+  for (size_t i = 0; i < a.ts.t.size(); ++i) {
+    const double th = a.at("q_crank", i), f = a.ts.forces[0][i];
+    peak = std::max(peak, std::abs(f));
+    EXPECT_NEAR(f, a.at("R_crank_x", i) * std::cos(th) + a.at("R_crank_y", i) * std::sin(th), 1e-6 * (1 + std::abs(f)));
+  }
+  EXPECT_GT(peak, 10.0);
+}
+
 }  // namespace
 }  // namespace rdyn::engine
