@@ -214,7 +214,7 @@ void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::Ti
       const auto& jt = s.joints[j];
       const Kin P = jt.parent == models::kGround ? Kin{} : body[s.body_index(jt.parent)];
       const double cP = std::cos(P.th), sP = std::sin(P.th);
-      double px = jt.parent_point.x, py = jt.parent_point.y, vrx = 0, vry = 0, arx = 0, ary = 0;
+      double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
       Kin C = P;
       if (jt.type == models::JointType::Revolute) {
         C.th = P.th + jt.offset_rad + qj[j];
@@ -227,7 +227,6 @@ void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::Ti
         // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
         arx = ux * aj[j] - 2 * P.w * uy * uj[j];
         ary = uy * aj[j] + 2 * P.w * ux * uj[j];
-        (void)vrx, (void)vry;
       }
       const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
       double Jax, Jay;
