@@ -9,6 +9,7 @@
 #include "engine/full_model_impl.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/kinetostatic.hpp"
+#include "reduced/joint_outputs.hpp"
 
 namespace rdyn::engine {
 
@@ -63,6 +64,11 @@ void record(const FullModel::Impl& m, const State& s, TimeSeries& ts) {
   ts.gates.push_back(mask);
   const auto f = m.constraint_forces(s);
   for (size_t k = 0; k < f.size(); ++k) ts.forces[k].push_back(f[k]);
+  if (!ts.columns.empty()) {
+    std::vector<double> c;
+    calc_joint_outputs(m, s, c);
+    for (size_t k = 0; k < c.size(); ++k) ts.columns[k].push_back(c[k]);
+  }
   ts.stats.max_constraint_error = std::max(ts.stats.max_constraint_error, m.worst_loop_gap(s).first);
 }
 
@@ -104,6 +110,7 @@ void check_finite_row(const TimeSeries& ts) {
   check(ts.work.back(), "work");
   for (size_t k = 0; k < ts.forces.size(); ++k)
     check(ts.forces[k].back(), "constraint force '" + ts.force_names[k] + "'");
+  for (size_t k = 0; k < ts.columns.size(); ++k) check(ts.columns[k].back(), "output '" + ts.column_names[k] + "'");
 }
 
 }  // namespace
@@ -155,6 +162,8 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   TimeSeries ts;
   for (const auto& c : m.scene.outputs.constraint_forces) ts.force_names.push_back(c.name);
   ts.forces.resize(ts.force_names.size());
+  ts.column_names = reduced::joint_output_names(m.scene);
+  ts.columns.resize(ts.column_names.size());
   const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
   record(m, integ->getState(), ts);
   check_finite_row(ts);

@@ -223,7 +223,38 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
                                 where, m.scene.independent));
 }
 
+// Each loop that names its branch must have closed on it: the named joint's coordinate (a
+// revolute angle wrapped to (−180°, 180°]) has the sign asked for. Zero (the boundary between
+// the branches, a singular position) is neither.
+void check_branches(const FullModel::Impl& m, const State& s) {
+  for (const auto& l : m.scene.loops) {
+    if (!l.branch) continue;
+    const int j = m.scene.joint_index(l.branch->joint);
+    if (j < 0) throw EngineError(fmt::format("{}: loop '{}' names its branch by an unknown joint '{}'",
+                                             m.scene.source_file, l.name, l.branch->joint));
+    const auto& jt = m.scene.joints[j];
+    const bool rev = jt.type == JointType::Revolute;
+    const double q = m.joint_q(s, j);
+    const double v = rev ? std::remainder(q, 2 * Pi) : q;
+    if (l.branch->sign * v > 0) continue;
+    const double shown = rev ? v * 180 / Pi : v;
+    throw EngineError(fmt::format(
+        "{}: field 'loops.{}.branch': loop '{}' assembled on the other branch: joint '{}' is at {:.6g}{} but the "
+        "branch asks for a {} value{}; move the guesses toward that branch (e.g. {} of '{}')",
+        m.scene.source_file, l.name, l.name, jt.name, shown, rev ? "° (wrapped to (−180°, 180°])" : " m",
+        l.branch->sign > 0 ? "positive" : "negative", v == 0 ? " (0 is the boundary between the branches)" : "",
+        rev ? "guess_deg" : "guess_m", jt.name));
+  }
+}
+
 }  // namespace
+
+void calc_mobility_count(const FullModel::Impl& m, const State& s, int& mobilities, int& rows, int& rank) {
+  const Mobility mob = calc_mobility(m, s);
+  mobilities = mob.mobilities;
+  rows = mob.rows;
+  rank = mob.rank;
+}
 
 FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     : scene(s), options(o), matter(system), forces(system) {
@@ -238,10 +269,10 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   // this keeps a scene built in code from reaching Simbody with a dangling handle).
   for (const auto& c : scene.outputs.constraint_forces) {
     const int j = scene.joint_index(c.joint);
-    if (j < 0 || scene.joints[j].type != JointType::Revolute || j == independent ||
-        !(std::hypot(c.direction.x, c.direction.y) > 0))
-      throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint other than the independent "
-                                    "one and a non-zero direction",
+    // The independent joint is accepted here (its pin is prescribed, the sliders after it carry
+    // the child): the reduced model's reaction lines (reduced/joint_outputs.hpp) use it.
+    if (j < 0 || scene.joints[j].type != JointType::Revolute || !(std::hypot(c.direction.x, c.direction.y) > 0))
+      throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint and a non-zero direction",
                                     scene.source_file, c.name));
   }
   actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
@@ -488,6 +519,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
                                   m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
   }
   check_one_dof(m, s);
+  check_branches(m, s);
 }
 
 FullWorkspace::~FullWorkspace() = default;

@@ -99,6 +99,15 @@ struct FullWorkspace::Impl {
   explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
 };
 
+// Joint coordinates of the mechanism (constraint actuators' sliders excluded), loop and gear
+// condition rows and the rank of their Jacobian, at a state realized to Position
+// (full_model.cpp; the same count check_one_dof uses).
+void calc_mobility_count(const FullModel::Impl& m, const SimTK::State& s, int& mobilities, int& rows, int& rank);
+
+// The columns of reduced::joint_output_names (joint motions, reactions, shaking) at a state
+// realized to Acceleration (engine/joint_outputs.cpp).
+void calc_joint_outputs(const FullModel::Impl& m, const SimTK::State& s, std::vector<double>& out);
+
 // Adds the scene's loads as one custom force (engine/scene_loads.cpp).
 void add_scene_loads(FullModel::Impl& impl);
 // Generalized power of the non-conservative loads [W] (for the work integral).

@@ -114,6 +114,7 @@ reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_cons
     g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
   }
   g.ratios.wrt_x = calc_velocity_ratios(model_, ws_, q, false, true).wrt_x;
+  g.ratios.joint_q = vel.joint_q;
   // Singular configuration: the loop Jacobian lost rank (or the projection needed its
   // fallback tolerance). The constraints do not determine the velocities there.
   g.singular = model_.impl().near_singular_projections > singular_before ||
@@ -135,7 +136,9 @@ reduced::ConservativePoint FullKinetostaticSource::conservative(double q) {
 reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
   return at(q, [&] {
     const auto v = calc_velocity_ratios(model_, ws_, q);
-    return reduced::RatioPoint{v.wrt_q, v.wrt_x};
+    std::vector<double> joint_q(model_.scene().joints.size());
+    for (size_t j = 0; j < joint_q.size(); ++j) joint_q[j] = model_.impl().joint_q(ws_.impl().state, static_cast<int>(j));
+    return reduced::RatioPoint{v.wrt_q, v.wrt_x, joint_q};
   });
 }
 

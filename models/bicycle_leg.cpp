@@ -268,7 +268,7 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
                         0.0,
                         wrap(pose.shank_angle - pose.thigh_angle)});
     s.loops.push_back(
-        {"pedal_" + side, shank.name, fit.sf.pedal, "crank", crank.points["pedal_" + side]});
+        {"pedal_" + side, shank.name, fit.sf.pedal, "crank", crank.points["pedal_" + side], std::nullopt});
     // Hip torque pushes the thigh down (counter-clockwise: the knee is in front, at −x),
     // and acts only while the thigh descends, i.e. while its angle increases.
     if (p.hip_torque_Nm != 0.0)

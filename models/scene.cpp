@@ -330,8 +330,8 @@ void check_scene(const Scene& s) {
     const Joint* j = s.find_joint(cf.joint);
     if (!j) fail(f + ".joint", "unknown joint '" + printable(cf.joint) + "'");
     if (j->type != JointType::Revolute) fail(f, "constraint forces are offered on revolute joints");
-    if (cf.joint == s.independent)
-      fail(f, "the independent coordinate's joint has no constraint actuator; pick another joint");
+    // The independent joint too: its pin is the prescribed (or free) coordinate and the
+    // constraint actuator's sliders follow it (engine/full_model.cpp).
     c.direction(f + ".direction", cf.direction);
   }
   {

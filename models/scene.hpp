@@ -115,6 +115,14 @@ struct Joint {
   double guess = 0.0;       // starting value for assembly [rad or m]; picks the branch
 };
 
+// Assembly branch of a loop: the loop closes with `joint`'s coordinate of this sign (a
+// revolute angle wrapped to (−180°, 180°], a prismatic q as it is). Assembly fails, naming the
+// loop, when the guesses lead to the other branch, instead of silently simulating it.
+struct BranchSign {
+  std::string joint;
+  int sign = +1;  // +1 positive, −1 negative
+};
+
 // Loop closure: a point of body_a coincides with a point of body_b (a planar revolute).
 struct Loop {
   std::string name;
@@ -122,6 +130,7 @@ struct Loop {
   Vec2 point_a;
   std::string body_b;
   Vec2 point_b;
+  std::optional<BranchSign> branch;  // empty: the branch the guesses lead to
 };
 
 // Gear: rate(driven) = ratio · rate(driver); both revolute.
@@ -195,6 +204,14 @@ struct ConstraintForceRequest {
 struct Outputs {
   std::vector<ConstraintForceRequest> constraint_forces;
   std::vector<std::string> bodies;  // bodies whose own motion is requested
+  // Joints whose motion is output (columns q_<j>, qdot_<j>, qddot_<j>; "all" in YAML: every
+  // joint, in scene order).
+  std::vector<std::string> joints;
+  // Joints and loops whose reaction is output: R_<n>_x, R_<n>_y (the joint's force on its child,
+  // the loop's force of body_a on body_b, ground frame [N]); prismatic joints add R_<n>_normal
+  // [N] and R_<n>_M [N·m] ("all": every joint, then every loop).
+  std::vector<std::string> reactions;
+  bool shaking = false;  // shaking_x, shaking_y [N], shaking_M [N·m]: the mechanism's load on the ground
 };
 
 struct Initial {

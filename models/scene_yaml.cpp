@@ -540,13 +540,25 @@ void read_mechanism(const Fields& top, Scene& s) {
     s.joints.push_back(j);
   });
   for_each_item(top, "loops", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b"});
+    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b", "branch"});
     Loop l;
     l.name = f.name("name");
     l.body_a = f.str("body_a");
     l.body_b = f.str("body_b");
     l.point_a = read_point(f, "point_a", l.body_a, s);
     l.point_b = read_point(f, "point_b", l.body_b, s);
+    if (f.has("branch")) {  // {joint, sign: positive|negative} (or +1 / -1)
+      Fields b(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"});
+      BranchSign br{b.str("joint"), +1};
+      if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
+      if (br.joint == top.str_or("independent", ""))
+        b.fail("joint", "the independent coordinate is set by `initial`, not by assembly: name another joint");
+      const std::string sign = b.str("sign");
+      if (sign == "positive" || sign == "+1" || sign == "1") br.sign = +1;
+      else if (sign == "negative" || sign == "-1") br.sign = -1;
+      else b.fail("sign", "expected positive or negative (or +1, -1)");
+      l.branch = br;
+    }
     s.loops.push_back(l);
   });
   for_each_item(top, "gears", [&](const YAML::Node& n, const std::string& path) {
@@ -721,7 +733,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
   }
   if (top.has("outputs")) {
-    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies"});
+    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies", "joints", "reactions", "shaking"});
     for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
       Fields c(n, path, ctx, {"name", "joint", "direction"});
       ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
@@ -750,6 +762,38 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
         s.outputs.bodies.push_back(b[i].as<std::string>());
       }
     }
+    // `all` or a list of names; each name known (joints; for reactions, joints or loops).
+    auto names_or_all = [&](const std::string& key, bool loops_too) {
+      std::vector<std::string> out;
+      const YAML::Node n = f.raw(key);
+      const std::string what = loops_too ? "joint or loop" : "joint";
+      if (n.IsScalar() && n.Scalar() == "all") {
+        for (const auto& j : s.joints) out.push_back(j.name);
+        if (loops_too)
+          for (const auto& l : s.loops) out.push_back(l.name);
+      } else if (n.IsSequence()) {
+        for (const auto& item : n) {
+          const std::string name = item.IsScalar() ? item.Scalar() : "";
+          const bool loop = loops_too && std::any_of(s.loops.begin(), s.loops.end(),
+                                                     [&](const Loop& l) { return l.name == name; });
+          if (!s.find_joint(name) && !loop)
+            f.fail_at(item, f.join(key), "unknown " + what + " '" + name.substr(0, 64) + "'");
+          if (std::find(out.begin(), out.end(), name) != out.end())
+            f.fail_at(item, f.join(key), "'" + name + "' is listed twice");
+          out.push_back(name);
+        }
+      } else {
+        f.fail(key, "expected all or a list of " + what + " names");
+      }
+      for (const auto& name : out)  // R_<name> must say which one it is
+        if (loops_too && s.find_joint(name) &&
+            std::any_of(s.loops.begin(), s.loops.end(), [&](const Loop& l) { return l.name == name; }))
+          f.fail(key, "'" + name + "' names both a joint and a loop: rename one");
+      return out;
+    };
+    if (f.has("joints")) s.outputs.joints = names_or_all("joints", false);
+    if (f.has("reactions")) s.outputs.reactions = names_or_all("reactions", true);
+    s.outputs.shaking = f.flag_or("shaking", false);
   }
   if (top.has("simulation")) {
     Fields f(top.raw("simulation"), "simulation", ctx,

@@ -26,6 +26,10 @@ struct TimeSeries {
   std::vector<double> work;                 // cumulative work of non-conservative loads [J]
   std::vector<std::vector<double>> forces;  // forces[k][i]: force k at sample i [N]
   std::vector<std::uint32_t> gates;         // bit g set: rate-gated load g on at sample i
+  // Every requested joint's motion and reaction and the shaking load (outputs.joints, reactions,
+  // shaking; names and units: reduced/joint_outputs.hpp), written after the forces.
+  std::vector<std::string> column_names;
+  std::vector<std::vector<double>> columns;  // columns[c][i]: column c at sample i
   RunStats stats;
 };
 

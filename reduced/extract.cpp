@@ -11,6 +11,7 @@
 
 #include "models/scene_hash.hpp"
 #include "reduced/table.hpp"
+#include "reduced/joint_outputs.hpp"
 
 namespace rdyn::reduced {
 
@@ -223,7 +224,8 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   // The table must be one the reader accepts (samples.hpp limits): count its columns first
   // (m1, m2, Q_cons, V; me1, me2, Qx_cons per force; r per joint; rx per force and joint;
   // w and wx per resistance) and refuse before allocating.
-  const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk);
+  const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk) +
+                    (wants_joint_outputs(scene) ? 2L * nj : 0L);  // p_, k_ (reduced/joint_outputs.hpp)
   if (cols + 1 > kMaxTableColumns || (cols + 1) * n > kMaxTableValues)
     throw TableError(fmt::format("a {:g}° table of this scene would have {} points × {} columns, more than the limits "
                                  "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
@@ -292,6 +294,8 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   const bool conservative_loads = scene.gravity.enabled || !scene.springs.empty();
   const bool inertial_here = opt.method == Method::Kinetostatic || opt.method == Method::Integrated;
   std::vector<char> singular(n, 0);
+  const bool joint_outputs = wants_joint_outputs(scene);
+  std::vector<std::vector<double>> p(joint_outputs ? nj : 0, std::vector<double>(n));
   // Joints gating loads: their ratio's zeros are the switch angles (refined during the sweep).
   std::vector<int> gate_joints;
   for (const auto& t : scene.joint_torques)
@@ -330,6 +334,12 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     Q[i] = -g.conservative.forces.driving_force;
     V[i] = g.conservative.potential_energy;
     for (int k = 0; k < nk; ++k) Qx[k][i] = -g.conservative.forces.constraint_forces[k];
+    if (joint_outputs) {  // joint positions for the joint-output columns (reduced/joint_outputs.hpp)
+      if (static_cast<int>(g.ratios.joint_q.size()) != nj)
+        throw TableError("this kinetostatic source does not give joint positions, which outputs.joints, "
+                         "outputs.reactions and outputs.shaking need");
+      for (int j = 0; j < nj; ++j) p[j][i] = g.ratios.joint_q[j];
+    }
     for (int j = 0; j < nj; ++j) {
       r[j][i] = g.ratios.wrt_q[j];
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
@@ -391,6 +401,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   for (int j = 0; j < nj; ++j) s.add("r_" + scene.joints[j].name, r[j]);
   for (int k = 0; k < nk; ++k)
     for (int j = 0; j < nj; ++j) s.add("rx_" + forces[k].name + "_" + scene.joints[j].name, rx[k][j]);
+  if (joint_outputs) add_joint_position_columns(scene, s.q, h, r, p, s);
   // Switch angles of rate-gated loads: the zeros located during the sweep.
   for (size_t gj = 0; gj < gate_joints.size(); ++gj) {
     auto roots = gate_roots[gj];

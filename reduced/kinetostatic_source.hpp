@@ -25,6 +25,9 @@ struct ConservativePoint {
 struct RatioPoint {
   std::vector<double> wrt_q;               // [joint]
   std::vector<std::vector<double>> wrt_x;  // [constraint force][joint]
+  // Every joint's coordinate at this q (optional: empty when the source does not give it; the
+  // joint-output columns p_<joint> need it) [rad or m].
+  std::vector<double> joint_q;
 };
 
 // The cross-check of issue 3, route "direct": m1 = uᵀMu, me1 = u_xᵀMu, m2 = uᵀ(M b + c),

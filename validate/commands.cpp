@@ -14,12 +14,14 @@
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
 #include "validate/escape.hpp"
 #include "validate/harness.hpp"
+#include "validate/inspect.hpp"
 #include "validate/report.hpp"
 #include "validate/summary.hpp"
 #include "validate/sweep.hpp"
@@ -112,6 +114,11 @@ int run_simulate(const SimulateArgs& a) {
 
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
                         {"duration_s", duration},  {"output_interval_s", dt_out}};
+  {  // The assembled configuration (every joint coordinate at t = 0), with its warnings.
+    const auto assembly = engine::calc_assembly(engine::FullModel(scene));
+    for (const auto& w : assembly.warnings) std::fprintf(stderr, "rdyn: warning: %s\n", w.c_str());
+    run["assembly"] = assembly_json(assembly);
+  }
   models::TimeSeries ts;
   if (a.model == "full") {
     engine::FullModelOptions mo;
@@ -125,13 +132,15 @@ int run_simulate(const SimulateArgs& a) {
                 {"simbody_bodies", model.num_simbody_bodies()},
                 {"max_loop_gap_m", ts.stats.max_constraint_error}});
   } else {
+    // Joint outputs: the table and the model carry one constraint line per reaction component.
+    const models::Scene rscene = reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene;
     reduced::Samples samples;
     double extraction_ms = 0.0;
     if (!a.table.empty()) {
       samples = reduced::read_samples_csv(a.table);
       run["table"] = a.table;
     } else {
-      auto e = extract_from_full(scene, a.grid_deg, reduced::parse_method(a.method));
+      auto e = extract_from_full(rscene, a.grid_deg, reduced::parse_method(a.method));
       samples = std::move(e.samples);
       extraction_ms = e.extraction_ms;
       run.update({{"grid_deg", a.grid_deg}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
@@ -141,10 +150,11 @@ int run_simulate(const SimulateArgs& a) {
         if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
       }
     }
-    const auto model = reduced::make_reduced_model(samples, scene, reduced::parse_interpolation(a.interpolation),
+    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
                                                    a.energy_consistent);
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
+    if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(scene, model, ts);
     run.update({{"interpolation", a.interpolation},
                 {"energy_consistent_m2", a.energy_consistent},
                 {"integrator", a.reduced_integrator},
@@ -177,7 +187,8 @@ int run_extract(const ExtractArgs& a) {
   const models::Scene scene = load(a.scene, a.sets);
   const auto method = reduced::parse_method(a.method);
   OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
-  const auto e = extract_from_full(scene, a.grid_deg, method);
+  const auto e = extract_from_full(reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene,
+                                   a.grid_deg, method);
   out.write(reduced::format_samples_csv(e.samples));
   out.commit();
   std::string range;  // range tables: the span and, when found, the dead points

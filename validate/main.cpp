@@ -9,6 +9,7 @@
 #include "models/scene.hpp"
 #include "reduced/samples.hpp"
 #include "validate/commands.hpp"
+#include "validate/inspect.hpp"
 #include "validate/output_dir.hpp"
 
 namespace {
@@ -156,6 +157,16 @@ int main(int argc, char** argv) {
   sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load");
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
 
+  InspectArgs ins;
+  auto* inspect = app.add_subcommand(
+      "inspect",
+      "Assemble a scene and print, as JSON on standard output, what a newcomer needs while writing it: every "
+      "joint coordinate and body pose at t = 0 (degrees and metres), the degrees of freedom (rank of the "
+      "constraint Jacobian), each loop's closure gap, the range of the independent coordinate (full turn or its "
+      "dead points, found by continuation) and warnings (also on standard error).");
+  inspect->add_option("scene", ins.scene, "Scene name or YAML file")->required();
+  inspect->add_option("--set", ins.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -179,6 +190,7 @@ int main(int argc, char** argv) {
     if (*validate) return run_validate(val);
     if (*sweep) return run_sweep_command(sw);
     if (*report) return run_report(rep);
+    if (*inspect) return run_inspect(ins);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

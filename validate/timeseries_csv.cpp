@@ -18,6 +18,7 @@ void write_timeseries_csv(const std::string& path, const engine::TimeSeries& ts)
   TextSink sink(path);
   std::string header = "t,q,qdot,qddot,energy,work";
   for (const auto& n : ts.force_names) header += ",F_" + n;  // names are checked by the scene reader
+  for (const auto& n : ts.column_names) header += "," + n;
   sink.add(header + "\n");
   std::string row;
   for (size_t i = 0; i < ts.t.size(); ++i) {
@@ -31,6 +32,10 @@ void write_timeseries_csv(const std::string& path, const engine::TimeSeries& ts)
     for (size_t c = 0; c < ts.forces.size(); ++c) {
       finite(ts.forces[c][i], i, ("force " + ts.force_names[c]).c_str());
       row += fmt::format(",{:.17g}", ts.forces[c][i]);
+    }
+    for (size_t c = 0; c < ts.columns.size(); ++c) {
+      finite(ts.columns[c][i], i, ts.column_names[c].c_str());
+      row += fmt::format(",{:.17g}", ts.columns[c][i]);
     }
     row += '\n';
     sink.add(row);

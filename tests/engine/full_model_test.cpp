@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
@@ -207,6 +208,53 @@ TEST(FullModelConstraintForces, RequestOnAPrismaticJointIsAnEngineErrorNotAnAbor
     return std::string();
   }();
   EXPECT_TRUE(has(m, "constraint force 'on_slider'")) << m;
+}
+
+
+// Explicit branches (a loop's `branch`): the four-bar of models/scenes/fourbar.yaml at crank 30°
+// closes at C above or below the line B→D; the rocker angle's sign tells them apart. Closed form:
+// C = intersections of |C − B| = 0.28 and |C − D| = 0.20, B = 0.08 (cos 30°, sin 30°), D = (0.3, 0).
+std::pair<double, double> fourbar_rocker_angles() {
+  const double a = 0.08, b = 0.28, c = 0.20, d = 0.30, th = 30 * kPi / 180;
+  const double Bx = a * std::cos(th), By = a * std::sin(th), ex = d - Bx, ey = -By, e = std::hypot(ex, ey);
+  const double along = (b * b - c * c + e * e) / (2 * e), h = std::sqrt(b * b - along * along);
+  const double px = Bx + along * ex / e, py = By + along * ey / e;
+  return {std::atan2(py + h * ex / e, px - h * ey / e - d), std::atan2(py - h * ex / e, px + h * ey / e - d)};
+}
+
+models::Scene fourbar_with_branch(const std::string& sign, double coupler_guess, double rocker_guess) {
+  return models::load_scene("fourbar", {{"loops.C.branch.joint", "rocker"},
+                                        {"loops.C.branch.sign", sign},
+                                        {"joints.coupler.guess_deg", std::to_string(coupler_guess)},
+                                        {"joints.rocker.guess_deg", std::to_string(rocker_guess)}});
+}
+
+double assembled_rocker(const models::Scene& scene) {
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  return calc_kinetostatic(model, ws, scene.initial.q, 0, 0, Loads::Off).joint_q[2];
+}
+
+TEST(FullModelBranch, BothBranchesGiveTheClosedFormSolutions) {
+  const auto [up, down] = fourbar_rocker_angles();
+  ASSERT_GT(up, 0);
+  ASSERT_LT(down, 0);
+  EXPECT_NEAR(std::remainder(assembled_rocker(fourbar_with_branch("positive", 4.85, 90.27)) - up, 2 * kPi), 0, 1e-10);
+  EXPECT_NEAR(std::remainder(assembled_rocker(fourbar_with_branch("negative", -84.5, -110)) - down, 2 * kPi), 0,
+              1e-10);
+}
+
+TEST(FullModelBranch, GuessesOfTheOtherBranchFailNamingTheLoop) {
+  // Without a branch, these guesses silently give the lower assembly...
+  auto plain = models::load_scene("fourbar", {{"joints.coupler.guess_deg", "-84.5"},
+                                              {"joints.rocker.guess_deg", "-110"}});
+  EXPECT_LT(std::remainder(assembled_rocker(plain), 2 * kPi), 0);
+  // ...with the upper branch named, they are refused.
+  const std::string m = refusal(fourbar_with_branch("positive", -84.5, -110));
+  EXPECT_TRUE(has(m, "loop 'C' assembled on the other branch")) << m;
+  EXPECT_TRUE(has(m, "joint 'rocker' is at -109.9")) << m;
+  EXPECT_TRUE(has(m, "loops.C.branch")) << m;
+  EXPECT_TRUE(has(m, "fourbar.yaml")) << m;
 }
 
 }  // namespace

@@ -446,6 +446,51 @@ TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
   }
 }
 
+
+TEST(SceneYaml, LoopBranchNamesAJointAndASign) {
+  const auto scene = load_scene("fourbar", {{"loops.C.branch.joint", "rocker"}, {"loops.C.branch.sign", "-1"}});
+  ASSERT_TRUE(scene.loops[0].branch.has_value());
+  EXPECT_EQ(scene.loops[0].branch->joint, "rocker");
+  EXPECT_EQ(scene.loops[0].branch->sign, -1);
+  EXPECT_FALSE(load_scene("fourbar").loops[0].branch.has_value());
+  auto msg = [](std::vector<Override> o) {
+    try {
+      load_scene("fourbar", o);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto unknown = msg({{"loops.C.branch.joint", "rockr"}, {"loops.C.branch.sign", "positive"}});
+  EXPECT_NE(unknown.find("unknown joint 'rockr'"), std::string::npos) << unknown;
+  const auto sign = msg({{"loops.C.branch.joint", "rocker"}, {"loops.C.branch.sign", "up"}});
+  EXPECT_NE(sign.find("expected positive or negative"), std::string::npos) << sign;
+  const auto indep = msg({{"loops.C.branch.joint", "crank"}, {"loops.C.branch.sign", "positive"}});
+  EXPECT_NE(indep.find("independent coordinate is set by `initial`"), std::string::npos) << indep;
+}
+
+
+TEST(SceneYaml, JointOutputsAllOrNames) {
+  const auto all = load_scene("fourbar", {{"outputs.joints", "all"}, {"outputs.reactions", "all"},
+                                          {"outputs.shaking", "true"}});
+  EXPECT_EQ(all.outputs.joints, (std::vector<std::string>{"crank", "coupler", "rocker"}));
+  EXPECT_EQ(all.outputs.reactions, (std::vector<std::string>{"crank", "coupler", "rocker", "C"}));  // joints, loops
+  EXPECT_TRUE(all.outputs.shaking);
+  const std::string yaml = read_scene_text("fourbar") + "\n";
+  const auto listed = parse_scene(
+      std::string(yaml).replace(yaml.find("outputs:\n"), 9, "outputs:\n  joints: [rocker]\n  reactions: [C, crank]\n"),
+      "t.yaml");
+  EXPECT_EQ(listed.outputs.joints, (std::vector<std::string>{"rocker"}));
+  EXPECT_EQ(listed.outputs.reactions, (std::vector<std::string>{"C", "crank"}));
+  const std::string bad = std::string(yaml).replace(yaml.find("outputs:\n"), 9, "outputs:\n  reactions: [crank, D]\n");
+  const auto e = refusal(bad);
+  EXPECT_EQ(e.field(), "outputs.reactions");
+  EXPECT_NE(e.message().find("unknown joint or loop 'D'"), std::string::npos) << e.what();
+  EXPECT_GT(e.line(), 0);
+  EXPECT_NE(error_of(yaml, {{"outputs.joints", "some"}}).find("expected all or a list of joint names"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace rdyn::models
 

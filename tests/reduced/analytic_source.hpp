@@ -56,7 +56,7 @@ class AnalyticSource : public reduced::KinetostaticSource {
   }
   reduced::RatioPoint ratios(double q) override {
     ++calls;
-    return {{1.0, std::cos(q)}, {{0.0, 0.5}}};
+    return {{1.0, std::cos(q)}, {{0.0, 0.5}}, {}};
   }
 };
 

@@ -408,6 +408,7 @@ void scenes(std::vector<Case>& cs) {
                   {{"s.yaml", b.text}}, nullptr, "o"});
     cs.push_back({"scene_" + b.tag + "_calibrate", {"calibrate", "s.yaml", "--write-scene", "c.yaml"}, 2, b.field,
                   {{"s.yaml", b.text}}, nullptr, "c.yaml"});
+    cs.push_back({"scene_" + b.tag + "_inspect", {"inspect", "s.yaml"}, 2, b.field, {{"s.yaml", b.text}}, nullptr, "o"});
     cs.push_back({"scene_" + b.tag + "_sweep",
                   {"sweep", "s.yaml", "--vary", "bodies.crank.mass_kg=0.4:0.6:2", "--cadence-hz", "1", "--power-w",
                    "1", "--out", "w.csv"},
@@ -572,8 +573,24 @@ void found_later(std::vector<Case>& cs) {
     cs.push_back({"suite_bad_set_" + tag, {"validate", "--suite", "s", "--set", set, "--out", "o"}, 2, "--set",
                   {{"s/a.yaml", scene_text("fourbar")}}, nullptr, "o"});
   // Endless or special files as scenes: read up to the size limit, never to the end.
-  for (const std::string dev : {"/dev/zero", "/dev/urandom"})
+  for (const std::string dev : {"/dev/zero", "/dev/urandom"}) {
     cs.push_back({"scene_from_" + dev.substr(5), {"simulate", dev, "--out", "o"}, 2, "too large", {}, nullptr, "o"});
+    cs.push_back({"inspect_scene_from_" + dev.substr(5), {"inspect", dev}, 2, "too large", {}, nullptr, "o"});
+  }
+  // Joint outputs and branches (issue #10): bad names and values are exit 2 naming the field.
+  for (const auto& [tag, set, field] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"joints_word", "outputs.joints=some", "outputs.joints"},
+           {"shaking_word", "outputs.shaking=maybe", "outputs.shaking"},
+           {"branch_joint", "loops.C.branch.joint=nosuch", "branch"},
+           {"branch_sign", "loops.C.branch.sign=0", "branch"}})
+    for (const std::string cmd : {"simulate", "inspect"}) {
+      std::vector<std::string> args{cmd, "fourbar", "--set", set};
+      if (tag.rfind("branch", 0) == 0)
+        args.insert(args.end(), {"--set", tag == "branch_joint" ? "loops.C.branch.sign=positive"
+                                                                  : "loops.C.branch.joint=rocker"});
+      if (cmd == "simulate") args.insert(args.end(), {"--duration", "0.1", "--out", "o"});
+      cs.push_back({"outputs_" + tag + "_" + cmd, args, 2, field, {}, nullptr, "o"});
+    }
   cs.push_back({"suite_dangling_link_named_yaml", {"validate", "--suite", "s", "--out", "o"}, 2, "not a readable scene",
                 {{"s/a.yaml", scene_text("fourbar")}}, [](const fs::path& d) {
                   fs::create_symlink("nowhere.yaml", d / "s/b.yaml");

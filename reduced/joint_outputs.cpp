@@ -1,0 +1,350 @@
+#include "reduced/joint_outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace rdyn::reduced {
+
+std::vector<std::string> joint_output_names(const models::Scene& s) {
+  std::vector<std::string> n;
+  for (const auto& j : s.outputs.joints) {
+    n.push_back("q_" + j);
+    n.push_back("qdot_" + j);
+    n.push_back("qddot_" + j);
+  }
+  for (const auto& r : s.outputs.reactions) {
+    n.push_back("R_" + r + "_x");
+    n.push_back("R_" + r + "_y");
+    const auto* j = s.find_joint(r);
+    if (j && j->type == models::JointType::Prismatic) {
+      n.push_back("R_" + r + "_normal");
+      n.push_back("R_" + r + "_M");
+    }
+  }
+  if (s.outputs.shaking) {
+    n.push_back("shaking_x");
+    n.push_back("shaking_y");
+    n.push_back("shaking_M");
+  }
+  return n;
+}
+
+namespace {
+
+constexpr double kTwoPi = 2 * 3.14159265358979323846;
+
+// The body B whose Newton–Euler balance gives loop l's force: body_b, else body_a, when it hangs
+// from a revolute joint, its child joints are revolute, and no spring or other loop touches it.
+// Returns the body and +1 (B = body_b) or −1 (B = body_a; the force on body_b is the opposite).
+std::pair<std::string, int> loop_balance_body(const models::Scene& s, const models::Loop& l) {
+  for (const auto& [body, sign] : {std::pair{l.body_b, +1}, std::pair{l.body_a, -1}}) {
+    if (body == models::kGround) continue;
+    bool ok = true;
+    for (const auto& j : s.joints)
+      if ((j.child == body || j.parent == body) && j.type != models::JointType::Revolute) ok = false;
+    for (const auto& sp : s.springs) ok &= sp.body_a != body && sp.body_b != body;
+    for (const auto& o : s.loops) ok &= &o == &l || (o.body_a != body && o.body_b != body);
+    if (ok) return {body, sign};
+  }
+  throw TableError(fmt::format("the reduced model cannot give the reaction of loop '{}': neither of its bodies hangs "
+                               "from revolute joints only, free of springs and other loops (use --model full)",
+                               l.name));
+}
+
+// A prismatic joint's reaction by Newton–Euler of its child C: C's other joints are revolute
+// children (their reaction lines are known), each loop on C is solved from its other body, and
+// no spring, resistance or torque-type load on a child joint acts on C (the moment balance
+// about the child point would need them). Throws TableError naming what is missing.
+void check_prismatic_balance(const models::Scene& s, const models::Joint& jt) {
+  const std::string& c = jt.child;
+  auto refuse = [&](const std::string& why) {
+    throw TableError(fmt::format("the reduced model cannot give the reaction of prismatic joint '{}': its child '{}' {} "
+                                 "(use --model full)",
+                                 jt.name, c, why));
+  };
+  for (const auto& j : s.joints) {
+    if (j.parent != c) continue;
+    if (j.type != models::JointType::Revolute) refuse("carries a prismatic joint '" + j.name + "'");
+    for (const auto& t : s.joint_torques)
+      if (t.joint == j.name) refuse("takes the reaction of the torque on joint '" + j.name + "'");
+    for (const auto& m : s.motors)
+      if (m.joint == j.name) refuse("takes the reaction of the motor on joint '" + j.name + "'");
+  }
+  for (const auto& sp : s.springs)
+    if (sp.body_a == c || sp.body_b == c) refuse("carries spring '" + sp.name + "'");
+  for (const auto& r : s.resistances)
+    if (r.body == c) refuse("carries resistance '" + r.name + "'");
+  for (const auto& l : s.loops)
+    if ((l.body_a == c || l.body_b == c) && loop_balance_body(s, l).first == c)
+      refuse("is the only body that can balance loop '" + l.name + "'");
+}
+
+struct Kin {  // one body at one sample: angle, rates, origin and its acceleration (ground)
+  double th = 0, w = 0, al = 0, x = 0, y = 0, ax = 0, ay = 0;
+};
+
+// Rigid transfer: the point at offset d (ground frame) from a frame with acceleration a, ω, α.
+void transfer(const Kin& k, double dx, double dy, double& ax, double& ay) {
+  ax = k.ax - k.al * dy - k.w * k.w * dx;
+  ay = k.ay + k.al * dx - k.w * k.w * dy;
+}
+
+}  // namespace
+
+void add_joint_position_columns(const models::Scene& scene, const std::vector<double>& q, double h,
+                                const std::vector<std::vector<double>>& r, const std::vector<std::vector<double>>& p,
+                                Samples& samples) {
+  const size_t n = q.size();
+  for (size_t j = 0; j < scene.joints.size(); ++j) {
+    double k = 0.0;
+    if (scene.joints[j].type == models::JointType::Revolute) {
+      // After a turn of q the sweep's continued angle has gained 2π k: p(q_first + 2π) is the last
+      // sample plus the wrap interval's increment (trapezoid of the ratios, exact to O(h³)).
+      const double end = p[j][n - 1] + 0.5 * (r[j][n - 1] + r[j][0]) * h;
+      k = std::round((end - p[j][0]) / kTwoPi);
+    }
+    std::vector<double> col(n);
+    for (size_t i = 0; i < n; ++i) col[i] = p[j][i] - k * q[i];
+    samples.add("p_" + scene.joints[j].name, col);
+    samples.add("k_" + scene.joints[j].name, std::vector<double>(n, k));
+  }
+}
+
+models::Scene with_reaction_requests(const models::Scene& scene) {
+  models::Scene out = scene;
+  std::vector<std::string> joints;  // revolute joints whose reaction lines are needed
+  auto need = [&](const std::string& j) {
+    if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
+  };
+  for (const auto& name : scene.outputs.reactions) {
+    auto need_loop = [&](const models::Loop& l) {
+      const auto body = loop_balance_body(scene, l).first;
+      for (const auto& j : scene.joints)
+        if (j.child == body || j.parent == body) need(j.name);
+    };
+    if (const auto* j = scene.find_joint(name)) {
+      if (j->type == models::JointType::Revolute) {
+        need(name);
+        continue;
+      }
+      check_prismatic_balance(scene, *j);
+      for (const auto& k : scene.joints)
+        if (k.parent == j->child) need(k.name);
+      for (const auto& l : scene.loops)
+        if (l.body_a == j->child || l.body_b == j->child) need_loop(l);
+      continue;
+    }
+    for (const auto& l : scene.loops)
+      if (l.name == name) need_loop(l);
+  }
+  for (const auto& j : joints) {
+    for (char axis : {'x', 'y'}) {
+      const std::string name = internal_request_name(j, axis);
+      for (const auto& c : scene.outputs.constraint_forces)
+        if (c.name == name)
+          throw TableError("constraint force name '" + name + "' is reserved for the reduced model's reaction lines");
+      out.outputs.constraint_forces.push_back({name, j, axis == 'x' ? models::Vec2{1, 0} : models::Vec2{0, 1}});
+    }
+  }
+  return out;
+}
+
+void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::TimeSeries& ts) {
+  const auto names = joint_output_names(s);
+  const Table& T = m.table;
+  const size_t nj = s.joints.size(), nb = s.bodies.size(), ns = ts.t.size();
+  auto col = [&](const std::string& name) {
+    const int c = T.column(name);
+    if (c < 0)
+      throw TableError("the reduced table has no column '" + name +
+                       "': extract it from a scene that asks for outputs.joints, reactions or shaking");
+    return c;
+  };
+  std::vector<int> cp(nj), ck(nj), cr(nj);
+  for (size_t j = 0; j < nj; ++j) {
+    cp[j] = col("p_" + s.joints[j].name);
+    ck[j] = col("k_" + s.joints[j].name);
+    cr[j] = col("r_" + s.joints[j].name);
+  }
+  auto force = [&](const std::string& name) -> const std::vector<double>& {
+    for (size_t k = 0; k < ts.force_names.size(); ++k)
+      if (ts.force_names[k] == name) return ts.forces[k];
+    throw TableError("the reduced run has no constraint line '" + name + "'");
+  };
+  // Body order: parents before children (the scene's joints form a tree rooted at ground).
+  std::vector<int> order;
+  {
+    std::vector<char> done(nj, 0);
+    for (size_t pass = 0; pass <= nj && order.size() < nj; ++pass)
+      for (size_t j = 0; j < nj; ++j) {
+        if (done[j]) continue;
+        const auto& jt = s.joints[j];
+        const int pb = s.body_index(jt.parent);
+        bool ready = jt.parent == models::kGround;
+        for (int o : order) ready |= s.body_index(s.joints[o].child) == pb;
+        if (ready) order.push_back(static_cast<int>(j)), done[j] = 1;
+      }
+  }
+  const double gx = s.gravity.enabled ? s.gravity.g_m_s2.x : 0.0, gy = s.gravity.enabled ? s.gravity.g_m_s2.y : 0.0;
+  ts.column_names = names;
+  ts.columns.assign(names.size(), std::vector<double>(ns));
+  std::vector<double> qj(nj), uj(nj), aj(nj);
+  std::vector<Kin> body(nb);
+  std::vector<double> cax(nb), cay(nb), cx(nb), cy(nb);  // centre of mass: acceleration, position
+  auto R_of = [&](const std::string& joint, size_t i, double& Rx, double& Ry) {
+    // Child-frame components of the reaction lines, turned into ground by the child's angle.
+    const double fx = force(internal_request_name(joint, 'x'))[i], fy = force(internal_request_name(joint, 'y'))[i];
+    const double th = body[s.body_index(s.find_joint(joint)->child)].th;
+    Rx = std::cos(th) * fx - std::sin(th) * fy;
+    Ry = std::sin(th) * fx + std::cos(th) * fy;
+  };
+  for (size_t i = 0; i < ns; ++i) {
+    const double q = ts.q[i], qd = ts.qdot[i], qdd = ts.qddot[i];
+    // Joint motion: q_j = p_j + k_j q; q̇_j = r_j q̇; q̈_j = r_j q̈ + (dr_j/dq) q̇².
+    for (size_t j = 0; j < nj; ++j) {
+      const double rj = T.eval(cr[j], q);
+      qj[j] = T.eval(cp[j], q) + T.eval(ck[j], q) * q;
+      uj[j] = rj * qd;
+      aj[j] = rj * qdd + T.eval_deriv(cr[j], q) * qd * qd;
+    }
+    // Planar tree kinematics: each child's frame from its parent's and its joint's motion.
+    for (int j : order) {
+      const auto& jt = s.joints[j];
+      const Kin P = jt.parent == models::kGround ? Kin{} : body[s.body_index(jt.parent)];
+      const double cP = std::cos(P.th), sP = std::sin(P.th);
+      double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
+      Kin C = P;
+      if (jt.type == models::JointType::Revolute) {
+        C.th = P.th + jt.offset_rad + qj[j];
+        C.w = P.w + uj[j];
+        C.al = P.al + aj[j];
+      } else {  // slides along the axis (parent frame) by q_j
+        px += jt.axis.x * qj[j];
+        py += jt.axis.y * qj[j];
+        const double ux = cP * jt.axis.x - sP * jt.axis.y, uy = sP * jt.axis.x + cP * jt.axis.y;
+        // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
+        arx = ux * aj[j] - 2 * P.w * uy * uj[j];
+        ary = uy * aj[j] + 2 * P.w * ux * uj[j];
+      }
+      const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
+      double Jax, Jay;
+      transfer(P, dx, dy, Jax, Jay);
+      Jax += arx, Jay += ary;
+      const double cC = std::cos(C.th), sC = std::sin(C.th);
+      const double ex = -(cC * jt.child_point.x - sC * jt.child_point.y);  // joint point → child origin
+      const double ey = -(sC * jt.child_point.x + cC * jt.child_point.y);
+      C.x = P.x + dx + ex;
+      C.y = P.y + dy + ey;
+      Kin Jk = C;
+      Jk.ax = Jax, Jk.ay = Jay;
+      transfer(Jk, ex, ey, C.ax, C.ay);
+      const int b = s.body_index(jt.child);
+      body[b] = C;
+      const auto& bd = s.bodies[b];
+      const double fx = cC * bd.com_m.x - sC * bd.com_m.y, fy = sC * bd.com_m.x + cC * bd.com_m.y;
+      cx[b] = C.x + fx, cy[b] = C.y + fy;
+      transfer(C, fx, fy, cax[b], cay[b]);
+    }
+    size_t c = 0;
+    for (const auto& name : s.outputs.joints) {
+      const int j = s.joint_index(name);
+      ts.columns[c++][i] = qj[j];
+      ts.columns[c++][i] = uj[j];
+      ts.columns[c++][i] = aj[j];
+    }
+    // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
+    // R_parent + Σ(−R_children) + F_loop + m g = m a_c.
+    auto loop_force = [&](const models::Loop& l, double& Rx, double& Ry) {
+      const auto [bname, sign] = loop_balance_body(s, l);
+      const int b = s.body_index(bname);
+      const double m_b = s.bodies[b].mass_kg;
+      double Fx = m_b * (cax[b] - gx), Fy = m_b * (cay[b] - gy);
+      for (const auto& j : s.joints) {
+        double jx, jy;
+        if (j.child == bname) R_of(j.name, i, jx, jy), Fx -= jx, Fy -= jy;
+        if (j.parent == bname) R_of(j.name, i, jx, jy), Fx += jx, Fy += jy;
+      }
+      Rx = sign * Fx, Ry = sign * Fy;
+    };
+    for (const auto& name : s.outputs.reactions) {
+      double Rx = 0, Ry = 0;
+      const auto* jt = s.find_joint(name);
+      if (jt && jt->type == models::JointType::Revolute) {
+        R_of(name, i, Rx, Ry);
+      } else if (jt) {
+        // Prismatic: Newton–Euler of the child C about the joint's child point P:
+        // R = m (a_c − g) − Σ F_loops on C + Σ R_children; M = I α + (r_c − P) × m (a_c − g)
+        // − Σ (r_k − P) × F_k over the other forces on C.
+        const int b = s.body_index(jt->child);
+        const auto& bd = s.bodies[b];
+        const Kin& C = body[b];
+        const double cC = std::cos(C.th), sC = std::sin(C.th);
+        auto at = [&](models::Vec2 p, double& x, double& y) {
+          x = C.x + cC * p.x - sC * p.y, y = C.y + sC * p.x + cC * p.y;
+        };
+        double Px, Py;
+        at(jt->child_point, Px, Py);
+        const double mx = bd.mass_kg * (cax[b] - gx), my = bd.mass_kg * (cay[b] - gy);
+        Rx = mx, Ry = my;
+        double M = bd.inertia_kgm2 * C.al + (cx[b] - Px) * my - (cy[b] - Py) * mx;
+        auto other = [&](double x, double y, double fx, double fy) {  // another force on C at (x, y)
+          Rx -= fx, Ry -= fy;
+          M -= (x - Px) * fy - (y - Py) * fx;
+        };
+        for (const auto& k : s.joints)
+          if (k.parent == jt->child) {
+            double kx, ky, x, y;
+            R_of(k.name, i, kx, ky);
+            at(k.parent_point, x, y);
+            other(x, y, -kx, -ky);
+          }
+        for (const auto& l : s.loops) {
+          if (l.body_a != jt->child && l.body_b != jt->child) continue;
+          double fx, fy, x, y;
+          loop_force(l, fx, fy);
+          const bool on_b = l.body_b == jt->child;
+          at(on_b ? l.point_b : l.point_a, x, y);
+          other(x, y, on_b ? fx : -fx, on_b ? fy : -fy);
+        }
+        ts.columns[c++][i] = Rx;
+        ts.columns[c++][i] = Ry;
+        const Kin P = jt->parent == models::kGround ? Kin{} : body[s.body_index(jt->parent)];
+        const double ux = std::cos(P.th) * jt->axis.x - std::sin(P.th) * jt->axis.y;
+        const double uy = std::sin(P.th) * jt->axis.x + std::cos(P.th) * jt->axis.y;
+        ts.columns[c++][i] = -uy * Rx + ux * Ry;
+        ts.columns[c++][i] = M;
+        continue;
+      } else {
+        for (const auto& l : s.loops)
+          if (l.name == name) loop_force(l, Rx, Ry);
+      }
+      ts.columns[c++][i] = Rx;
+      ts.columns[c++][i] = Ry;
+    }
+    if (s.outputs.shaking) {
+      // The mechanism's load on the ground: −(Σ m a_c − Σ m g), moment about O likewise.
+      double Fx = 0, Fy = 0, M = 0;
+      for (size_t b = 0; b < nb; ++b) {
+        const auto& bd = s.bodies[b];
+        const double fx = bd.mass_kg * (gx - cax[b]), fy = bd.mass_kg * (gy - cay[b]);
+        Fx += fx, Fy += fy;
+        M += cx[b] * fy - cy[b] * fx - bd.inertia_kgm2 * body[b].al;
+      }
+      ts.columns[c++][i] = Fx;
+      ts.columns[c++][i] = Fy;
+      ts.columns[c++][i] = M;
+    }
+  }
+  // The internal reaction lines are not outputs of their own.
+  for (size_t k = ts.force_names.size(); k-- > 0;) {
+    const bool user = std::any_of(s.outputs.constraint_forces.begin(), s.outputs.constraint_forces.end(),
+                                  [&](const models::ConstraintForceRequest& c) { return c.name == ts.force_names[k]; });
+    if (user) continue;
+    ts.force_names.erase(ts.force_names.begin() + static_cast<long>(k));
+    ts.forces.erase(ts.forces.begin() + static_cast<long>(k));
+  }
+}
+
+}  // namespace rdyn::reduced

@@ -1,0 +1,113 @@
+// `rdyn inspect` end to end: the JSON on standard output and the exit statuses of the contract
+// (0 success, 2 bad input naming the file and field, never an abort).
+#include "validate/inspect.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int status;
+  std::string out, err;
+};
+
+CliRun rdyn(const std::string& args) {
+  const auto err_file = fs::temp_directory_path() / ("rdyn_inspect_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(RDYN_BINARY) + " " + args + " 2>" + err_file.string();
+  CliRun r{-1, "", ""};
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) r.out.append(buf.data(), n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  std::ifstream in(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  fs::remove(err_file);
+  return r;
+}
+
+TEST(InspectCli, FourbarPrintsTheAssembledConfiguration) {
+  const CliRun r = rdyn("inspect fourbar");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["degrees_of_freedom"]["value"], 1);
+  EXPECT_EQ(j["degrees_of_freedom"]["constraint_rows"], 2);
+  EXPECT_NEAR(j["joints"]["crank"]["q_deg"].get<double>(), 30.0, 1e-9);  // the scene's initial q
+  // The scene's own guesses (4.85°, 90.27°) are the closed-form assembly to 0.01°.
+  EXPECT_NEAR(j["joints"]["coupler"]["q_deg"].get<double>(), 4.85, 0.01);
+  EXPECT_NEAR(j["joints"]["rocker"]["q_deg"].get<double>(), 90.27, 0.01);
+  EXPECT_LT(j["loops"]["C"]["gap_m"].get<double>(), 1e-10);
+  EXPECT_TRUE(j["range"]["full_turn"].get<bool>());
+  EXPECT_TRUE(j["warnings"].empty());
+}
+
+TEST(InspectCli, RockerDrivenRangeHasTwoDeadPoints) {
+  const CliRun r = rdyn(
+      "inspect fourbar --set independent=rocker --set initial.q_deg=110 --set joints.crank.guess_deg=110 --set "
+      "joints.coupler.guess_deg=-85 --set outputs.constraint_forces.rocker_axial.joint=coupler");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["range"]["full_turn"].get<bool>());
+  ASSERT_EQ(j["range"]["dead_points"].size(), 2u);
+  EXPECT_NEAR(j["range"]["dead_points"][0].get<double>(), 90.19099, 1e-3);   // acos((0.36² − 0.13)/0.12)
+  EXPECT_NEAR(j["range"]["dead_points"][1].get<double>(), 138.59038, 1e-3);  // acos((0.20² − 0.13)/0.12)
+  EXPECT_EQ(j["range"]["unit"], "deg");
+}
+
+TEST(InspectCli, BadInputIsExitTwoNamingTheField) {
+  CliRun r = rdyn("inspect fourbar --set bodies.crank.mass_kg=-1");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("mass_kg"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  // A loop that cannot close: the rocker too short to reach the coupler.
+  r = rdyn("inspect fourbar --set bodies.rocker.points.C.0=0.01");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("loop 'C' cannot close"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  r = rdyn("inspect no-such-scene");
+  EXPECT_EQ(r.status, 2) << r.err;
+}
+
+TEST(InspectCli, FarGuessesWarnOnStandardError) {
+  const CliRun r = rdyn("inspect fourbar --set joints.coupler.guess_deg=60");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: joint 'coupler' assembled at"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["warnings"].size(), 1u);
+}
+
+
+TEST(InspectCli, SimulateRecordsTheAssemblyInRunJson) {
+  const auto out = fs::temp_directory_path() / ("rdyn_inspect_run_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const CliRun r = rdyn("simulate fourbar --duration 0.01 --out " + out.string() +
+                        " --set joints.coupler.guess_deg=60");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: joint 'coupler' assembled at"), std::string::npos) << r.err;
+  std::ifstream in(out / "run.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["assembly"]["crank"]["q_deg"].get<double>(), 30.0, 1e-9);
+  EXPECT_NEAR(j["assembly"]["rocker"]["q_deg"].get<double>(), 90.27, 0.01);
+  EXPECT_NEAR(j["assembly"]["coupler"]["q_deg"].get<double>(), 4.85, 0.01);
+  fs::remove_all(out);
+}
+
+TEST(InspectCli, NamedBranchRefusesGuessesOfTheOtherOne) {
+  const CliRun r = rdyn(
+      "simulate fourbar --duration 0.01 --out /tmp/never-written-rdyn --set loops.C.branch.joint=rocker --set "
+      "loops.C.branch.sign=positive --set joints.rocker.guess_deg=-110 --set joints.coupler.guess_deg=-84.5");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("loop 'C' assembled on the other branch"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists("/tmp/never-written-rdyn"));
+}
+
+}  // namespace
