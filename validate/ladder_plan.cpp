@@ -28,8 +28,10 @@ LadderPlan plan_ladders(const TimeScale& scale, bool quick) {
     p.extraction_repeats_10deg = 3;
   }
   p.fixed_steps_s = calc_fixed_step_ladder(scale, quick);
+  p.peer_steps_s = calc_peer_step_ladder(scale, quick);
   // Timings: the median of repeats until a minimum wall time, so a 50 µs run is not timed once.
   p.full_repeats = quick ? RepeatPolicy{1, 50, 0.0} : RepeatPolicy{3, 50, 0.3};
+  p.peer_repeats = p.full_repeats;
   p.reduced_repeats = quick ? RepeatPolicy{1, 200, 0.02} : RepeatPolicy{3, 200, 0.1};
   return p;
 }
