@@ -34,6 +34,9 @@ void check_options(const Scene& scene, const MjcfOptions& o) {
   auto bad = [&](const std::string& field, const std::string& why) {
     throw SceneError(scene.source_file, 0, field, why);
   };
+  // MJCF's ground is the body "world": a scene body of that name would be a second one.
+  if (scene.find_body("world"))
+    bad("bodies.world.name", "'world' is MJCF's name for ground; rename the body to export the scene as MJCF");
   if (!o.reference_q.empty() && o.reference_q.size() != scene.joints.size())
     bad("reference_q", fmt::format("{} coordinates for {} joints", o.reference_q.size(), scene.joints.size()));
   for (double q : o.reference_q)

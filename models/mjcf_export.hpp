@@ -38,8 +38,9 @@ struct MjcfOptions {
 // so both engines simulate the same bodies.
 std::vector<bool> calc_foldable_gears(const Scene& scene);
 
-// The MJCF document. Throws SceneError for options out of range (reference_q of the wrong
-// size or not finite, a time step ≤ 0, an unknown integrator).
+// The MJCF document. Throws SceneError for a body named "world" (MJCF's ground) and for options
+// out of range (reference_q of the wrong size or not finite, a time step ≤ 0, an unknown
+// integrator).
 std::string export_mjcf(const Scene& scene, const MjcfOptions& options = {});
 
 // Text for an XML attribute value or element content: & < > " ' as character references,

@@ -43,7 +43,8 @@ PeerLadder run_mujoco_ladder(const models::Scene& scene, const JointState& start
   ladder.how = fmt::format(
       "MuJoCo {} ({} integrator) at fixed steps, each shortened to fill the {:g} s output interval with whole steps; "
       "the scene exported as MJCF (rdyn export-mjcf --fold), loops as connect equalities with solref = [2·step, 1], "
-      "solimp = [{:g}, {:g}, 0.001]; loads applied at every evaluation; started from the full model's assembled state.",
+      "solimp = [{:g}, {:g}, 0.001]; loads applied at every evaluation; started from the full model's assembled state; "
+      "timed with its outputs, like the reduced model (its fixed step is not capped by them).",
       ladder.version, integrator == "rk4" ? "RK4" : "semi-implicit Euler", v.output_interval_s, settings.impedance,
       settings.impedance);
   for (double h0 : plan.peer_steps_s) {

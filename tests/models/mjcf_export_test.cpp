@@ -237,6 +237,14 @@ TEST(MjcfExport, OptionsOutOfRangeAreSceneErrors) {
   o = {};
   o.integrator = "implicit";
   EXPECT_EQ(refused(o), "integrator");
+  Scene world = s;
+  world.bodies[0].name = "world";  // valid in rdyn, MJCF's ground in MuJoCo
+  try {
+    export_mjcf(world);
+    ADD_FAILURE() << "a body named world was exported";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.field(), "bodies.world.name");
+  }
 }
 
 }  // namespace
