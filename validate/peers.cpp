@@ -19,6 +19,9 @@ JointState calc_initial_joint_state(const models::Scene& scene) {
 }
 
 void check_peers(const std::vector<std::string>& peers) {
+  for (size_t i = 0; i < peers.size(); ++i)
+    for (size_t k = 0; k < i; ++k)
+      if (peers[i] == peers[k]) throw ArgumentError("--peers: '" + peers[i] + "' given twice");
   for (const auto& p : peers) {
     if (p != "mujoco") throw ArgumentError("--peers: unknown peer '" + p + "' (mujoco)");
     if (!engine::mujoco_available())

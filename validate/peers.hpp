@@ -23,7 +23,8 @@ struct JointState {
 JointState calc_initial_joint_state(const models::Scene& scene);
 
 // Peers `rdyn validate --peers` accepts, and whether this build can run `name` (MuJoCo only when
-// CMake found it). check_peers throws ArgumentError (exit 2) for an unknown or absent peer.
+// CMake found it). check_peers throws ArgumentError (exit 2) for an unknown, absent or repeated
+// peer.
 inline const std::vector<std::string> kPeers{"mujoco"};
 void check_peers(const std::vector<std::string>& peers);
 

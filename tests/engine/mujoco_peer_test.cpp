@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/kinetostatic.hpp"
@@ -153,6 +154,33 @@ initial: {q_deg: -60, qdot: 2.0}
   // differ by 2.8e-6 J at the end (the motions' own difference).
   EXPECT_NEAR(rk4.energy.back(), c.ref.energy.back(), 1e-5 * eb.energy_scale_J);
   EXPECT_NEAR(rk4.work.back(), c.ref.work.back(), 1e-5 * eb.energy_scale_J);
+}
+
+// Every shipped scene (revolute and prismatic joints, folded and unfolded gears, springs, motors)
+// compiles in MuJoCo and moves: 0.1 s at 0.1 ms from the assembled state, loops closed to 1 mm.
+TEST(MujocoPeer, EveryShippedSceneLoadsAndMoves) {
+  if (!mujoco_available()) GTEST_SKIP() << "rdyn was built without MuJoCo";
+  int scenes = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(RDYN_SCENES)) {
+    if (e.path().extension() != ".yaml") continue;
+    ++scenes;
+    const auto s = models::load_scene(e.path().string());
+    const auto st = assembled(s);
+    MujocoSettings ms;
+    ms.timestep_s = 1e-4;
+    MujocoModel m(s, st.q, ms);
+    MujocoRunOptions ro;
+    ro.duration_s = 0.1;
+    ro.output_interval_s = 0.01;
+    ro.initial_u = st.u;
+    const auto ts = simulate_mujoco(m, ro);
+    ASSERT_EQ(ts.t.size(), 11u) << e.path();
+    EXPECT_NEAR(ts.q.front(), s.initial.q, 1e-12) << e.path();
+    EXPECT_NEAR(ts.qdot.front(), s.initial.qdot, 1e-12) << e.path();
+    EXPECT_LT(ts.stats.max_constraint_error, 1e-3) << e.path();
+    if (s.initial.qdot != 0) EXPECT_NE(ts.q.back(), ts.q.front()) << e.path();
+  }
+  EXPECT_GE(scenes, 11);
 }
 
 TEST(MujocoPeer, SettingsAndOptionsOutOfRangeAreEngineErrors) {

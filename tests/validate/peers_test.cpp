@@ -110,6 +110,10 @@ TEST_F(ExportMjcfCli, PeersOptionNeedsMujocoAtBuildTime) {
   auto r = rdyn({"validate", "fourbar", "--quick", "--peers", "bullet", "--out", "v"});
   EXPECT_EQ(r.status, 2);
   EXPECT_FALSE(fs::exists(dir_ / "v"));
+  r = rdyn({"validate", "fourbar", "--quick", "--peers", "mujoco", "--peers", "mujoco", "--out", "v"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("given twice"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "v"));
   if (engine::mujoco_available()) {
     EXPECT_NO_THROW(check_peers({"mujoco"}));
     return;
