@@ -14,7 +14,10 @@
 #include "models/scene_yaml.hpp"
 #include "run_rdyn.hpp"
 #include "tests/validate/run_records.hpp"
+#include "tests/validate/validation_fixture.hpp"
 #include "validate/commands.hpp"
+#include "validate/report.hpp"
+#include "validate/summary.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -104,6 +107,40 @@ TEST(AnalysePeers, SpeedupPerLadderAtMatchedError) {
   v.fail("a threshold missed");
   analyse_peers(v);
   EXPECT_FALSE(v.peers[0].speedup_at_matched_error);
+}
+
+// The peers' series, speedup and "how" are rendered from summary.json alone; text from the
+// summary is escaped for gnuplot and HTML (a hand-edited summary is input like any other).
+TEST_F(ExportMjcfCli, PeersAreRenderedFromTheSummaryAlone) {
+  ValidationResult v = test::synthetic_validation();
+  PeerLadder p;
+  p.engine = "mujoco'<b>";
+  p.integrator = "euler";
+  p.how = "how <i>it</i> ran";
+  p.runs = {test::record("mujoco", 0.03, {{"qdot", 1e-4}, {v.headline_quantity, 8e-4}}),
+            test::record("mujoco", 0.3, {{"qdot", 1e-5}, {v.headline_quantity, 1e-4}})};
+  p.runs[0].fixed_step_s = 1e-3;
+  p.runs[1].fixed_step_s = 1e-4;
+  for (auto& r : p.runs) r.integrator = "euler";
+  p.speedup_at_matched_error = 123.0;
+  p.matched_peer = 0;
+  p.matched_reduced = 0;
+  v.peers = {p};
+  v.full_timing = "timed with one output";
+  const auto s = summary_json(v);
+  ASSERT_EQ(s.at("peers").size(), 1u);
+  EXPECT_EQ(s.at("peers")[0].at("runs")[1].at("fixed_step_s").get<double>(), 1e-4);
+  EXPECT_EQ(s.at("peers")[0].at("speedup_at_matched_error").get<double>(), 123.0);
+  fs::create_directories(dir_ / "r");
+  render_report(s, (dir_ / "r").string());
+  EXPECT_EQ(test::slurp(dir_ / "r" / "pareto_peer0.csv"),
+            "wall_s,error,label\n0.03,0.0008,mujoco euler h=1 ms\n0.3,0.0001,mujoco euler h=0.1 ms\n");
+  const std::string gp = test::slurp(dir_ / "r" / "pareto.gp");
+  EXPECT_NE(gp.find("title 'mujoco''<b> euler (fixed steps)'"), std::string::npos) << gp;
+  const std::string html = test::slurp(dir_ / "r" / "report.html");
+  EXPECT_NE(html.find("how &lt;i&gt;it&lt;/i&gt; ran"), std::string::npos);
+  EXPECT_NE(html.find("is 123× faster than mujoco&#39;&lt;b&gt;"), std::string::npos);
+  EXPECT_NE(html.find("timed with one output"), std::string::npos);
 }
 
 TEST_F(ExportMjcfCli, PeersOptionNeedsMujocoAtBuildTime) {
