@@ -2,7 +2,7 @@
 //
 // With q as the independent variable and u = q̇²/2 (so du/dq = q̈), Eksergian's equation
 //   m1(q) q̈ + m2(q) q̇² = F*(q, q̇)   reads   m1(q) du/dq + 2 m2(q) u = F*(q, s·√(2u)),
-// s = sign q̇ (fixed over the cycle), and time follows from dt = dq/q̇ (docs/theory.md §6c).
+// s = sign q̇ (fixed over the cycle), and time follows from dt = dq/q̇ (docs/theory.md §6a).
 // One pass over a period P of the table maps u at the section q_s to u after the period,
 // u ↦ Φ(u); the steady cycle is the fixed point u = Φ(u), found by the secant method on
 // Φ(u) − u. Rate-gated loads switch where sign(r_g(q)·q̇) changes: with s fixed those are

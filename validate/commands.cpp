@@ -27,7 +27,9 @@
 #include "validate/sweep.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
+#include "validate/peers.hpp"
 #include "validate/timeseries_csv.hpp"
+#include "models/mjcf_export.hpp"
 
 namespace rdyn::validate {
 
@@ -83,6 +85,7 @@ void require_timing(double duration, double dt_out) {
 
 // Recognisers of rdyn's own single-file outputs, so a re-run may replace them.
 bool is_rdyn_table(const std::string& head) { return head.rfind("# rdyn-table", 0) == 0; }
+bool is_rdyn_mjcf(const std::string& head) { return head.rfind("<mujoco model=", 0) == 0; }
 bool is_rdyn_calibrated_scene(const std::string& head) { return head.rfind("# Calibrated by `rdyn calibrate`", 0) == 0; }
 bool is_rdyn_sweep(const std::string& head) {
   // Shard 0 starts with the header; other shards with a case row "<index>,...,ok|error,".
@@ -410,6 +413,7 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
   OutputDir out(a.out, a.force);
   ValidationOptions opt;
   opt.quick = !a.thorough;
+  opt.peers = a.peers;
   nlohmann::json scenes = nlohmann::json::array();
   bool all_pass = true;
   std::string rows;
@@ -487,12 +491,14 @@ int run_validate(const ValidateArgs& a) {
   if (!a.suite.empty() && !a.scene.empty()) throw ArgumentError("give a scene or --suite, not both");
   if (a.suite.empty() && a.scene.empty()) throw ArgumentError("give a scene or --suite FOLDER");
   if (a.quick && a.thorough) throw ArgumentError("--quick and --thorough: give one of them");
+  check_peers(a.peers);  // before any work: a peer this build cannot run is exit 2
   Progress progress;
   if (!a.suite.empty()) return run_suite(a, progress);
   const auto scene = load(a.scene, a.sets);
   OutputDir out(a.out, a.force);
   ValidationOptions opt;
   opt.quick = a.quick;
+  opt.peers = a.peers;
   const ValidationResult v = run_validation(scene, opt, progress);
   const nlohmann::json summary = summary_json(v);
   render_report(summary, out.file(""));
@@ -500,6 +506,20 @@ int run_validate(const ValidateArgs& a) {
   std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
   if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
   return v.pass ? 0 : 1;
+}
+
+int run_export_mjcf(const ExportMjcfArgs& a) {
+  require_in("--timestep", a.timestep_s, kMinFixedStep_s, kMaxFixedStep_s, " s");
+  const models::Scene scene = load(a.scene, a.sets);
+  OutputFile out(a.out, a.force, is_rdyn_mjcf);  // fails early on an unusable destination
+  models::MjcfOptions opt;
+  opt.reference_q = calc_initial_joint_state(scene).q;  // loops closed where MJCF infers its anchors
+  opt.fold_geared_bodies = a.fold;
+  opt.timestep_s = a.timestep_s;
+  opt.integrator = a.integrator;
+  out.write(models::export_mjcf(scene, opt));
+  out.commit();
+  return 0;
 }
 
 }  // namespace rdyn::validate

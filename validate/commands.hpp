@@ -73,6 +73,7 @@ struct ValidateArgs {
   bool quick = false;     // short ladders (default for --suite)
   bool thorough = false;  // full ladders even for --suite
   bool force = false;
+  std::vector<std::string> peers;  // peer engines beside the full model (validate/peers.hpp)
 };
 int run_validate(const ValidateArgs& args);
 
@@ -97,5 +98,18 @@ struct SweepArgs {
   bool force = false;
 };
 int run_sweep_command(const SweepArgs& args);
+
+// `rdyn export-mjcf`: the scene as MJCF (MuJoCo XML), its loops closed at the assembled initial
+// configuration (models/mjcf_export.hpp).
+struct ExportMjcfArgs {
+  std::string scene;
+  std::vector<std::string> sets;
+  std::string out = "/dev/stdout";
+  bool force = false;
+  bool fold = false;             // fold geared bodies into their drivers
+  double timestep_s = 1e-3;      // <option timestep>
+  std::string integrator = "Euler";
+};
+int run_export_mjcf(const ExportMjcfArgs& args);
 
 }  // namespace rdyn::validate

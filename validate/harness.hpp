@@ -20,8 +20,23 @@
 
 namespace rdyn::validate {
 
+// Fewest output samples over which an error maximum is claimed (a 20-point maximum of a
+// smooth signal sampled at 1/20 of its cycle still resolves its peak to ~1 %).
+constexpr long kMinComparedSamples = 20;
+
 struct ValidationOptions {
   bool quick = false;  // shorter ladders and single repeats (suites, smoke runs)
+  std::vector<std::string> peers;  // peer engines to run beside the full model ("mujoco")
+};
+
+// One peer engine's ladder (validate/peers.hpp): fixed-step runs with one integrator, and the
+// reduced model's speedup over it at matched error.
+struct PeerLadder {
+  std::string engine, version, integrator;
+  std::string how;  // how it was run, in plain words
+  std::vector<RunRecord> runs;
+  std::optional<double> speedup_at_matched_error;
+  int matched_peer = -1, matched_reduced = -1;  // indices into runs and ValidationResult::runs
 };
 
 struct ValidationResult {
@@ -36,6 +51,9 @@ struct ValidationResult {
   Comparison reference_change;  // reference at half its tolerance vs the reference
   SteadyWindow window;
   std::vector<RunRecord> runs;
+  std::string full_timing;  // how the full-model ladder was timed (fair baseline), plain words
+  std::vector<PeerLadder> peers;
+  std::vector<double> peer_steps;  // peer ladders' fixed steps before fitting the output grid [s]
   std::vector<ExtractionRecord> extractions;
   double extraction_ms = 0.0;  // the 10° table
   double tightest_tolerance = 0.0;  // of the reduced rk8pd ladder
@@ -78,6 +96,12 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
 // tolerance is halved, the compared window and the scene's time scale, into `v` (whose
 // duration, output interval and reference tolerance are set).
 void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress);
+
+// A ladder run's timing (median of the repeats), stability metrics and errors against the
+// reference; and a run that stopped, recorded with its reason and infinite cost and errors.
+void finish_run(RunRecord& r, const std::vector<double>& walls, const models::TimeSeries& ts,
+                const ValidationResult& v);
+void mark_stopped(RunRecord& r, const std::string& why, const std::vector<std::string>& quantities);
 
 // Stage 4 (no simulation): Pareto front, matched-error speedup, recommended setting and
 // convergence series from v.runs.

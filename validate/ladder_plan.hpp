@@ -24,7 +24,11 @@ struct LadderPlan {
   std::vector<double> rk8pd_tolerances;  // ascending accuracy; the last is the tightest
   bool rkck = false;                     // one rkck run at 1e-8 per variant
   std::vector<double> fixed_steps_s;     // rk4-fixed, from the time scale
-  RepeatPolicy full_repeats, reduced_repeats;
+  std::vector<double> peer_steps_s;      // peer engines' fixed steps, from the time scale
+  // Full-model runs are timed with one output at the end (fair baseline: the output grid does
+  // not cap the step); their errors come from one untimed run on the output grid.
+  bool time_full_without_outputs = true;
+  RepeatPolicy full_repeats, reduced_repeats, peer_repeats;
   int extraction_repeats_10deg = 1;  // median of this many for the 10° table
   double tightest_tolerance() const { return rk8pd_tolerances.back(); }
   long reduced_runs() const;  // runs of the reduced ladder

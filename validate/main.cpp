@@ -11,6 +11,7 @@
 #include "validate/commands.hpp"
 #include "validate/inspect.hpp"
 #include "validate/output_dir.hpp"
+#include "validate/peers.hpp"
 
 namespace {
 constexpr int kExitBadInput = 2;
@@ -125,6 +126,11 @@ int main(int argc, char** argv) {
   validate->add_option("--set", val.sets, "Override a scalar of the scene(s): key.path=value (repeatable)");
   validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
   validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
+  validate->add_option("--peers", val.peers,
+                       "Peer engines to run beside the full model: mujoco (MuJoCo's Euler and RK4 at fixed steps from "
+                       "the scene's time scale, in summary.json's peers and the accuracy-against-cost figure; needs "
+                       "rdyn built with MuJoCo)")
+      ->check(CLI::IsMember(kPeers));
 
   ReportArgs rep;
   auto* report = app.add_subcommand(
@@ -166,6 +172,20 @@ int main(int argc, char** argv) {
       "dead points, found by continuation) and warnings (also on standard error).");
   inspect->add_option("scene", ins.scene, "Scene name or YAML file")->required();
   inspect->add_option("--set", ins.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  ExportMjcfArgs mj;
+  auto* export_mjcf = app.add_subcommand(
+      "export-mjcf",
+      "Write the scene as MJCF (MuJoCo XML): bodies, hinges and slides, loops as connect equalities and gears as "
+      "joint equalities, written at the assembled initial configuration; a comment lists the loads MJCF cannot "
+      "express (rdyn's MuJoCo runner applies them at every step).");
+  export_mjcf->add_option("scene", mj.scene, "Scene name or YAML file")->required();
+  export_mjcf->add_option("--out", mj.out, "Output XML file (default: standard output)");
+  export_mjcf->add_flag("--force", mj.force, kForceHelpFile);
+  export_mjcf->add_option("--set", mj.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  export_mjcf->add_flag("--fold", mj.fold, "Fold geared bodies into their drivers (as the full model does)");
+  export_mjcf->add_option("--timestep", mj.timestep_s, "<option timestep> [s] (default 1e-3)");
+  export_mjcf->add_option("--integrator", mj.integrator, "<option integrator>: Euler or RK4")
+      ->check(CLI::IsMember({"Euler", "RK4"}));
 
   try {
     app.parse(argc, argv);
@@ -191,6 +211,7 @@ int main(int argc, char** argv) {
     if (*sweep) return run_sweep_command(sw);
     if (*report) return run_report(rep);
     if (*inspect) return run_inspect(ins);
+    if (*export_mjcf) return run_export_mjcf(mj);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

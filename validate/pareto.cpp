@@ -21,11 +21,11 @@ void mark_pareto(std::vector<RunRecord>& runs, const std::string& q) {
 }
 
 MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& q,
-                                    double target) {
+                                    double target, const std::string& baseline) {
   MatchedSpeedup m;
   for (size_t i = 0; i < runs.size(); ++i) {
     const auto& r = runs[i];
-    if (r.model != "full" || !r.failure.empty() || !(r.error_of(q) <= target)) continue;
+    if (r.model != baseline || !r.failure.empty() || !(r.error_of(q) <= target)) continue;
     if (m.full < 0 || r.wall_s < runs[m.full].wall_s) m.full = static_cast<int>(i);
   }
   if (m.full < 0) return m;

@@ -20,10 +20,11 @@ struct MatchedSpeedup {
   std::optional<double> speedup;  // full wall / reduced wall
 };
 
-// The cheapest full run within `target` on `quantity`, then the cheapest reduced run at equal
-// or better error; the speedup is their cost ratio.
+// The cheapest `baseline` run ("full", or a peer engine's model name) within `target` on
+// `quantity`, then the cheapest reduced run at equal or better error; the speedup is their cost
+// ratio.
 MatchedSpeedup calc_matched_speedup(const std::vector<RunRecord>& runs, const std::string& quantity,
-                                    double target);
+                                    double target, const std::string& baseline = "full");
 
 // The cheapest completed reduced run within `target` on every one of `quantities`; −1 if none.
 int pick_recommended(const std::vector<RunRecord>& runs, const std::vector<std::string>& quantities,

@@ -163,6 +163,21 @@ void write_pareto(const json& s, const std::string& dir) {
   write_text_file(dir + "/pareto_reduced.csv", red);
   write_text_file(dir + "/pareto_front.csv", front);
   write_text_file(dir + "/pareto_full.csv", full);
+  // Peer engines' ladders (summary.json "peers"), one series each, files by index.
+  std::string peer_plots;
+  const json peers = s.value("peers", json::array());
+  for (size_t i = 0; i < peers.size(); ++i) {
+    std::string csv = "wall_s,error,label\n";
+    for (const auto& r : peers[i].value("runs", json::array())) {
+      const double w = d(r, "wall_s"), e = error_of(r, Q);
+      if (std::isfinite(w) && std::isfinite(e))
+        csv += fmt::format("{:.6g},{:.6g},{}\n", w, std::max(e, 1e-12), csv_field(str(r, "label")));
+    }
+    write_text_file(dir + fmt::format("/pareto_peer{}.csv", i), csv);
+    peer_plots += fmt::format(", 'pareto_peer{}.csv' skip 1 using 1:2 with linespoints pt {} lw 2 title {}", i, 8 + i,
+                              gnuplot_quoted(str(peers[i], "engine") + " " + str(peers[i], "integrator") +
+                                             " (fixed steps)"));
+  }
   write_text_file(
       dir + "/pareto.gp",
       fmt::format("# Error of {0} (max over the compared window, relative to its peak) against "
@@ -184,14 +199,41 @@ void write_pareto(const json& s, const std::string& dir) {
               "rgb '#d62728' "
               "title 'reduced Pareto front', 'pareto_full.csv' skip 1 using 1:2 with linespoints "
               "pt 5 lw 2 lc "
-              "rgb '#1f77b4' title 'full model (tolerance ladder)', {0:g} with lines dt 2 lc rgb "
+              "rgb '#1f77b4' title 'full model (tolerance ladder)'{3}, {0:g} with lines dt 2 lc rgb "
               "'#555555' "
               "title 'matched-error target'\n",
               // A hand-edited summary without it: the harness's default (ValidationResult).
               std::isfinite(d(s, "matched_error_target")) ? d(s, "matched_error_target") : 1e-3,
               gnuplot_quoted(Q + " error / peak"),
               gnuplot_quoted(
-                  fmt::format("computing time for the {} s run [s]", num(d(s, "duration_s"))))));
+                  fmt::format("computing time for the {} s run [s]", num(d(s, "duration_s")))),
+              peer_plots));
+}
+
+// How the baselines were run (fair timing) and the peers' speedups, under figure 3.
+std::string baselines_note(const json& s) {
+  std::string h;
+  if (s.contains("full_model_timing")) h += "<p>" + H(str(s, "full_model_timing")) + "</p>";
+  for (const auto& p : s.value("peers", json::array())) {
+    h += "<p>" + H(str(p, "how")) + " ";
+    const json& sp = p.contains("speedup_at_matched_error") ? p.at("speedup_at_matched_error") : json(nullptr);
+    if (sp.is_number() && p.at("matched_peer").is_object() && p.at("matched_reduced").is_object()) {
+      h += fmt::format("At matched {} error the reduced model ({}) is {:.3g}× faster than {} ({}), counting "
+                       "integration only",
+                       H(str(s, "headline_quantity")), H(str(p.at("matched_reduced"), "label")), sp.get<double>(),
+                       H(str(p, "engine")), H(str(p.at("matched_peer"), "label")));
+      // Its table is extracted once per mechanism: say what that costs beside one run.
+      for (const auto& e : s.value("extractions", json::array()))
+        if (d(e, "grid_deg") == d(p.at("matched_reduced"), "grid_deg"))
+          h += fmt::format("; its {}° table costs {} ms to extract once", num(d(e, "grid_deg")), num(d(e, "ms")));
+      h += ".";
+    } else {
+      h += "No speedup is claimed over this ladder (no run within the matched-error target, or no reduced run as "
+           "accurate).";
+    }
+    h += "</p>";
+  }
+  return h;
 }
 
 // Figure 4 data and script: error against grid step per interpolation.
@@ -520,7 +562,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
                        ? "<h2>2. Full and reduced model toward the end of the run</h2>"
                        : "<h2>2. Full and reduced model over the last periods</h2>") +
        svg_or_note(figures, "timeseries");
-  h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto");
+  h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto") + baselines_note(s);
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");
   h += "<p>Observed orders (fitted above 10× the reference's own change, " +
        pct(d(s.at("convergence"), "floor")) + "):";

@@ -10,16 +10,21 @@
 namespace rdyn::validate {
 
 struct RunRecord {
-  std::string model;  // "full" or "reduced"
+  std::string model;  // "full", "reduced" or a peer engine ("mujoco")
   double tolerance = 0.0;
   std::string integrator;
   double grid_deg = 0.0;      // reduced
   std::string interpolation;  // reduced
   bool energy_consistent = false;
-  double fixed_step_s = 0.0;     // rk4-fixed
+  double fixed_step_s = 0.0;     // rk4-fixed, and a peer's fixed step
   double wall_s = 0.0;           // median over repeats, the run as simulated [s]
   double per_simulated_s = 0.0;  // wall_s / duration [s per simulated s]
   int repeats = 0;
+  // Full model (fair baseline): the timed repeats write outputs this far apart (the whole run), so
+  // the output grid never caps Simbody's step; errors and the statistics below come from one more
+  // run of the same settings on the output grid. 0: timed on the output grid.
+  double timed_output_interval_s = 0.0;
+  long timed_steps = 0;  // steps of the timed run
   long steps = 0;
   long rejected = 0;  // rejected steps (error control)
   double smallest_step_s = 0.0;

@@ -125,6 +125,12 @@ nlohmann::json run_json(const RunRecord& r) {
                       {"pareto", r.pareto}};
   if (!r.failure.empty()) j["failure"] = r.failure;
   if (r.model == "full") j["constraint_violation_m"] = num(r.constraint_violation_m);
+  if (r.model == "full" && r.timed_output_interval_s > 0) j["timed_output_interval_s"] = r.timed_output_interval_s;
+  if (r.model == "full" || (r.model != "reduced" && r.failure.empty())) j["timed_steps"] = r.timed_steps;
+  if (r.model != "full" && r.model != "reduced") {  // a peer engine's fixed-step run
+    j["fixed_step_s"] = r.fixed_step_s;
+    j["constraint_violation_m"] = num(r.constraint_violation_m);
+  }
   if (r.model == "reduced") {
     j["grid_deg"] = r.grid_deg;
     j["interpolation"] = r.interpolation;
@@ -216,6 +222,24 @@ nlohmann::json summary_json(const ValidationResult& v) {
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& r : v.runs) runs.push_back(run_json(r));
   j["runs"] = runs;
+  j["full_model_timing"] = v.full_timing;
+  // Peer engines (issue #11): each ladder's runs and the reduced model's speedup over it.
+  nlohmann::json peers = nlohmann::json::array();
+  for (const auto& p : v.peers) {
+    nlohmann::json pr = nlohmann::json::array();
+    for (const auto& r : p.runs) pr.push_back(run_json(r));
+    peers.push_back({{"engine", p.engine},
+                     {"version", p.version},
+                     {"integrator", p.integrator},
+                     {"how", p.how},
+                     {"runs", pr},
+                     {"speedup_at_matched_error",
+                      p.speedup_at_matched_error ? num(*p.speedup_at_matched_error) : nlohmann::json(nullptr)},
+                     {"matched_peer", p.matched_peer >= 0 ? run_json(p.runs[p.matched_peer]) : nlohmann::json(nullptr)},
+                     {"matched_reduced",
+                      p.matched_reduced >= 0 ? run_json(v.runs[p.matched_reduced]) : nlohmann::json(nullptr)}});
+  }
+  j["peers"] = peers;
   if (v.calibration) j["calibration"] = calibration_json(v);
   nlohmann::json th = nlohmann::json::array();
   for (const auto& t : v.thresholds)

@@ -31,9 +31,10 @@ TimeScale calc_time_scale(const models::TimeSeries& ref, bool rotating) {
   return s;
 }
 
-std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
-  const std::vector<double> fractions =
-      quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 50, 25};
+namespace {
+
+// period / fraction for each fraction, capped at duration / kMinFixedSteps; distinct, ascending.
+std::vector<double> steps_from_fractions(const TimeScale& ts, const std::vector<double>& fractions) {
   const double h_max = ts.duration_s / kMinFixedSteps;
   std::vector<double> h;
   for (double f : fractions) {
@@ -45,6 +46,16 @@ std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
                       [](double a, double b) { return std::abs(a - b) <= 1e-12 * b; }),
           h.end());
   return h;
+}
+
+}  // namespace
+
+std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
+  return steps_from_fractions(ts, quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 50, 25});
+}
+
+std::vector<double> calc_peer_step_ladder(const TimeScale& ts, bool quick) {
+  return steps_from_fractions(ts, quick ? std::vector<double>{1000} : std::vector<double>{10000, 3000, 1000, 300});
 }
 
 }  // namespace rdyn::validate

@@ -31,6 +31,12 @@ TimeScale calc_time_scale(const models::TimeSeries& reference, bool rotating);
 // `quick`: the period/200 step only.
 std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick);
 
+// Fixed steps of a peer engine's ladder (MuJoCo): period/10000 … period/300 (0.1–3 ms for a 1 s
+// cycle: MuJoCo's soft loop closures need steps ~10× finer than the reduced model's RK4 for the
+// same constraint-force error), each capped so the run takes at least kMinFixedSteps; ascending.
+// `quick`: the period/1000 step only.
+std::vector<double> calc_peer_step_ladder(const TimeScale& ts, bool quick);
+
 // Whether a cost per simulated second is a measurement (the run lasted at least that long).
 inline bool per_second_is_measured(double duration_s) {
   return duration_s >= kMinDurationPerSecond_s;

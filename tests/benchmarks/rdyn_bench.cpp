@@ -14,6 +14,8 @@
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
+#include "engine/kinetostatic.hpp"
+#include "engine/mujoco_peer.hpp"
 #include "engine/reduced_source.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/extract.hpp"
@@ -222,6 +224,51 @@ void BM_FullPerSimulatedSecond(benchmark::State& st) {
                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_FullPerSimulatedSecond)->Arg(6)->Arg(10)->Unit(benchmark::kMillisecond);
+
+// The same over 5 s with one output at the end (the fair baseline of `rdyn validate`: the output
+// grid does not cap Simbody's step), RK-Merson at 1e-4…1e-6 (range: −log10 tolerance).
+void BM_FullFairPerSimulatedSecond(benchmark::State& st) {
+  engine::FullModel full(bicycle());
+  engine::ForwardOptions o;
+  o.duration_s = 5.0;
+  o.output_interval_s = 5.0;
+  o.tolerance = std::pow(10.0, -static_cast<double>(st.range(0)));
+  long steps = 0;
+  for (auto _ : st) steps = engine::simulate_full(full, o).stats.steps_taken;
+  st.counters["steps"] = static_cast<double>(steps);
+  st.counters["s_per_simulated_s"] = benchmark::Counter(o.duration_s * st.iterations(),
+                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_FullFairPerSimulatedSecond)->Arg(4)->Arg(5)->Arg(6)->Unit(benchmark::kMillisecond);
+
+// MuJoCo (peer) on the bicycle, 5 s with 5 ms outputs, per simulated second: range(0) 0 Euler,
+// 1 RK4; range(1) the step in µs.
+void BM_MujocoPerSimulatedSecond(benchmark::State& st) {
+  if (!engine::mujoco_available()) {
+    st.SkipWithError("rdyn was built without MuJoCo");
+    return;
+  }
+  engine::FullModel full(bicycle());
+  engine::FullWorkspace ws(full);
+  const auto k = engine::calc_kinetostatic(full, ws, bicycle().initial.q, bicycle().initial.qdot, 0, engine::Loads::Off);
+  engine::MujocoSettings ms;
+  ms.integrator = st.range(0) == 0 ? "euler" : "rk4";
+  ms.timestep_s = engine::calc_peer_step(st.range(1) * 1e-6, 0.005);
+  const engine::MujocoModel m(bicycle(), k.joint_q, ms);
+  engine::MujocoRunOptions o;
+  o.duration_s = 5.0;
+  o.output_interval_s = 0.005;
+  o.initial_u = k.joint_u;
+  for (auto _ : st) benchmark::DoNotOptimize(engine::simulate_mujoco(m, o).q.back());
+  st.counters["s_per_simulated_s"] = benchmark::Counter(o.duration_s * st.iterations(),
+                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_MujocoPerSimulatedSecond)
+    ->Args({0, 1000})
+    ->Args({0, 100})
+    ->Args({1, 1000})
+    ->Args({1, 100})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -2,13 +2,19 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace rdyn::validate {
 namespace {
 
 TEST(LadderPlan, FullAndQuickLadders) {
   const TimeScale one_second{1.0, 5.0, ""};
   const auto p = plan_ladders(one_second, false);
-  EXPECT_EQ(p.full.size(), 10u);
+  EXPECT_EQ(p.full.size(), 13u);
+  for (const char* integrator : {"rkmerson", "rk3", "cpodes"})  // every Simbody integrator has a ladder
+    EXPECT_GE(std::count_if(p.full.begin(), p.full.end(), [&](const auto& f) { return f.first == integrator; }), 3)
+        << integrator;
+  EXPECT_TRUE(p.time_full_without_outputs);  // fair baseline: the output grid does not cap the step
   EXPECT_EQ(p.grids_deg.front(), 30);
   EXPECT_EQ(p.grids_deg.back(), 0.5);
   EXPECT_EQ(p.tightest_tolerance(), 1e-10);

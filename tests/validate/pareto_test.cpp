@@ -47,6 +47,19 @@ TEST(Pareto, MatchedSpeedupTakesTheCheapestOnBothSides) {
   EXPECT_FALSE(none.speedup);
 }
 
+// A peer engine is a baseline like the full model: its runs only, never the full model's.
+TEST(Pareto, MatchedSpeedupAgainstAPeerUsesThePeersRunsOnly) {
+  auto runs = ladder();
+  runs.push_back(record("mujoco", 0.05, {{"qdot", 1e-4}, {"F", 9.5e-4}}));  // 7: within 1e-3
+  runs.push_back(record("mujoco", 0.01, {{"qdot", 1e-3}, {"F", 5e-3}}));    // 8: outside
+  const auto m = calc_matched_speedup(runs, "F", 1e-3, "mujoco");
+  EXPECT_EQ(m.full, 7);
+  EXPECT_EQ(m.reduced, 3);  // 9e-4 ≤ 9.5e-4: the cheapest as accurate
+  ASSERT_TRUE(m.speedup);
+  EXPECT_DOUBLE_EQ(*m.speedup, 0.05 / 0.002);
+  EXPECT_EQ(calc_matched_speedup(runs, "F", 1e-3).full, 1);  // the default baseline is still the full model
+}
+
 TEST(Pareto, RecommendedIsTheCheapestWithinTheTargetOnEveryQuantity) {
   const auto runs = ladder();
   EXPECT_EQ(pick_recommended(runs, {"qdot", "F"}, 1e-3), 3);

@@ -33,6 +33,18 @@ TEST(TimeScale, OneRevolutionAtThePeakSpeed) {
   EXPECT_EQ(calc_fixed_step_ladder(s, true), std::vector<double>{5e-3});
 }
 
+// MuJoCo's ladder: 0.1, 0.33, 1, 3.3 ms for a 1 s cycle; capped like the reduced ladder.
+TEST(TimeScale, PeerLadderIsTenTimesFinerAndCappedTheSameWay) {
+  const auto s = calc_time_scale(spinning(2 * M_PI, 5.0), true);
+  const auto h = calc_peer_step_ladder(s, false);
+  const std::vector<double> expected{1e-4, 1.0 / 3000, 1e-3, 1.0 / 300};
+  ASSERT_EQ(h.size(), expected.size());
+  for (size_t i = 0; i < h.size(); ++i) EXPECT_NEAR(h[i], expected[i], 1e-15);
+  EXPECT_EQ(calc_peer_step_ladder(s, true), std::vector<double>{1e-3});
+  const auto slow = calc_time_scale(spinning(0.5, 2.0), true);  // no revolution: period = 2 s
+  for (double step : calc_peer_step_ladder(slow, false)) EXPECT_LE(step, 2.0 / kMinFixedSteps * (1 + 1e-12));
+}
+
 TEST(TimeScale, ShortTransientTakesEnoughStepsInEveryRun) {
   // 30 ms at up to 800 rad/s (the squeezing mechanism): period ≈ 7.9 ms.
   const auto s = calc_time_scale(spinning(800.0, 0.03), true);
