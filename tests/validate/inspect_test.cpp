@@ -50,12 +50,8 @@ TEST(InspectCli, FourbarPrintsTheAssembledConfiguration) {
   EXPECT_TRUE(j["warnings"].empty());
 }
 
-const std::string kRockerDriven =
-    "--set independent=rocker --set joints.crank.guess_deg=110 --set joints.coupler.guess_deg=-85 --set "
-    "outputs.constraint_forces.rocker_axial.joint=coupler";
-
 TEST(InspectCli, RockerDrivenRangeHasTwoDeadPoints) {
-  const CliRun r = rdyn("inspect fourbar --set initial.q_deg=110 " + kRockerDriven);
+  const CliRun r = rdyn("inspect fourbar-rocker");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const auto& range = j["range"];
@@ -77,9 +73,18 @@ TEST(InspectCli, RockerDrivenRangeHasTwoDeadPoints) {
 
 TEST(InspectCli, AnInitialQNextToADeadPointIsExitTwo) {
   // The same refusal simulate and extract give: no output, the dead points named.
-  const CliRun r = rdyn("inspect fourbar --set initial.q_deg=90.5 " + kRockerDriven);
+  const CliRun r = rdyn("inspect fourbar-rocker --set initial.q_deg=90.5");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("within 5 % of a dead point of 'rocker' (dead points at 90.19"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST(InspectCli, FourbarRockerNamesItsBranch) {
+  // Guesses of the mirrored assembly (B on the other side of A–C: the coupler's relative angle
+  // changes sign) are refused by the branch the scene names, not assembled silently.
+  const CliRun r = rdyn("inspect fourbar-rocker --set joints.crank.guess_deg=-26 --set joints.coupler.guess_deg=80");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("joint 'coupler' is at 79.56"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
 }
 
