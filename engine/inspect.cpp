@@ -1,16 +1,13 @@
-// Assembly report and range of the independent coordinate (`rdyn inspect`). The range walk is
-// a bounded continuation of its own (engine/reduced_source.cpp keeps extraction's): steps of
-// 2° (or 2 % of the length scale) with the secant predictor of engine/kinetostatic.cpp,
-// quartered on each failed projection, so a dead point is bracketed to kDeadPointTolerance.
+// Assembly report and domain of the independent coordinate (`rdyn inspect`). The domain is the
+// one walk every run uses (engine/independent_range.cpp), so inspect shows what extraction and
+// both models' domain stop will use, not a second estimate of it.
 #include "engine/inspect.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
 
 #include "engine/full_model_impl.hpp"
-#include "engine/kinetostatic.hpp"
 
 namespace rdyn::engine {
 
@@ -19,23 +16,6 @@ using namespace SimTK;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Continuation moves one direction may take (successful and failed): a full turn in 2° steps is
-// 180; each dead point costs ~log4(2°/1e-6 rad) ≈ 8 refinements per approach. 5000 bounds a
-// prismatic walk of kSearchSpan length scales in 2 % steps (500) with room to spare.
-constexpr int kMaxMoves = 5000;
-
-double length_scale(const models::Scene& sc) {
-  double L = 0.0;
-  auto see = [&](models::Vec2 p) { L = std::max(L, std::hypot(p.x, p.y)); };
-  for (const auto& [n, p] : sc.ground_points) see(p);
-  for (const auto& b : sc.bodies) {
-    see(b.com_m);
-    for (const auto& [n, p] : b.points) see(p);
-  }
-  for (const auto& j : sc.joints) see(j.parent_point), see(j.child_point);
-  for (const auto& l : sc.loops) see(l.point_a), see(l.point_b);
-  return L > 0 ? L : 1.0;
-}
 
 // Pose of a scene body in ground at a state realized to Position (folded bodies turn about
 // their ground joint: origin = parent point − R(offset + q)·child point).
@@ -63,30 +43,6 @@ AssembledBody body_pose(const FullModel::Impl& m, const State& s, int b) {
   return out;
 }
 
-// One direction of the range walk from the assembled configuration: the farthest q reached
-// (at most `span` away) and whether a dead point stopped it.
-std::pair<double, bool> walk(const FullModel& model, double dir, double span, double first_step) {
-  FullWorkspace ws(model);
-  const double q0 = model.scene().initial.q;
-  double q = q0, step = first_step;
-  for (int moves = 0; moves < kMaxMoves; ++moves) {
-    if (std::abs(q - q0) >= span) return {q0 + dir * span, false};
-    const double h = std::min(step, span - std::abs(q - q0));
-    const Vector backup = ws.impl().state.getQ();
-    try {
-      move_configuration(model, ws, q + dir * h);
-      q += dir * h;
-    } catch (const EngineError&) {
-      // The loops cannot close at q + h from here: a dead point lies within h.
-      ws.impl().state.updQ() = backup;
-      if (step < kDeadPointTolerance) return {q, true};
-      step /= 4;
-    }
-  }
-  throw models::NumericalError(fmt::format("{}: the range walk of '{}' did not finish in {} continuation moves",
-                                           model.scene().source_file, model.scene().independent, kMaxMoves));
-}
-
 }  // namespace
 
 Inspection calc_assembly(const FullModel& model) {
@@ -96,7 +52,7 @@ Inspection calc_assembly(const FullModel& model) {
   const State& s = ws.impl().state;
   m.system.realize(s, Stage::Position);
   Inspection out;
-  out.length_scale_m = length_scale(sc);
+  out.length_scale_m = calc_length_scale(sc);
   for (size_t j = 0; j < sc.joints.size(); ++j) {
     const auto& jt = sc.joints[j];
     const bool rev = jt.type == models::JointType::Revolute;
@@ -132,30 +88,9 @@ Inspection calc_assembly(const FullModel& model) {
 
 Inspection calc_inspection(const FullModel& model) {
   Inspection out = calc_assembly(model);
-  const auto& sc = model.scene();
-  const bool rev = sc.find_joint(sc.independent)->type == models::JointType::Revolute;
-  const double q0 = sc.initial.q;
-  const double span = rev ? 2 * kPi : kSearchSpan * out.length_scale_m;
-  const double first = rev ? 2 * kPi / 180 : 0.02 * out.length_scale_m;
-  const auto [hi, hi_dead] = walk(model, +1.0, span, first);
-  if (rev && !hi_dead) {
-    out.range = {true, q0 - kPi, q0 + kPi, false, false};
-    return out;
-  }
-  const auto [lo, lo_dead] = walk(model, -1.0, span, first);
-  out.range = {false, lo, hi, lo_dead, hi_dead};
-  const double unit = rev ? 180 / kPi : 1.0;
-  const char* u = rev ? "°" : " m";
-  for (const auto& [at, dead, which] : {std::tuple{lo, lo_dead, "lower"}, std::tuple{hi, hi_dead, "upper"}})
-    if (dead && std::abs(at - q0) < 0.02 * (hi - lo))
-      out.warnings.push_back(fmt::format("the initial {} = {:.6g}{} is within 2 % of the range of its {} dead point "
-                                         "{:.6g}{}: the motion leaves the mechanism's range almost at once",
-                                         sc.independent, q0 * unit, u, which, at * unit, u));
-  if (!rev && !(lo_dead && hi_dead))
-    out.warnings.push_back(fmt::format("no dead point of '{}' within {:g} × the mechanism's size ({:.3g} m) of its "
-                                       "initial value on {}: the range reported is the search's",
-                                       sc.independent, kSearchSpan, out.length_scale_m,
-                                       lo_dead ? "the upper side" : hi_dead ? "the lower side" : "either side"));
+  out.range = calc_independent_domain(model);
+  // Runs still go (the full model runs unbounded), but no reduced table can be built.
+  if (!out.range.unbounded_reason.empty()) out.warnings.push_back(out.range.unbounded_reason);
   return out;
 }
 

@@ -1,13 +1,14 @@
 // What a newcomer needs while writing a scene (`rdyn inspect`): the configuration the full
-// model assembles at t = 0, its degrees of freedom, the loops' closure gaps, and the range
-// of the independent coordinate found by continuation (full turn, or the dead points that
-// bound it). Plain records; no Simbody type here.
+// model assembles at t = 0, its degrees of freedom, the loops' closure gaps, and the domain of
+// the independent coordinate exactly as the models use it (engine/independent_range.hpp: full
+// turn, declared range, or the dead points less the 5 % margin). Plain records; no Simbody type.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
 
 namespace rdyn::engine {
 
@@ -38,38 +39,25 @@ struct MobilityCount {
   int mobilities = 0, rows = 0, rank = 0;
 };
 
-// Range of the independent coordinate reachable from the assembled configuration by
-// continuation on its branch.
-struct CoordinateRange {
-  bool full_turn = false;  // revolute: a whole turn walked without a dead point
-  double q_min = 0.0, q_max = 0.0;  // [rad or m] (full turn: q0 − π, q0 + π)
-  // Each end: a dead point (the loops cannot close beyond it, located to kDeadPointTolerance),
-  // or the end of the search (prismatic coordinates are searched to ± kSearchSpan · length scale).
-  bool min_is_dead_point = false, max_is_dead_point = false;
-};
-
-// Dead points are located to this width of the independent coordinate [rad or m]; the
-// continuation step starts at 2° (or 2 % of the mechanism's length scale) and is quartered on
-// each failed projection until it is narrower than this.
-inline constexpr double kDeadPointTolerance = 1e-6;
-// A prismatic coordinate is searched to this many length scales (the largest distance of a
-// scene point from its frame's origin) on either side of its initial value.
-inline constexpr double kSearchSpan = 10.0;
-
 struct Inspection {
   std::vector<AssembledJoint> joints;
   std::vector<AssembledBody> bodies;
   MobilityCount mobility;
   std::vector<LoopGap> loops;
-  CoordinateRange range;
-  double length_scale_m = 0.0;  // largest |point| of the scene (warnings and prismatic steps) [m]
+  // The domain extraction, both models' domain stop and run.json use (calc_independent_domain);
+  // not set by calc_assembly.
+  IndependentDomain range;
+  double length_scale_m = 0.0;  // calc_length_scale: the mechanism's size (warnings, prismatic moves) [m]
   std::vector<std::string> warnings;
 };
 
-// Assembles the scene at its initial q (as every run does), reports the configuration and
-// walks the independent coordinate both ways on the assembled branch. Throws EngineError when
-// the scene cannot assemble (a loop that cannot close, not one degree of freedom, the other
-// branch than the one named) and models::NumericalError when a configuration is not finite.
+// Assembles the scene at its initial q (as every run does), reports the configuration and the
+// independent coordinate's domain from calc_independent_domain. Throws EngineError when the
+// scene cannot assemble (a loop that cannot close, not one degree of freedom, the other branch
+// than the one named) or its domain is refused (a declared range across a dead point, an
+// initial q within the margin of a dead point, the walk's move budget), and
+// models::NumericalError when a configuration is not finite. A prismatic coordinate meeting
+// fewer than two dead points is no error: the domain is unbounded and a warning says why.
 Inspection calc_inspection(const FullModel& model);
 
 // The assembled configuration only (no range walk): every joint coordinate and body pose at

@@ -32,16 +32,30 @@ nlohmann::json inspection_json(const models::Scene& scene, const engine::Inspect
   const bool rev = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
   const double k = rev ? kDeg : 1.0;
   const std::string unit = rev ? "deg" : "m";
-  nlohmann::json range = {{"joint", scene.independent}, {"unit", unit}, {"full_turn", in.range.full_turn}};
-  if (!in.range.full_turn) {
-    range["min"] = in.range.q_min * k;
-    range["max"] = in.range.q_max * k;
-    range["min_is_dead_point"] = in.range.min_is_dead_point;
-    range["max_is_dead_point"] = in.range.max_is_dead_point;
+  // The domain the models use (engine/independent_range.hpp); edges named as the range tables
+  // name them (`edges=dead_point,declared_limit`, docs/theory.md "Range tables").
+  const auto& d = in.range;
+  auto edge = [](std::string e) {
+    for (char& ch : e)
+      if (ch == ' ') ch = '_';
+    return e;
+  };
+  nlohmann::json range = {{"joint", scene.independent}, {"unit", unit}, {"full_turn", d.periodic}};
+  if (!d.unbounded_reason.empty()) {
+    range["unbounded_reason"] = d.unbounded_reason;  // no finite edges: min/max left out
+  } else if (!d.periodic) {
+    range["min"] = d.min * k;
+    range["max"] = d.max * k;
+    range["min_edge"] = edge(d.min_edge);
+    range["max_edge"] = edge(d.max_edge);
+    range["min_is_dead_point"] = d.min_edge == "dead point";
+    range["max_is_dead_point"] = d.max_edge == "dead point";
   }
   nlohmann::json dead = nlohmann::json::array();
-  if (in.range.min_is_dead_point) dead.push_back(in.range.q_min * k);
-  if (in.range.max_is_dead_point) dead.push_back(in.range.q_max * k);
+  if (d.dead_min && d.dead_max) {
+    dead = {*d.dead_min * k, *d.dead_max * k};
+    range["dead_point_margin"] = engine::kDeadPointMargin;
+  }
   range["dead_points"] = dead;
   return {{"scene", scene.name},
           {"scene_file", scene.source_file},

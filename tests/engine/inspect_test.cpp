@@ -1,6 +1,7 @@
-// Assembly report and range walk (engine/inspect.cpp) against closed-form position analysis:
-// the four-bar's two assemblies as circle intersections, the rocker's dead points where crank
-// and coupler are collinear, the slider-crank's slider position and stroke ends.
+// Assembly report and domain (engine/inspect.cpp) against closed-form position analysis: the
+// four-bar's two assemblies as circle intersections, the rocker's dead points where crank and
+// coupler are collinear, the slider-crank's slider position and stroke ends, and the 5 % margin
+// the models keep from them.
 #include "engine/inspect.hpp"
 
 #include <gtest/gtest.h>
@@ -71,25 +72,56 @@ TEST(Inspect, FourBarAssemblyMatchesTheCircleIntersection) {
   EXPECT_EQ(in.mobility.rows, 2);
   ASSERT_EQ(in.loops.size(), 1u);
   EXPECT_LT(in.loops[0].gap_m, 1e-10);
-  EXPECT_TRUE(in.range.full_turn);  // Grashof crank-rocker: the crank turns fully
+  EXPECT_TRUE(in.range.periodic);  // Grashof crank-rocker: the crank turns fully
   EXPECT_TRUE(in.warnings.empty());
 }
 
 TEST(Inspect, RockerRangeEndsAtTheCollinearDeadPoints) {
-  // Driven by the rocker, the range ends where crank and coupler are collinear:
-  // |AC| = b ± a, |AC|² = d² + c² + 2 d c cos θ.
+  // Driven by the rocker, the loops close only between the dead points where crank and coupler
+  // are collinear: |AC| = b ± a, |AC|² = d² + c² + 2 d c cos θ. The domain stops
+  // kDeadPointMargin of their distance short of each (the models' rule).
   const auto scene = models::parse_scene(fourbar_yaml("rocker", 110, 110, -85, 110), "fb.yaml");
   const auto in = calc_inspection(FullModel(scene));
   const double lo = std::acos(((b + a) * (b + a) - d * d - c * c) / (2 * d * c));
   const double hi = std::acos(((b - a) * (b - a) - d * d - c * c) / (2 * d * c));
-  EXPECT_FALSE(in.range.full_turn);
-  EXPECT_TRUE(in.range.min_is_dead_point);
-  EXPECT_TRUE(in.range.max_is_dead_point);
-  EXPECT_NEAR(in.range.q_min, lo, 5 * kDeadPointTolerance);
-  EXPECT_NEAR(in.range.q_max, hi, 5 * kDeadPointTolerance);
-  EXPECT_GE(in.range.q_min, lo - 1e-9);  // reached configurations lie inside the range
-  EXPECT_LE(in.range.q_max, hi + 1e-9);
+  EXPECT_FALSE(in.range.periodic);
+  ASSERT_TRUE(in.range.dead_min && in.range.dead_max);
+  // The shared walk bisects to 1e-11; the projection it accepts next to a dead point (1e-9 m)
+  // leaves ~8e-9 rad.
+  EXPECT_NEAR(*in.range.dead_min, lo, 1e-8);
+  EXPECT_NEAR(*in.range.dead_max, hi, 1e-8);
+  EXPECT_NEAR(in.range.min, lo + kDeadPointMargin * (hi - lo), 2e-8);
+  EXPECT_NEAR(in.range.max, hi - kDeadPointMargin * (hi - lo), 2e-8);
+  EXPECT_EQ(in.range.min_edge, "dead point");
+  EXPECT_EQ(in.range.max_edge, "dead point");
+  EXPECT_TRUE(in.warnings.empty());
 }
+
+TEST(Inspect, ADeclaredRangeIsReportedAsTheModelsUseIt) {
+  auto scene = models::parse_scene(fourbar_yaml("rocker", 110, 110, -85, 110), "fb.yaml");
+  scene.independent_range = models::IndependentRange{100 * kDeg, 120 * kDeg};
+  const auto in = calc_inspection(FullModel(scene));
+  EXPECT_EQ(in.range.min, 100 * kDeg);
+  EXPECT_EQ(in.range.max, 120 * kDeg);
+  EXPECT_EQ(in.range.min_edge, "declared limit");
+  EXPECT_EQ(in.range.max_edge, "declared limit");
+  EXPECT_FALSE(in.range.dead_min);
+}
+
+TEST(Inspect, AnInitialQInsideTheMarginOfADeadPointIsRefused) {
+  // 90.5° lies between the dead point 90.19° and the domain's edge 92.61°: no model may start there.
+  const auto scene = models::parse_scene(fourbar_yaml("rocker", 90.5, 90, -60, 90.5), "fb.yaml");
+  const FullModel model(scene);
+  EXPECT_NO_THROW(calc_assembly(model));  // the assembly itself is fine
+  try {
+    calc_inspection(model);
+    FAIL() << "accepted";
+  } catch (const EngineError& e) {
+    EXPECT_NE(std::string(e.what()).find("within 5 % of a dead point of 'rocker'"), std::string::npos) << e.what();
+  }
+}
+
+// A prismatic coordinate without dead points (unbounded, exit 0 with a warning): tests/validate/inspect_test.cpp.
 
 TEST(Inspect, GuessesFarFromTheAssemblyWarn) {
   // Guesses of the other branch's neighbourhood for the coupler: the assembly lands 20°+ away.
@@ -127,13 +159,16 @@ TEST(Inspect, SliderCrankPositionAndStroke) {
   const auto in = calc_inspection(FullModel(models::parse_scene(slider_crank_yaml("crank", 30, 30, -37, 0.24), "sc")));
   EXPECT_NEAR(in.joints[2].q, r * std::cos(th) + std::sqrt(l * l - r * r * std::sin(th) * std::sin(th)), 1e-12);
   EXPECT_NEAR(wrap(in.joints[1].q + th + std::asin(r * std::sin(th) / l)), 0.0, 1e-10);  // rod angle −asin(r sinθ/l)
-  EXPECT_TRUE(in.range.full_turn);
-  // Driven from the slider: the stroke ends at the dead points x = l ± r.
+  EXPECT_TRUE(in.range.periodic);
+  // Driven from the slider: the stroke ends at the dead points x = l ± r (to the 1e-9 m the
+  // projection accepts next to them: measured 1.4e-9 m).
   const auto sl = calc_inspection(FullModel(models::parse_scene(slider_crank_yaml("slider", 0.2, 60, -60, 0.2), "sc")));
-  EXPECT_FALSE(sl.range.full_turn);
-  EXPECT_TRUE(sl.range.min_is_dead_point && sl.range.max_is_dead_point);
-  EXPECT_NEAR(sl.range.q_min, l - r, 1e-5);
-  EXPECT_NEAR(sl.range.q_max, l + r, 1e-5);
+  EXPECT_FALSE(sl.range.periodic);
+  ASSERT_TRUE(sl.range.dead_min && sl.range.dead_max);
+  EXPECT_NEAR(*sl.range.dead_min, l - r, 1e-8);
+  EXPECT_NEAR(*sl.range.dead_max, l + r, 1e-8);
+  EXPECT_NEAR(sl.range.min, l - r + kDeadPointMargin * 2 * r, 2e-8);
+  EXPECT_NEAR(sl.range.max, l + r - kDeadPointMargin * 2 * r, 2e-8);
 }
 
 TEST(Inspect, BicycleIsOneDegreeOfFreedomAndTurnsFully) {
@@ -141,7 +176,7 @@ TEST(Inspect, BicycleIsOneDegreeOfFreedomAndTurnsFully) {
   const auto in = calc_inspection(FullModel(scene));
   EXPECT_EQ(in.mobility.mobilities - in.mobility.rank, 1);
   EXPECT_EQ(in.mobility.rank, in.mobility.rows);
-  EXPECT_TRUE(in.range.full_turn);
+  EXPECT_TRUE(in.range.periodic);
   for (const auto& l : in.loops) EXPECT_LT(l.gap_m, 1e-9) << l.name;
   EXPECT_EQ(in.bodies.size(), scene.bodies.size());
 }

@@ -51,16 +51,71 @@ TEST(InspectCli, FourbarPrintsTheAssembledConfiguration) {
 }
 
 TEST(InspectCli, RockerDrivenRangeHasTwoDeadPoints) {
-  const CliRun r = rdyn(
-      "inspect fourbar --set independent=rocker --set initial.q_deg=110 --set joints.crank.guess_deg=110 --set "
-      "joints.coupler.guess_deg=-85 --set outputs.constraint_forces.rocker_axial.joint=coupler");
+  const CliRun r = rdyn("inspect fourbar-rocker");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_FALSE(j["range"]["full_turn"].get<bool>());
-  ASSERT_EQ(j["range"]["dead_points"].size(), 2u);
-  EXPECT_NEAR(j["range"]["dead_points"][0].get<double>(), 90.19099, 1e-3);   // acos((0.36² − 0.13)/0.12)
-  EXPECT_NEAR(j["range"]["dead_points"][1].get<double>(), 138.59038, 1e-3);  // acos((0.20² − 0.13)/0.12)
-  EXPECT_EQ(j["range"]["unit"], "deg");
+  const auto& range = j["range"];
+  EXPECT_FALSE(range["full_turn"].get<bool>());
+  ASSERT_EQ(range["dead_points"].size(), 2u);
+  // The shared walk's accuracy (~8e-9 rad = 4.3e-7°, measured).
+  const double lo = 90.1909862854, hi = 138.5903778907;  // acos((0.36² − 0.13)/0.12), acos((0.20² − 0.13)/0.12)
+  EXPECT_NEAR(range["dead_points"][0].get<double>(), lo, 1e-6);
+  EXPECT_NEAR(range["dead_points"][1].get<double>(), hi, 1e-6);
+  // The domain the models use: 5 % of the dead points' distance inside each.
+  EXPECT_EQ(range["dead_point_margin"].get<double>(), 0.05);
+  EXPECT_NEAR(range["min"].get<double>(), lo + 0.05 * (hi - lo), 2e-6);
+  EXPECT_NEAR(range["max"].get<double>(), hi - 0.05 * (hi - lo), 2e-6);
+  EXPECT_EQ(range["min_edge"], "dead_point");
+  EXPECT_EQ(range["max_edge"], "dead_point");
+  EXPECT_TRUE(range["min_is_dead_point"].get<bool>());
+  EXPECT_EQ(range["unit"], "deg");
+}
+
+TEST(InspectCli, AnInitialQNextToADeadPointIsExitTwo) {
+  // The same refusal simulate and extract give: no output, the dead points named.
+  const CliRun r = rdyn("inspect fourbar-rocker --set initial.q_deg=90.5");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("within 5 % of a dead point of 'rocker' (dead points at 90.19"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST(InspectCli, FourbarRockerNamesItsBranch) {
+  // Guesses of the mirrored assembly (B on the other side of A–C: the coupler's relative angle
+  // changes sign) are refused by the branch the scene names, not assembled silently.
+  const CliRun r = rdyn("inspect fourbar-rocker --set joints.crank.guess_deg=-26 --set joints.coupler.guess_deg=80");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("joint 'coupler' is at 79.56"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST(InspectCli, DeclaredAndUnboundedRanges) {
+  const auto dir = fs::temp_directory_path() / ("rdyn_inspect_scenes_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string slider =
+      "name: free\nground_points: {O: [0, 0]}\nbodies:\n"
+      "  - {name: slider, mass_kg: 1.0, inertia_kgm2: 1.0e-3, points: {P: [0.2, 0]}}\njoints:\n"
+      "  - {name: slide, type: prismatic, parent: ground, parent_point: O, child: slider, axis: [1, 0]}\n"
+      "independent: slide\ninitial: {q: 0.1}\n";
+  std::ofstream(dir / "free.yaml") << slider;
+  std::ofstream(dir / "declared.yaml") << slider << "independent_range: [-0.5, 0.75]\n";
+  // No dead point: exit 0 (the full model can run it), no finite edges, the reason as a warning.
+  CliRun r = rdyn("inspect " + (dir / "free.yaml").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["range"].contains("min"));
+  EXPECT_NE(j["range"]["unbounded_reason"].get<std::string>().find("meets no dead point"), std::string::npos);
+  EXPECT_NE(r.err.find("warning: ") , std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("declare independent_range"), std::string::npos) << r.err;
+  r = rdyn("inspect " + (dir / "declared.yaml").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["range"]["min"].get<double>(), -0.5);
+  EXPECT_EQ(j["range"]["max"].get<double>(), 0.75);
+  EXPECT_EQ(j["range"]["min_edge"], "declared_limit");
+  EXPECT_FALSE(j["range"]["max_is_dead_point"].get<bool>());
+  EXPECT_TRUE(j["range"]["dead_points"].empty());
+  EXPECT_TRUE(j["warnings"].empty());
+  fs::remove_all(dir);
 }
 
 TEST(InspectCli, BadInputIsExitTwoNamingTheField) {
