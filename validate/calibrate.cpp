@@ -118,7 +118,8 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     const double q = scene.initial.q + (i + 0.5) * dq;
     for (const auto& t : m.torques) {
       const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-      if (on) W_unit += (t.value < 0 ? -1.0 : 1.0) * m.table.eval(t.c_r, q) * dq;
+      const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;  // profiled: τ(θ(q)) per unit value
+      if (on) W_unit += (t.value < 0 ? -1.0 : 1.0) * tau * m.table.eval(t.c_r, q) * dq;
     }
     const auto& b = m.brakes[0];
     const double w = m.table.eval(b.c_w, q);
@@ -227,7 +228,18 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   std::vector<models::Override> o = base;
   auto num = [](double v) { return fmt::format("{:.12g}", v); };
   if (models::scene_yaml_has(text, "bicycle_leg")) {
-    o.push_back({"bicycle_leg.hip_torque_Nm", num(r.torque_Nm)});
+    // Torques the scene lists under `loads` (profiled hips, say) are scaled there; the
+    // generated constant hip torques through hip_torque_Nm, only when the generator made some.
+    bool generated = false;
+    for (const auto& t : scene.joint_torques) {
+      if (!models::scene_yaml_has(text, "loads." + t.name)) {
+        generated = true;
+        continue;
+      }
+      const std::string key = models::scene_yaml_has(text, "loads." + t.name + ".force_N") ? "force_N" : "torque_Nm";
+      o.push_back({"loads." + t.name + "." + key, num((t.value < 0 ? -1 : 1) * r.torque_Nm)});
+    }
+    if (generated) o.push_back({"bicycle_leg.hip_torque_Nm", num(r.torque_Nm)});
     o.push_back({"bicycle_leg.resistance.power_W", num(opt.power_w)});
     o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
   } else {
