@@ -232,7 +232,7 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
     // generated constant hip torques through hip_torque_Nm, only when the generator made some.
     bool generated = false;
     for (const auto& t : scene.joint_torques) {
-      if (!models::scene_yaml_has(text, "loads." + t.name)) {
+      if (!models::scene_yaml_has(text, "loads." + t.name + ".joint")) {
         generated = true;
         continue;
       }

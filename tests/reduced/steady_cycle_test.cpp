@@ -113,6 +113,29 @@ TEST(SteadyCycle, FlywheelWithAProfiledTorqueDoesA0TwoPiPerTurn) {
   EXPECT_LT(rel(tsc.speed_max, fi.speed_max), 1e-7);
 }
 
+TEST(SteadyCycle, GatedProfileSwitchesAtTheSameAnglesInBothRoutes) {
+  // A lever torque value·τ(θ_lever), τ = 1 + 0.8 sin 2θ of the lever angle θ = sin q, on only
+  // while the lever turns forward (cos q · q̇ > 0: switches at ±90°), against a crank brake; on
+  // the flywheel the drive work per turn is the closed form value·∫ τ(sin q) cos q dq over
+  // (−90°, 90°) = value·∫_{−1}^{1} (1 + 0.8 sin 2θ) dθ = 2·value.
+  auto scene = test::analytic_scene();
+  models::LoadProfile p;
+  p.of = "lever";
+  p.a0 = 1.0;
+  p.b = {0.0, 0.8};
+  scene.joint_torques.push_back({"drive", "lever", 1.5, models::RateGate{"lever", +1}, p});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 0.02});
+  const auto m = flywheel(scene);
+  const auto fi = calc_steady_cycle(m, options(20.0, 0.3));
+  const auto ts = calc_steady_cycle_time_stepping(m, options(20.0, 0.3));
+  EXPECT_EQ(fi.method, CycleMethod::FirstIntegral);
+  EXPECT_NEAR(fi.drive_work_J, 2 * 1.5, 1e-7 * 3.0);
+  EXPECT_NEAR(fi.dissipated_work_J, 2 * 1.5, 1e-7 * 3.0);
+  EXPECT_LT(rel(fi.period_s, ts.period_s), 1e-8);
+  EXPECT_LT(rel(fi.qdot_section, ts.qdot_section), 1e-8);
+  EXPECT_LT(rel(fi.drive_work_J, ts.drive_work_J), 1e-7);
+}
+
 TEST(SteadyCycle, FlywheelWithQuadraticResistanceTurnsAtRootOfTorqueOverCoefficient) {
   // I q̈ = T − c2 q̇|q̇|: steady q̇ = √(T/c2). The equation is linear in u = q̇²/2, so the
   // map u ↦ Φ(u) is affine and the secant lands on the cycle at its third pass.
