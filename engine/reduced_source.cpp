@@ -126,6 +126,14 @@ double FullKinetostaticSource::ratio(double q, int joint) {
   return at(q, [&] { return calc_velocity_ratios(model_, ws_, q, true, false).wrt_q[joint]; });
 }
 
+std::optional<double> FullKinetostaticSource::joint_coordinate(double q, int joint) {
+  // A position projection only (the sweep already stands at q, so it is one Newton solve).
+  return at(q, [&] {
+    move_configuration(model_, ws_, q);
+    return model_.impl().joint_q(ws_.impl().state, joint);
+  });
+}
+
 reduced::ConservativePoint FullKinetostaticSource::conservative(double q) {
   return at(q, [&] {
     const auto r = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);

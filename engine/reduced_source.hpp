@@ -21,6 +21,7 @@ class FullKinetostaticSource : public reduced::KinetostaticSource {
   std::optional<reduced::DirectPoint> direct(double q) override;
   reduced::GridSample sample(double q, bool with_conservative) override;
   double ratio(double q, int joint) override;
+  std::optional<double> joint_coordinate(double q, int joint) override;
   long calls() const { return calls_; }
 
  private:

@@ -26,6 +26,12 @@ bool torque_active(const FullModel::Impl& m, const State& s, int i, int mode) {
   return t.active_when->sign * rate > 0.0;
 }
 
+// A joint torque's load now [N·m or N]: value, or value·τ(θ) of its profile's joint angle.
+double torque_value(const FullModel::Impl& m, const State& s, int i) {
+  const auto& t = m.scene.joint_torques[i];
+  return models::calc_joint_torque(t, t.profile ? m.joint_q(s, m.scene.joint_index(t.profile->of)) : 0.0);
+}
+
 // Generalized force on a scene joint's coordinate; a folded joint's load goes to its
 // driver by virtual power (τ_driver = r·τ_driven).
 void add_joint_force(const FullModel::Impl& m, const State& s, int joint, double tau, Vector& mobility) {
@@ -79,7 +85,8 @@ class SceneLoads : public Force::Custom::Implementation {
     if (mode == kLoadsConservative) return;
     for (size_t i = 0; i < sc.joint_torques.size(); ++i)
       if (torque_active(m_, s, static_cast<int>(i), mode))
-        add_joint_force(m_, s, sc.joint_index(sc.joint_torques[i].joint), sc.joint_torques[i].value, mobility);
+        add_joint_force(m_, s, sc.joint_index(sc.joint_torques[i].joint), torque_value(m_, s, static_cast<int>(i)),
+                        mobility);
     for (const auto& mo : sc.motors) {
       const int j = sc.joint_index(mo.joint);
       add_joint_force(m_, s, j, mo.stall_torque * (1.0 - m_.joint_u(s, j) / mo.no_load_speed), mobility);
@@ -157,7 +164,7 @@ double non_conservative_power(const FullModel::Impl& m, const State& s) {
   double P = 0.0;
   for (size_t i = 0; i < sc.joint_torques.size(); ++i) {
     const int j = sc.joint_index(sc.joint_torques[i].joint);
-    if (torque_active(m, s, static_cast<int>(i), mode)) P += sc.joint_torques[i].value * m.joint_u(s, j);
+    if (torque_active(m, s, static_cast<int>(i), mode)) P += torque_value(m, s, static_cast<int>(i)) * m.joint_u(s, j);
   }
   for (const auto& mo : sc.motors) {
     const double u = m.joint_u(s, sc.joint_index(mo.joint));

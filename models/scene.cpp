@@ -135,6 +135,49 @@ struct Checker {
   }
 };
 
+// A joint torque's profile (models/load_profile.hpp): a revolute `of` joint, bounded counts,
+// finite coefficients or rows, and an applied load |value|·max|τ| within limits::kMaxForce.
+void check_profile(const Checker& c, const std::string& f, bool prismatic, const JointTorque& t) {
+  const LoadProfile& p = *t.profile;
+  const std::string pf = f + ".profile";
+  const Joint* of = c.s.find_joint(p.of);
+  if (!of) c.fail(pf + ".of", "unknown joint '" + printable(p.of) + "'");
+  if (of->type != JointType::Revolute)
+    c.fail(pf + ".of", "a profile reads the angle of a revolute joint ('" + p.of + "' is prismatic)");
+  const char* unit = prismatic ? "N" : "N·m";
+  if (!p.is_table()) {
+    if (p.a.size() > limits::kMaxProfileHarmonics || p.b.size() > limits::kMaxProfileHarmonics)
+      c.fail(pf + ".fourier", fmt::format("at most {} harmonics", limits::kMaxProfileHarmonics));
+    c.abs_at_most(pf + ".fourier.a0", p.a0, limits::kMaxForce, unit);
+    for (size_t k = 0; k < p.a.size(); ++k)
+      c.abs_at_most(pf + fmt::format(".fourier.a[{}]", k), p.a[k], limits::kMaxForce, unit);
+    for (size_t k = 0; k < p.b.size(); ++k)
+      c.abs_at_most(pf + fmt::format(".fourier.b[{}]", k), p.b[k], limits::kMaxForce, unit);
+  } else {
+    const size_t n = p.table_theta_rad.size();
+    if (n < limits::kMinProfileRows || n > limits::kMaxProfileRows || p.table_value.size() != n ||
+        p.table_d2.size() != n)
+      c.fail(pf + ".table_deg", fmt::format("a periodic table takes {} to {} rows (got {})",
+                                            limits::kMinProfileRows, limits::kMaxProfileRows, n));
+    constexpr double kPi = 3.14159265358979323846, h_min = limits::kMinProfileSpacing_deg * kPi / 180;
+    for (size_t i = 0; i < n; ++i) {
+      const std::string row = pf + fmt::format(".table_deg[{}]", i);
+      c.abs_at_most(row + "[1]", p.table_value[i], limits::kMaxForce, unit);
+      const double x = p.table_theta_rad[i];
+      const double next = i + 1 < n ? p.table_theta_rad[i + 1] : p.table_theta_rad[0] + 2 * kPi;
+      if (!std::isfinite(x) || std::abs(x) > 2 * kPi + 1e-12 || !(next - x >= h_min * (1 - 1e-9)))
+        c.fail(row + "[0]", fmt::format("table angles must lie in [−360°, 360°] and increase by at least {:g}° "
+                                        "within one turn",
+                                        limits::kMinProfileSpacing_deg));
+    }
+  }
+  const double bound = std::abs(t.value) * calc_profile_bound(p);
+  if (!(bound <= limits::kMaxForce))
+    c.fail(f + (prismatic ? ".force_N" : ".torque_Nm"),
+           fmt::format("the profiled load can reach {:g} {} (|amplitude {:g}| × profile bound {:g}); at most {:g}",
+                       bound, unit, t.value, calc_profile_bound(p), limits::kMaxForce));
+}
+
 }  // namespace
 
 void check_scene(const Scene& s) {
@@ -278,6 +321,7 @@ void check_scene(const Scene& s) {
     c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce,
                   prismatic ? "N" : "N·m");
     if (t.active_when) check_joint_ref(f + ".active_when.joint", t.active_when->joint);
+    if (t.profile) check_profile(c, f, prismatic, t);
   }
   for (const auto& r : s.resistances) {
     const std::string f = "loads." + r.name;

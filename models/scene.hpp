@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "models/load_profile.hpp"
+
 namespace rdyn::models {
 
 struct Vec2 {
@@ -156,7 +158,15 @@ struct JointTorque {  // torque on a revolute joint, force on a prismatic one
   std::string joint;
   double value = 0.0;               // [N·m] or [N], acts on the child, reaction on the parent
   std::optional<RateGate> active_when;
+  // Position-dependent drive: the applied load is value·τ(θ_of) (value an amplitude
+  // multiplier, 1 unless given), τ a periodic profile of a revolute joint's angle.
+  std::optional<LoadProfile> profile = std::nullopt;
 };
+// The load a joint torque applies now [N·m or N], given the angle of its profile's joint
+// (ignored without a profile): value·τ(θ) or value.
+inline double calc_joint_torque(const JointTorque& t, double theta_of) {
+  return t.profile ? t.value * calc_profile(*t.profile, theta_of) : t.value;
+}
 
 // Resistance torque on a body that turns at a fixed ratio to the independent coordinate
 // (the crank, or a body geared to it): T = −c0·sgn ω, −c1·ω or −c2·ω|ω|.

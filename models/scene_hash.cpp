@@ -78,6 +78,13 @@ std::string canonical_scene_text(const Scene& s) {
   for (const auto& t : s.joint_torques) {
     c.str("joint", t.joint).integer("gated", t.active_when ? 1 : 0);
     if (t.active_when) c.str("gate_joint", t.active_when->joint).integer("gate_sign", t.active_when->sign);
+    if (t.profile) {  // its shape is tabulated (the amplitude, t.value, is not)
+      const auto& p = *t.profile;
+      c.str("profile_of", p.of).num("a0", p.a0);
+      for (double v : p.a) c.num("a", v);
+      for (double v : p.b) c.num("b", v);
+      for (size_t i = 0; i < p.table_theta_rad.size(); ++i) c.num("row_deg", p.table_theta_rad[i]).num("row", p.table_value[i]);
+    }
   }
   c.open("motors", s.motors.size());
   for (const auto& m : s.motors) c.str("joint", m.joint);

@@ -588,6 +588,58 @@ void read_independent_range(const Fields& top, Scene& s) {
   }
   if (!(v.x < v.y)) top.fail(key, fmt::format("needs min < max (got [{:g}, {:g}])", v.x, v.y));  // here: the line
   s.independent_range = IndependentRange{v.x * k, v.y * k};
+// A joint torque's profile: {of: joint, fourier: {a0, a: [...], b: [...]}} or
+// {of: joint, table_deg: [[θ_deg, τ], ...]} (models/load_profile.hpp). Counts, finiteness and
+// the order of the table's angles are checked here, where the line of each row is known;
+// the joint and the load's range by check_scene.
+LoadProfile read_profile(const Fields& parent, const std::string& key) {
+  Fields p(parent.raw(key), parent.join(key), parent.ctx(), {"of", "fourier", "table_deg"});
+  if (p.has("fourier") == p.has("table_deg"))
+    p.fail("fourier", "give fourier: {a0, a, b} or table_deg: [[angle_deg, value], ...], one of them");
+  const std::string of = p.str("of");
+  auto list = [&](const Fields& f, const std::string& k, size_t max, const char* what) {
+    std::vector<double> v;
+    if (!f.has(k)) return v;
+    const YAML::Node seq = f.raw(k);
+    if (!seq.IsSequence()) f.fail(k, "expected a list of numbers");
+    if (seq.size() > max) f.fail(k, fmt::format("{} {}; at most {}", seq.size(), what, max));
+    for (size_t i = 0; i < seq.size(); ++i) v.push_back(f.to_num(seq[i], f.join(k) + fmt::format("[{}]", i)));
+    return v;
+  };
+  if (p.has("fourier")) {
+    Fields f(p.raw("fourier"), p.join("fourier"), parent.ctx(), {"a0", "a", "b"});
+    LoadProfile out;
+    out.of = of;
+    out.a0 = f.num_or("a0", 0.0);
+    out.a = list(f, "a", limits::kMaxProfileHarmonics, "cosine coefficients");
+    out.b = list(f, "b", limits::kMaxProfileHarmonics, "sine coefficients");
+    return out;
+  }
+  const YAML::Node rows = p.raw("table_deg");
+  const std::string field = p.join("table_deg");
+  if (!rows.IsSequence()) p.fail("table_deg", "expected a list of [angle_deg, value] rows");
+  if (rows.size() < limits::kMinProfileRows || rows.size() > limits::kMaxProfileRows)
+    p.fail("table_deg", fmt::format("{} rows; a periodic table takes {} to {}", rows.size(),
+                                    limits::kMinProfileRows, limits::kMaxProfileRows));
+  std::vector<double> theta, value;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const std::string fi = field + fmt::format("[{}]", i);
+    const Vec2 row = p.to_vec2(rows[i], fi);
+    if (std::abs(row.x) > 360.0)
+      p.fail_at(rows[i], fi + "[0]", fmt::format("angle {:g}° outside [−360°, 360°]", row.x));
+    if (i > 0 && !(row.x - theta.back() * 180 / kPi >= limits::kMinProfileSpacing_deg))
+      p.fail_at(rows[i], fi + "[0]",
+                fmt::format("angles must increase by at least {:g}° from row to row (got {:g}° after {:g}°)",
+                            limits::kMinProfileSpacing_deg, row.x, theta.back() * 180 / kPi));
+    if (i > 0 && !(theta.front() * 180 / kPi + 360.0 - row.x >= limits::kMinProfileSpacing_deg))
+      p.fail_at(rows[i], fi + "[0]",
+                fmt::format("the table covers one turn: angles must stay below the first + 360° (got {:g}° "
+                            "after a first angle of {:g}°)",
+                            row.x, theta.front() * 180 / kPi));
+    theta.push_back(row.x * kPi / 180.0);
+    value.push_back(row.y);
+  }
+  return make_table_profile(of, std::move(theta), std::move(value));
 }
 
 struct PendingDissipation {
@@ -613,11 +665,15 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
                        "duplicate load name '" + name + "'");
     if (type == "joint_torque") {
       Fields f(n, path, top.ctx(),
-               {"type", "name", "joint", "torque_Nm", "force_N", "active_when"});
-      JointTorque t{name, f.str("joint"), 0.0, std::nullopt};
-      if (f.has("torque_Nm") == f.has("force_N"))
+               {"type", "name", "joint", "torque_Nm", "force_N", "active_when", "profile"});
+      JointTorque t{name, f.str("joint"), 0.0, std::nullopt, std::nullopt};
+      if (f.has("torque_Nm") && f.has("force_N"))
+        f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic), not both");
+      // With a profile the value is an amplitude multiplier, 1 unless given.
+      if (f.has("profile")) t.profile = read_profile(f, "profile");
+      if (!f.has("profile") && !f.has("torque_Nm") && !f.has("force_N"))
         f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
-      t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num("force_N");
+      t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num_or("force_N", 1.0);
       if (f.has("active_when")) {
         Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
         const std::string rate = g.str("rate");

@@ -224,8 +224,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   // The table must be one the reader accepts (samples.hpp limits): count its columns first
   // (m1, m2, Q_cons, V; me1, me2, Qx_cons per force; r per joint; rx per force and joint;
   // w and wx per resistance) and refuse before allocating.
+  long profiled = 0;  // joint torques with a profile: one tau_<load> column each
+  for (const auto& t : scene.joint_torques) profiled += t.profile ? 1 : 0;
   const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk) +
-                    (wants_joint_outputs(scene) ? 2L * nj : 0L);  // p_, k_ (reduced/joint_outputs.hpp)
+                    profiled + (wants_joint_outputs(scene) ? 2L * nj : 0L);  // p_, k_ (reduced/joint_outputs.hpp)
   if (cols + 1 > kMaxTableColumns || (cols + 1) * n > kMaxTableValues)
     throw TableError(fmt::format("a {:g}° table of this scene would have {} points × {} columns, more than the limits "
                                  "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
@@ -304,6 +306,16 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       if (std::find(gate_joints.begin(), gate_joints.end(), j) == gate_joints.end()) gate_joints.push_back(j);
     }
   std::vector<std::vector<double>> gate_roots(gate_joints.size());
+  // Joints whose angle a profiled load reads: their coordinate along the grid.
+  std::vector<int> profile_joints;
+  for (const auto& t : scene.joint_torques)
+    if (t.profile) {
+      const int j = scene.joint_index(t.profile->of);
+      if (j < 0) throw TableError("profile of load '" + t.name + "' reads unknown joint '" + t.profile->of + "'");
+      if (std::find(profile_joints.begin(), profile_joints.end(), j) == profile_joints.end())
+        profile_joints.push_back(j);
+    }
+  std::vector<std::vector<double>> theta(profile_joints.size(), std::vector<double>(n));
   auto bracket = [&](size_t g, long i0, long i1, double x1_offset) {
     // Sign change of gate joint g between samples i0 and i1 (i1 may wrap to 0 + 2π).
     const int j = gate_joints[g];
@@ -345,6 +357,11 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
     }
     singular[i] = g.singular;
+    for (size_t p = 0; p < profile_joints.size(); ++p) {
+      const auto th = src.joint_coordinate(s.q[i], profile_joints[p]);
+      if (!th) throw TableError("this kinetostatic source cannot give joint angles, which profiled loads need");
+      theta[p][i] = *th;
+    }
     if (i >= 1)
       for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, i - 1, i, 0.0);
   }
@@ -402,6 +419,16 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   for (int k = 0; k < nk; ++k)
     for (int j = 0; j < nj; ++j) s.add("rx_" + forces[k].name + "_" + scene.joints[j].name, rx[k][j]);
   if (joint_outputs) add_joint_position_columns(scene, s.q, h, r, p, s);
+  // Profiled drive loads are position-only (apart from their gate): tabulate each profile per
+  // unit amplitude along the grid, τ(θ_of(q)); the model applies value·τ·r_j (virtual power).
+  for (const auto& t : scene.joint_torques)
+    if (t.profile) {
+      const auto pj = std::find(profile_joints.begin(), profile_joints.end(), scene.joint_index(t.profile->of)) -
+                     profile_joints.begin();
+      std::vector<double> tau(n);
+      for (long i = 0; i < n; ++i) tau[i] = models::calc_profile(*t.profile, theta[pj][i]);
+      s.add("tau_" + t.name, tau);
+    }
   // Switch angles of rate-gated loads: the zeros located during the sweep.
   for (size_t gj = 0; gj < gate_joints.size(); ++gj) {
     auto roots = gate_roots[gj];

@@ -81,6 +81,12 @@ class KinetostaticSource {
   }
   // Rate of one joint per unit q̇ at q (root finding of switch angles).
   virtual double ratio(double q, int joint) { return ratios(q).wrt_q[joint]; }
+  // Coordinate of one joint at q [rad or m] on the branch the sweep follows (the angle a
+  // profiled drive load reads). Empty when the source cannot give positions.
+  virtual std::optional<double> joint_coordinate(double q, int joint) {
+    (void)q, (void)joint;
+    return std::nullopt;
+  }
 };
 
 }  // namespace rdyn::reduced

@@ -64,8 +64,10 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
       }
       m.gates.push_back(std::move(g));
     }
+    if (t.profile) tq.c_tau = s.require("tau_" + t.name);
     m.torques.push_back(tq);
     m.rhs_cols.push_back(tq.c_r);
+    if (tq.c_tau >= 0) m.rhs_cols.push_back(tq.c_tau);
   }
   for (const auto& mo : scene.motors) {
     m.motors.push_back({mo.stall_torque, mo.no_load_speed, s.require("r_" + mo.joint), rx_cols("rx_", mo.joint)});
@@ -78,7 +80,10 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
   m.out_cols = {m.c_m1, m.c_V};
   for (size_t k = 0; k < m.c_me1.size(); ++k) {
     m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
-    for (const auto& t : m.torques) m.out_cols.push_back(t.c_rx[k]);
+    for (const auto& t : m.torques) {
+      m.out_cols.push_back(t.c_rx[k]);
+      if (t.c_tau >= 0) m.out_cols.push_back(t.c_tau);
+    }
     for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
     for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
   }
@@ -117,8 +122,10 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
   const double* r = v + 3;
   for (size_t i = 0; i < m.torques.size(); ++i) {
     const auto& t = m.torques[i];
-    if (t.gate < 0 || ws.gate_on[t.gate]) F_nc += ws.torque_value[i] * *r;
-    ++r;
+    // Profiled: value·τ(θ_of(q))·r_j, the profile tabulated next to r.
+    const double tau = t.c_tau >= 0 ? r[1] : 1.0;
+    if (t.gate < 0 || ws.gate_on[t.gate]) F_nc += ws.torque_value[i] * tau * *r;
+    r += t.c_tau >= 0 ? 2 : 1;
   }
   for (const auto& mo : m.motors) {
     const double u = *r * qdot;  // joint rate
@@ -197,8 +204,9 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
     c += 3;
     for (size_t i = 0; i < m.torques.size(); ++i) {
       const auto& t = m.torques[i];
-      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += ws.torque_value[i] * *c;
-      ++c;
+      const double tau = t.c_tau >= 0 ? c[1] : 1.0;
+      if (t.gate < 0 || ws.gate_on[t.gate]) Qx += ws.torque_value[i] * tau * *c;
+      c += t.c_tau >= 0 ? 2 : 1;
     }
     for (const auto& mo : m.motors) {
       Qx += mo.stall * (1.0 - c[0] * qdot / mo.no_load_speed) * c[1];

@@ -4,7 +4,7 @@
 //   Eksergian:        m1(q) q̈ + m2(q) q̇² = F*(q, q̇, t)
 //   constraint line:  me1_k(q) q̈ + me2_k(q) q̇² = F*_x,k = F_E,k + Q_x,k(loads)
 //
-// F* = Q_cons(q) + Σ torques T·r_j(q)·[gate] + Σ motors τ(r_j q̇)·r_j + Σ brakes T(w_b q̇)·w_b
+// F* = Q_cons(q) + Σ torques T·[τ(q)]·r_j(q)·[gate] + Σ motors τ(r_j q̇)·r_j + Σ brakes T(w_b q̇)·w_b
 // (virtual power), and likewise Q_x,k with the ratios along x_k.
 #pragma once
 
@@ -42,6 +42,7 @@ struct ReducedModel {
     int c_r = -1;         // ratio of its joint
     std::vector<int> c_rx;
     int gate = -1;        // index into gates, −1 when always on
+    int c_tau = -1;       // profiled load: column tau_<load>, τ(θ_of(q)) per unit value; −1 constant
   };
   struct Motor {
     double stall = 0.0, no_load_speed = 0.0;
@@ -59,11 +60,11 @@ struct ReducedModel {
   std::vector<Motor> motors;
   std::vector<Brake> brakes;
 
-  // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r,
-  // each motor's r, each brake's w.
+  // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r
+  // (and its tau when profiled), each motor's r, each brake's w.
   std::vector<int> rhs_cols;
   // Columns the outputs need (one fused lookup): m1, V, then per constraint force k:
-  // me1, me2, Qx_cons, each torque's rx, each motor's r and rx, each brake's w and wx.
+  // me1, me2, Qx_cons, each torque's rx (and tau), each motor's r and rx, each brake's w and wx.
   std::vector<int> out_cols;
   std::vector<int> record_cols;  // rhs_cols then out_cols: one lookup per output sample
 };

@@ -242,7 +242,9 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
     for (size_t k = 0; k < m.torques.size(); ++k) {
       const auto& t = m.torques[k];
       const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-      const double r_j = m.table.eval(t.c_r, q);
+      // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
+      const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
+      const double r_j = tau * m.table.eval(t.c_r, q);
       if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
       if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
       if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq;
@@ -443,9 +445,20 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   const double T = std::abs(r.load_value);
   std::vector<models::Override> o = base;
   auto num = [](double v) { return fmt::format("{:.12g}", v); };
-  const bool generated = opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg");
-  if (generated) {
-    o.push_back({"bicycle_leg.hip_torque_Nm", num(T)});
+  const bool generated_drive = opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg");
+  if (generated_drive) {
+    // Torques the scene lists under `loads` (profiled hips, say) are scaled there; the
+    // generated constant hip torques through hip_torque_Nm, only when the generator made some.
+    bool generated = false;
+    for (const auto& t : scene.joint_torques) {
+      if (!models::scene_yaml_has(text, "loads." + t.name + ".joint")) {
+        generated = true;
+        continue;
+      }
+      const std::string key = models::scene_yaml_has(text, "loads." + t.name + ".force_N") ? "force_N" : "torque_Nm";
+      o.push_back({"loads." + t.name + "." + key, num((t.value < 0 ? -1 : 1) * T)});
+    }
+    if (generated) o.push_back({"bicycle_leg.hip_torque_Nm", num(T)});
   } else {
     for (const auto& e : sel.entries) o.push_back({value_key(text, scene, e), num(e.sign * T)});
   }

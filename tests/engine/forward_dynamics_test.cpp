@@ -39,6 +39,54 @@ TEST(ForwardDynamics, EnergyBalanceClosesOnEveryShippedScene) {
   }
 }
 
+// A profiled crank torque reading the rocker's angle (a table, gated by the rocker's rate) and
+// a Fourier profile of the crank's own angle.
+const char* kProfiledLoads =
+    "  - {type: joint_torque, name: push, joint: crank, torque_Nm: 0.5, active_when: {joint: rocker, rate: negative},\n"
+    "     profile: {of: rocker, table_deg: [[0, 0.2], [60, 0.5], [85, 1.0], [100, 1.4], [120, 0.6], [240, 0.1]]}}\n"
+    "  - {type: joint_torque, name: wave, joint: crank, profile: {of: crank, fourier: {a0: 1.5, a: [0.5], b: [0, "
+    "0.3]}}}\n";
+
+TEST(ForwardDynamics, EnergyBalanceClosesWithProfiledTorques) {
+  const auto scene = models::parse_scene(test::fourbar_with_loads(kProfiledLoads, "0.05"), "profiled.yaml");
+  FullModel model(scene);
+  ForwardOptions opt;
+  opt.duration_s = 3.0;
+  opt.output_interval_s = 0.01;
+  opt.tolerance = 1e-9;
+  const auto ts = simulate_full(model, opt);
+  double residual = 0;
+  for (size_t i = 0; i < ts.t.size(); ++i)
+    residual = std::max(residual, std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]));
+  // E(t) − E(0) = W(t), W the integral of Σ value·τ(θ_of)·rate: the profiles' power.
+  EXPECT_LT(residual, 1e-6 * max_abs(ts.energy));
+  EXPECT_GT(ts.q.back() - ts.q.front(), 4 * 2 * M_PI) << "the profiles must drive it round";
+  EXPECT_GT(max_abs(ts.work), 0.1 * max_abs(ts.energy));
+  EXPECT_GT(ts.stats.events, 2) << "the gate switches where the rocker turns back";
+}
+
+TEST(ForwardDynamics, ConstantProfileReproducesTheConstantTorque) {
+  const auto constant = models::parse_scene(
+      test::fourbar_with_loads("  - {type: joint_torque, name: d, joint: crank, torque_Nm: 0.4, active_when: {joint: "
+                               "rocker, rate: positive}}\n"),
+      "c.yaml");
+  const auto profile = models::parse_scene(
+      test::fourbar_with_loads("  - {type: joint_torque, name: d, joint: crank, active_when: {joint: rocker, rate: "
+                               "positive}, profile: {of: rocker, fourier: {a0: 0.4}}}\n"),
+      "p.yaml");
+  ForwardOptions opt;
+  opt.duration_s = 1.0;
+  opt.output_interval_s = 0.01;
+  const auto a = simulate_full(FullModel(constant), opt);
+  const auto b = simulate_full(FullModel(profile), opt);
+  ASSERT_EQ(a.t.size(), b.t.size());
+  for (size_t i = 0; i < a.t.size(); ++i) {
+    EXPECT_NEAR(b.q[i], a.q[i], 1e-12 * (1 + std::abs(a.q[i]))) << a.t[i];
+    EXPECT_NEAR(b.qdot[i], a.qdot[i], 1e-12 * (1 + std::abs(a.qdot[i]))) << a.t[i];
+    EXPECT_NEAR(b.work[i], a.work[i], 1e-12 * (1 + std::abs(a.work[i]))) << a.t[i];
+  }
+}
+
 TEST(ForwardDynamics, ParallelogramFollowsConstantInertiaClosedForm) {
   // m1 constant and m2 = 0: q(t) = q0 + ω0 t + ½ (T/m1) t².
   const double T = 0.05;

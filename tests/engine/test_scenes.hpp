@@ -2,6 +2,8 @@
 // the geometry its closed form uses.
 #pragma once
 
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace rdyn::test {
@@ -37,6 +39,19 @@ initial: {q_deg: 40, qdot: 1.0}
 inline double parallelogram_m1() {
   const double a = 0.1;
   return (4.0e-4 + 0.5 * 0.05 * 0.05) + (6.0e-4 + 0.7 * 0.05 * 0.05) + 1.2 * a * a;
+}
+
+// The shipped four-bar (models/scenes/fourbar.yaml) with `loads` added before its bearing,
+// whose viscous coefficient becomes `bearing` [N·m·s].
+inline std::string fourbar_with_loads(const std::string& loads, const std::string& bearing = "1.0e-3") {
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const auto c = yaml.find("coefficient: 1.0e-3");
+  if (c != std::string::npos) yaml.replace(c, 19, "coefficient: " + bearing);
+  const auto at = yaml.find("loads:\n");
+  return at == std::string::npos ? "" : yaml.insert(at + 7, loads);
 }
 
 }  // namespace rdyn::test

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "models/scene_hash.hpp"
+
 namespace rdyn::models {
 namespace {
 
@@ -164,7 +166,7 @@ TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
         EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
         ++n;
       }
-  EXPECT_EQ(n, 14);
+  EXPECT_EQ(n, 15);  // 7 scenes (bicycle-profile included) + 8 hard ones
 }
 
 TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
@@ -550,6 +552,95 @@ initial: {q: 0.2}
   const SceneError e = refusal(sc + "independent_range_deg: [10, 20]\n");
   EXPECT_EQ(e.field(), "independent_range_deg");
   EXPECT_NE(e.message().find("metres"), std::string::npos) << e.what();
+}
+
+// Profiled joint torques (models/load_profile.hpp): the two forms, the amplitude, and refusals
+// naming file, line and field.
+TEST(SceneYaml, ProfiledJointTorquesReadBothForms) {
+  const std::string yaml = std::string(kFourbar) +
+                           "  - {type: joint_torque, name: f, joint: crank, profile: {of: rocker, fourier: {a0: 2, a: "
+                           "[0.5], b: [0, -1]}}}\n"
+                           "  - {type: joint_torque, name: t, joint: crank, torque_Nm: -3, active_when: {joint: rocker, "
+                           "rate: positive},\n"
+                           "     profile: {of: crank, table_deg: [[-10, 1], [100, 4], [200, 2]]}}\n"
+                           "  - {type: joint_torque, name: c, joint: crank, torque_Nm: 5}\n";
+  const Scene s = parse_scene(yaml, "p.yaml");
+  ASSERT_EQ(s.joint_torques.size(), 3u);
+  const auto& f = s.joint_torques[0];
+  ASSERT_TRUE(f.profile);
+  EXPECT_EQ(f.value, 1.0);  // the amplitude multiplier defaults to 1
+  EXPECT_EQ(f.profile->of, "rocker");
+  EXPECT_NEAR(calc_joint_torque(f, 0.3), 2 + 0.5 * std::cos(0.3) - std::sin(0.6), 1e-15);
+  const auto& t = s.joint_torques[1];
+  ASSERT_TRUE(t.profile && t.profile->is_table() && t.active_when);
+  EXPECT_NEAR(calc_joint_torque(t, 100 * kPi / 180), -12.0, 1e-12);  // amplitude × row
+  EXPECT_NEAR(calc_joint_torque(t, 460 * kPi / 180), -12.0, 1e-12);  // one turn later
+  EXPECT_FALSE(s.joint_torques[2].profile);
+  EXPECT_EQ(calc_joint_torque(s.joint_torques[2], 1.0), 5.0);
+}
+
+TEST(SceneYaml, ProfileShapeIsPartOfTheSceneHashItsAmplitudeIsNot) {
+  auto scene = [](const std::string& load) { return parse_scene(std::string(kFourbar) + load, "p.yaml"); };
+  const auto a = scene("  - {type: joint_torque, name: f, joint: crank, profile: {of: rocker, fourier: {a0: 2}}}\n");
+  const auto b = scene("  - {type: joint_torque, name: f, joint: crank, profile: {of: rocker, fourier: {a0: 3}}}\n");
+  const auto c = scene(
+      "  - {type: joint_torque, name: f, joint: crank, torque_Nm: 7, profile: {of: rocker, fourier: {a0: 2}}}\n");
+  const auto d = scene("  - {type: joint_torque, name: f, joint: crank, profile: {of: crank, fourier: {a0: 2}}}\n");
+  EXPECT_NE(scene_hash(a), scene_hash(b));  // the tabulated τ(θ) differs
+  EXPECT_EQ(scene_hash(a), scene_hash(c));  // a calibration scales the amplitude without re-extraction
+  EXPECT_NE(scene_hash(a), scene_hash(d));
+}
+
+TEST(SceneYaml, BadProfilesAreRefusedNamingLineAndField) {
+  struct Bad {
+    std::string load, field, message;
+  };
+  const std::string many = [] {
+    std::string a;
+    for (int i = 0; i < 65; ++i) a += i ? ", 0.1" : "0.1";
+    return a;
+  }();
+  const std::vector<Bad> bad{
+      {"profile: {of: rocker, fourier: {a0: .nan}}", "loads[1].profile.fourier.a0", "finite"},
+      {"profile: {of: rocker, fourier: {a: [1, .inf]}}", "loads[1].profile.fourier.a[1]", "finite"},
+      {"profile: {of: rocker, fourier: {b: [" + many + "]}}", "loads[1].profile.fourier.b", "at most 64"},
+      {"profile: {of: rocker, fourier: {a0: 1}, table_deg: [[0, 1], [90, 1], [180, 1]]}", "loads[1].profile.fourier",
+       "one of them"},
+      {"profile: {of: rocker, table_deg: [[0, 1], [90, 1]]}", "loads[1].profile.table_deg", "3 to 720"},
+      {"profile: {of: rocker, table_deg: [[0, 1], [90, 1], [90, 2]]}", "loads[1].profile.table_deg[2][0]",
+       "increase"},
+      {"profile: {of: rocker, table_deg: [[10, 1], [90, 1], [370, 2]]}", "loads[1].profile.table_deg[2][0]",
+       "outside"},
+      {"profile: {of: rocker, table_deg: [[-10, 1], [90, 1], [350, 2]]}", "loads[1].profile.table_deg[2][0]",
+       "one turn"},
+      {"profile: {of: rocker, table_deg: [[0, 1], [90], [180, 2]]}", "loads[1].profile.table_deg[1]", "pair"},
+      {"profile: {of: rocker, table_deg: [[0, 1], [90, 1e300], [180, 2]]}", "loads.p.profile.table_deg[1][1]",
+       "finite with"},
+      {"profile: {of: nosuch, fourier: {a0: 1}}", "loads.p.profile.of", "unknown joint"},
+      {"profile: {of: rocker, fourier: {a0: 1}, extra: 2}", "loads[1].profile.extra", "unknown key"},
+      {"torque_Nm: 3.0e5, profile: {of: rocker, fourier: {a0: 3, a: [2]}}", "loads.p.torque_Nm", "can reach 1.5e+06"},
+  };
+  for (const auto& b : bad) {
+    const std::string line = "  - {type: joint_torque, name: p, joint: crank, " + b.load + "}\n";
+    const std::string yaml = std::string(kFourbar) + line;
+    const SceneError e = refusal(yaml);
+    EXPECT_EQ(e.file(), "test.yaml") << b.load;
+    EXPECT_EQ(e.field(), b.field) << b.load << "\n" << e.what();
+    EXPECT_EQ(e.line(), line_in(yaml, line)) << b.load << "\n" << e.what();
+    EXPECT_NE(e.message().find(b.message), std::string::npos) << b.load << "\n" << e.what();
+  }
+}
+
+TEST(SceneYaml, ProfileOfAPrismaticJointIsRefused) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/slider-crank.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string yaml =
+      with(text.str(), "loads:\n",
+           "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: slider, fourier: {a0: 1}}}\n");
+  const SceneError e = refusal(yaml);
+  EXPECT_EQ(e.field(), "loads.p.profile.of") << e.what();
+  EXPECT_NE(e.message().find("revolute"), std::string::npos) << e.what();
 }
 
 }  // namespace

@@ -58,6 +58,11 @@ class AnalyticSource : public reduced::KinetostaticSource {
     ++calls;
     return {{1.0, std::cos(q)}, {{0.0, 0.5}}, {}};
   }
+  // Coordinates consistent with the ratios: crank q, lever sin q (d/dq sin q = cos q).
+  std::optional<double> joint_coordinate(double q, int joint) override {
+    ++calls;
+    return joint == 0 ? q : std::sin(q);
+  }
 };
 
 // A scene naming the analytic source's joints and constraint force; loads added by tests.

@@ -106,6 +106,31 @@ TEST(Extract, SwitchAnglesAreExactRootsOfTheRatio) {
   EXPECT_NEAR((*roots)[1], 3 * M_PI / 2, 1e-12);
 }
 
+TEST(Extract, ProfiledTorqueIsTabulatedAtTheAngleOfItsJoint) {
+  // tau_<load>(q) = τ(θ_of(q)) per unit amplitude: here θ_lever = sin q (analytic source).
+  auto scene = test::analytic_scene();
+  models::LoadProfile p;
+  p.of = "lever";
+  p.a0 = 0.5;
+  p.a = {2.0};
+  p.b = {0.0, -1.0};
+  scene.joint_torques.push_back({"drive", "crank", 3.0, std::nullopt, p});
+  test::AnalyticSource src;
+  ExtractOptions opt;
+  opt.step_rad = 15 * M_PI / 180;
+  const Samples s = extract_samples(src, scene, opt);
+  const int c = s.require("tau_drive");
+  for (size_t i = 0; i < s.q.size(); ++i) {
+    const double th = std::sin(s.q[i]);
+    EXPECT_NEAR(s.columns[c][i], 0.5 + 2.0 * std::cos(th) - std::sin(2 * th), 1e-14) << s.q[i];
+  }
+  // A source without joint coordinates cannot tabulate it: refused, not guessed.
+  struct NoCoordinates : test::AnalyticSource {
+    std::optional<double> joint_coordinate(double, int) override { return std::nullopt; }
+  } blind;
+  EXPECT_THROW(extract_samples(blind, scene, opt), TableError);
+}
+
 TEST(Extract, GridMustDivideATurn) {
   test::AnalyticSource src;
   ExtractOptions opt;

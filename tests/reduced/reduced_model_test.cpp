@@ -146,6 +146,83 @@ TEST(ReducedModel, GatedTorqueWorkMatchesEnergyGain) {
   EXPECT_NEAR(ts.work.back(), 0.05 * 2 * turns, 0.05 * 2 * 1.01);
 }
 
+// A profiled, gated lever torque: value·τ(θ_lever(q))·r_lever in Eksergian's equation and
+// value·τ·rx_lever in the constraint line, with θ_lever = sin q (analytic source).
+models::JointTorque profiled(double value, double a0, double a1, std::optional<models::RateGate> gate) {
+  models::LoadProfile p;
+  p.of = "lever";
+  p.a0 = a0;
+  p.a = {a1};
+  return {"drive", "lever", value, gate, p};
+}
+
+TEST(ReducedModel, ProfiledTorqueEntersEksergianAndTheConstraintLine) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back(profiled(2.0, 1.0, 0.5, models::RateGate{"lever", +1}));
+  const auto s = analytic_samples(0.0, scene, 5);
+  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  ReducedWorkspace ws(m);
+  const test::SliderCrank sc;
+  for (double q : {0.3, 2.0, 4.0, 5.5}) {
+    for (double qd : {5.0, -5.0}) {
+      ws.q = q, ws.qdot = qd;
+      init_gates(m, ws);
+      const bool on = std::cos(q) * qd > 0;
+      EXPECT_EQ(static_cast<bool>(ws.gate_on[0]), on);
+      const double tau = 2.0 * (1.0 + 0.5 * std::cos(std::sin(q)));  // value·τ(θ_lever)
+      double qdd, p, F;
+      calc_acceleration(m, ws, q, qd, qdd, p);
+      calc_constraint_forces(m, ws, q, qd, qdd, &F);
+      EXPECT_NEAR(qdd, ((on ? tau * std::cos(q) : 0.0) - sc.m2(q) * qd * qd) / sc.m1(q), 1e-7 * std::abs(qdd) + 1e-9);
+      EXPECT_NEAR(p, (on ? tau * std::cos(q) : 0.0) * qd, 1e-7);
+      const double Qx = 0.4 * std::cos(q) + (on ? tau * 0.5 : 0.0);
+      EXPECT_NEAR(F, test::AnalyticSource::me1(q) * qdd + test::AnalyticSource::me2(q) * qd * qd - Qx,
+                  1e-9 * std::abs(F) + 1e-7);
+      // The fused lookup of an output sample gives the same numbers.
+      double qdd2, p2, F2;
+      calc_sample(m, ws, q, qd, qdd2, p2, &F2);
+      EXPECT_NEAR(qdd2, qdd, 1e-12 * std::abs(qdd) + 1e-14);
+      EXPECT_NEAR(F2, F, 1e-12 * std::abs(F) + 1e-14);
+    }
+  }
+}
+
+TEST(ReducedModel, ConstantProfileReproducesTheConstantTorque) {
+  // τ(θ) ≡ a0 with amplitude 1 is the constant torque a0: the same right-hand side and
+  // constraint force to round-off, and so the same motion (fixed-step RK4, so that no step-size
+  // control amplifies a last-bit difference; adaptive runs agree to their tolerance).
+  auto constant = test::analytic_scene(), profile = constant;
+  constant.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
+  profile.joint_torques.push_back(profiled(1.0, 0.05, 0.0, models::RateGate{"lever", +1}));
+  const auto ma = make_reduced_model(analytic_samples(0.0, constant, 5), constant, Interpolation::Fourier);
+  const auto mb = make_reduced_model(analytic_samples(0.0, profile, 5), profile, Interpolation::Fourier);
+  ReducedWorkspace wa(ma), wb(mb);
+  for (int i = 0; i < 1000; ++i) {
+    const double q = 0.00628 * i;
+    double qa, pa, qb, pb, Fa, Fb;
+    calc_acceleration(ma, wa, q, 3.0, qa, pa);
+    calc_acceleration(mb, wb, q, 3.0, qb, pb);
+    calc_constraint_forces(ma, wa, q, 3.0, qa, &Fa);
+    calc_constraint_forces(mb, wb, q, 3.0, qb, &Fb);
+    EXPECT_NEAR(qb, qa, 1e-14 * (1 + std::abs(qa))) << q;
+    EXPECT_NEAR(Fb, Fa, 1e-14 * (1 + std::abs(Fa))) << q;
+  }
+  ReducedOptions opt;
+  opt.duration_s = 3.0;
+  opt.output_interval_s = 0.01;
+  opt.integrator = "rk4-fixed";
+  opt.fixed_step_s = 1e-3;
+  const auto a = simulate_reduced(ma, 0.0, 10.0, opt);
+  const auto b = simulate_reduced(mb, 0.0, 10.0, opt);
+  ASSERT_EQ(a.t.size(), b.t.size());
+  EXPECT_GT(b.stats.events, 4);
+  for (size_t i = 0; i < a.t.size(); ++i) {
+    EXPECT_NEAR(b.q[i], a.q[i], 1e-12 * (1 + std::abs(a.q[i])));
+    EXPECT_NEAR(b.qdot[i], a.qdot[i], 1e-12 * std::abs(a.qdot[i]));
+    EXPECT_NEAR(b.work[i], a.work[i], 1e-12 * (1 + std::abs(a.work[i])));
+  }
+}
+
 TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
   auto scene = test::analytic_scene();
   scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});

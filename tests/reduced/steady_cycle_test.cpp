@@ -73,6 +73,69 @@ TEST(SteadyCycle, FlywheelWithViscousResistanceTurnsAtTorqueOverCoefficient) {
   }
 }
 
+TEST(SteadyCycle, FlywheelWithAProfiledTorqueDoesA0TwoPiPerTurn) {
+  // τ(θ) = a0 + a1 cos θ of the crank angle on a flywheel I with viscous resistance c: the
+  // cos θ part does no work per turn, so on the steady cycle a0·2π = c ∫ω dθ, i.e. the mean of
+  // ω over the angle is a0/c exactly, while ω itself fluctuates.
+  const double a0 = 2.0, a1 = 1.5, c = 0.1;
+  auto scene = test::analytic_scene();
+  models::LoadProfile p;
+  p.of = "crank";
+  p.a0 = a0;
+  p.a = {a1};
+  scene.joint_torques.push_back({"drive", "crank", 1.0, std::nullopt, p});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, c});
+  const auto m = flywheel(scene);
+  const auto fi = calc_steady_cycle(m, options(5.0, 0.7));
+  EXPECT_EQ(fi.method, CycleMethod::FirstIntegral);
+  EXPECT_NEAR(fi.drive_work_J, a0 * 2 * M_PI, 1e-8 * a0 * 2 * M_PI);
+  EXPECT_NEAR(fi.dissipated_work_J, a0 * 2 * M_PI, 1e-8 * a0 * 2 * M_PI);  // c ∫ω dθ, integrated by the cycle
+  EXPECT_GT(fi.speed_fluctuation, 0.01);  // a1 shapes the cycle
+  // The time mean 2π/period is below the angle mean a0/c (slow stretches last longer).
+  EXPECT_LT(2 * M_PI / fi.period_s, a0 / c);
+  EXPECT_GT(2 * M_PI / fi.period_s, 0.95 * a0 / c);
+  // ∫ω dθ by a second route: the reduced model integrated in time over one cycle from the
+  // cycle's own section speed, ω dθ = ω² dt by the trapezoidal rule on a fine output.
+  ReducedOptions ro;
+  ro.duration_s = fi.period_s;
+  ro.output_interval_s = fi.period_s / 20000;
+  ro.tolerance = 1e-12;
+  const auto ts = simulate_reduced(m, 0.7, fi.qdot_section, ro);
+  double integral = 0.0;
+  for (size_t i = 1; i < ts.t.size(); ++i)
+    integral += 0.5 * (ts.qdot[i] * ts.qdot[i] + ts.qdot[i - 1] * ts.qdot[i - 1]) * (ts.t[i] - ts.t[i - 1]);
+  EXPECT_NEAR(c * integral, a0 * 2 * M_PI, 1e-6 * a0 * 2 * M_PI);
+  EXPECT_NEAR(ts.q.back() - ts.q.front(), 2 * M_PI, 1e-7);  // one turn in one period
+  EXPECT_NEAR(ts.qdot.back(), fi.qdot_section, 1e-7 * fi.qdot_section);  // periodic
+  // The time-stepping Poincaré map finds the same cycle.
+  const auto tsc = calc_steady_cycle_time_stepping(m, options(5.0, 0.7));
+  EXPECT_LT(rel(tsc.period_s, fi.period_s), 1e-8);
+  EXPECT_LT(rel(tsc.speed_max, fi.speed_max), 1e-7);
+}
+
+TEST(SteadyCycle, GatedProfileSwitchesAtTheSameAnglesInBothRoutes) {
+  // A lever torque value·τ(θ_lever), τ = 1 + 0.8 sin 2θ of the lever angle θ = sin q, on only
+  // while the lever turns forward (cos q · q̇ > 0: switches at ±90°), against a crank brake; on
+  // the flywheel the drive work per turn is the closed form value·∫ τ(sin q) cos q dq over
+  // (−90°, 90°) = value·∫_{−1}^{1} (1 + 0.8 sin 2θ) dθ = 2·value.
+  auto scene = test::analytic_scene();
+  models::LoadProfile p;
+  p.of = "lever";
+  p.a0 = 1.0;
+  p.b = {0.0, 0.8};
+  scene.joint_torques.push_back({"drive", "lever", 1.5, models::RateGate{"lever", +1}, p});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 0.02});
+  const auto m = flywheel(scene);
+  const auto fi = calc_steady_cycle(m, options(20.0, 0.3));
+  const auto ts = calc_steady_cycle_time_stepping(m, options(20.0, 0.3));
+  EXPECT_EQ(fi.method, CycleMethod::FirstIntegral);
+  EXPECT_NEAR(fi.drive_work_J, 2 * 1.5, 1e-7 * 3.0);
+  EXPECT_NEAR(fi.dissipated_work_J, 2 * 1.5, 1e-7 * 3.0);
+  EXPECT_LT(rel(fi.period_s, ts.period_s), 1e-8);
+  EXPECT_LT(rel(fi.qdot_section, ts.qdot_section), 1e-8);
+  EXPECT_LT(rel(fi.drive_work_J, ts.drive_work_J), 1e-7);
+}
+
 TEST(SteadyCycle, FlywheelWithQuadraticResistanceTurnsAtRootOfTorqueOverCoefficient) {
   // I q̈ = T − c2 q̇|q̇|: steady q̇ = √(T/c2). The equation is linear in u = q̇²/2, so the
   // map u ↦ Φ(u) is affine and the secant lands on the cycle at its third pass.

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
+#include <fstream>
 
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
@@ -48,6 +50,26 @@ TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   // Two thighs, each descending through a realistic swing (40°–70°).
   EXPECT_GT(r.work_per_rev_per_unit / 2, 40 * M_PI / 180);
   EXPECT_LT(r.work_per_rev_per_unit / 2, 70 * M_PI / 180);
+}
+
+TEST(Calibrate, WrittenSceneScalesProfiledLoadsWhereTheSceneListsThem) {
+  // bicycle-profile: hip_torque_Nm 0 (no generated torques) and two profiled hip torques under
+  // `loads`: the amplitudes are rewritten there, the generator's hip torque stays 0 (setting it
+  // would add constant hip torques beside the profiles).
+  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle-profile.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto scene = models::parse_scene(text.str(), "bicycle-profile.yaml");
+  CalibrationResult r;
+  r.torque_Nm = 12.5;
+  r.steady_qdot = 6.0;
+  const std::string out = calibrated_scene_yaml("bicycle-profile.yaml", text.str(), {}, scene, CalibrationOptions{}, r);
+  const auto again = models::parse_scene(out, "written.yaml");
+  ASSERT_EQ(again.joint_torques.size(), 2u);
+  for (const auto& t : again.joint_torques) {
+    EXPECT_TRUE(t.profile) << t.name;
+    EXPECT_EQ(t.value, 12.5) << t.name;
+  }
 }
 
 TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {

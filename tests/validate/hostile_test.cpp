@@ -392,6 +392,13 @@ void scenes(std::vector<Case>& cs) {
        ""},
       {"too_large", fb + "# " + std::string(1 << 21, 'x') + "\n", "too large"},
       {"loop_cannot_close", edit(fb, "ground_points: {A: [0.0, 0.0], D: [0.30, 0.0]}", "ground_points: {A: [0.0, 0.0], D: [3.0, 0.0]}"), "C"},
+      // Profiled drive loads (models/load_profile.hpp): every number and the table's order.
+      {"profile_nan", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: rocker, fourier: {a0: .nan}}}\n"), "profile.fourier.a0"},
+      {"profile_unknown_joint", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: knee, fourier: {a0: 1}}}\n"), "profile.of"},
+      {"profile_too_many", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, fourier: {a: [" + [] { std::string a; for (int i = 0; i < 65; ++i) a += (i ? ", 1" : "1"); return a; }() + "]}}}\n"), "profile.fourier.a"},
+      {"profile_unordered", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, table_deg: [[0, 1], [180, 2], [90, 3]]}}\n"), "table_deg[2][0]"},
+      {"profile_over_a_turn", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, table_deg: [[0, 1], [180, 2], [360, 3]]}}\n"), "table_deg[2][0]"},
+      {"profile_amplitude_huge", edit(fb, "loads:\n", "loads:\n  - {type: joint_torque, name: p, joint: crank, torque_Nm: 1e5, profile: {of: crank, fourier: {a0: 20}}}\n"), "torque_Nm"},
   };
   for (const auto& b : bad) {
     cs.push_back({"scene_" + b.tag + "_simulate", {"simulate", "s.yaml", "--duration", "0.1", "--out", "o"}, 2,
