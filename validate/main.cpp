@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
       "full multibody model (Simbody).\n"
-      "A SCENE is a shipped scene name (bicycle, fourbar, slider-crank) or a YAML file (see models/README.md)."};
+      "A SCENE is a shipped scene name (bicycle, bicycle-profile, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
   app.require_subcommand(1);
 
   SimulateArgs sim;
