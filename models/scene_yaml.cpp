@@ -588,6 +588,8 @@ void read_independent_range(const Fields& top, Scene& s) {
   }
   if (!(v.x < v.y)) top.fail(key, fmt::format("needs min < max (got [{:g}, {:g}])", v.x, v.y));  // here: the line
   s.independent_range = IndependentRange{v.x * k, v.y * k};
+}
+
 // A joint torque's profile: {of: joint, fourier: {a0, a: [...], b: [...]}} or
 // {of: joint, table_deg: [[θ_deg, τ], ...]} (models/load_profile.hpp). Counts, finiteness and
 // the order of the table's angles are checked here, where the line of each row is known;
