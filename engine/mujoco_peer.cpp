@@ -199,8 +199,10 @@ struct Run {
     for (const auto& t : sc.joint_torques) {
       if (t.active_when && !(t.active_when->sign * joint_u(sc.joint_index(t.active_when->joint)) > 0.0)) continue;
       const int j = sc.joint_index(t.joint);
-      add_joint_force(j, t.value);
-      P += t.value * joint_u(j);
+      // value·τ(θ_of) for a profiled load (models::calc_joint_torque), value otherwise.
+      const double tau = models::calc_joint_torque(t, t.profile ? joint_q(sc.joint_index(t.profile->of)) : 0.0);
+      add_joint_force(j, tau);
+      P += tau * joint_u(j);
     }
     for (const auto& mo : sc.motors) {
       const int j = sc.joint_index(mo.joint);

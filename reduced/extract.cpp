@@ -196,7 +196,11 @@ long range_intervals(double span, double step_rad, bool revolute) {
   if (!(std::isfinite(span) && span > 0))
     throw TableError(fmt::format("the range of the independent coordinate must be finite and positive (got {:g})",
                                  span));
-  const double n = revolute ? std::ceil(span / step_rad - 1e-9) : std::round(2 * kPi / step_rad);
+  // A range table never has fewer intervals than a full turn at the same grid (360/g): a rocker
+  // swinging 48° at 10° would otherwise get 5 intervals, and its reduced speed missed the full
+  // model's by 24 % (fourbar-rocker); a revolute range wider than that keeps intervals ≤ g.
+  const double per_turn = std::round(2 * kPi / step_rad);
+  const double n = revolute ? std::max(per_turn, std::ceil(span / step_rad - 1e-9)) : per_turn;
   if (!(n + 1 <= static_cast<double>(kMaxTableRows)))
     throw TableError(fmt::format("a range table of {:.6g} with a {:.6g}° grid would have {:.3g} points, more than {}",
                                  span, step_rad * 180 / kPi, n + 1, kMaxTableRows));

@@ -10,6 +10,7 @@
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
@@ -201,6 +202,17 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
   }
   const engine::FullModel model(scene);
   const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
+  // A mean rate in rev/s needs a coordinate that turns fully: a rocker or a stroke moves within
+  // a range (docs/theory.md §6c) and has no steady revolution to hold.
+  const auto* indep = scene.find_joint(scene.independent);
+  if (indep->type != models::JointType::Revolute || scene.independent_range)
+    fail("independent", fmt::format("calibration holds a mean rate in rev/s, so '{}' must be a revolute that turns "
+                                    "fully; it moves within a range",
+                                    scene.independent));
+  if (!engine::calc_independent_domain(model).periodic)
+    fail("independent", fmt::format("calibration holds a mean rate in rev/s, so '{}' must turn fully; it cannot "
+                                    "(it meets dead points: see rdyn inspect)",
+                                    scene.independent));
 }
 
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {

@@ -30,13 +30,15 @@ Samples range_samples(test::AnalyticSource& src, const models::Scene& scene, dou
 }
 
 TEST(ExtractRange, GridRules) {
-  // Revolute: the fewest equal intervals no longer than the step; prismatic: as many as the
-  // step makes over a turn; never fewer than 4 (5 points: Akima's minimum).
-  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true), 12);
-  EXPECT_EQ(range_intervals(125 * kDeg, 10 * kDeg, true), 13);
+  // Never fewer intervals than a full turn at the same grid (360/g); a revolute range wider
+  // than a turn's worth keeps intervals no longer than the step.
+  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true), 36);
+  EXPECT_EQ(range_intervals(125 * kDeg, 1 * kDeg, true), 360);
+  EXPECT_EQ(range_intervals(500 * kDeg, 10 * kDeg, true), 50);
   EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false), 36);
   EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false), 180);
-  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 4);
+  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 36);
+  EXPECT_EQ(range_intervals(20 * kDeg, 90 * kDeg, true), 4);  // never fewer than 4 (5 points: Akima's minimum)
   EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true), TableError);
   EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true), TableError);
   EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true), TableError);  // > kMaxTableRows points
@@ -49,10 +51,10 @@ TEST(ExtractRange, SamplesTheRangeWithClosedFormValuesAndNoWrap) {
   const Samples s = range_samples(src, scene, 0.3, 2.5, 10);
   EXPECT_FALSE(s.periodic);
   EXPECT_TRUE(s.revolute);
-  ASSERT_EQ(s.q.size(), 14u);  // 2.2 rad = 126°: 13 intervals of 9.7°
+  ASSERT_EQ(s.q.size(), 37u);  // 2.2 rad = 126°: 36 intervals (a full turn's count at 10°)
   EXPECT_DOUBLE_EQ(s.q.front(), 0.3);
   EXPECT_DOUBLE_EQ(s.q.back(), 2.5);
-  EXPECT_NEAR(s.step, 2.2 / 13, 1e-15);
+  EXPECT_NEAR(s.step, 2.2 / 36, 1e-15);
   EXPECT_EQ(s.min_edge, "dead point");
   EXPECT_EQ(s.max_edge, "declared limit");
   for (size_t i = 0; i < s.q.size(); ++i) {

@@ -225,6 +225,18 @@ TEST(Calibrate, RefusalsNameTheField) {
   const auto fb = models::load_scene("fourbar");
   f = field_of(fb, calibration_options_of(fb, 1.0, 0.0, ""));
   EXPECT_EQ(f.rfind("validation.calibrate.load: name the load", 0), 0u) << f;
+  // A coordinate that moves within a range has no mean rate in rev/s to hold: a cylinder stroke
+  // (declared range) and a rocker between its dead points (found by the domain walk).
+  const auto crane = models::load_scene("crane-luffing");
+  f = field_of(crane, calibration_options_of(crane, 0.5, 0.0, "pressure"));
+  EXPECT_EQ(f.rfind("independent: calibration holds a mean rate in rev/s", 0), 0u) << f;
+  auto rocker = models::load_scene("fourbar-rocker");
+  models::JointTorque drive;
+  drive.name = "drive", drive.joint = "rocker", drive.value = 1.0;
+  rocker.joint_torques.push_back(drive);
+  f = field_of(rocker, calibration_options_of(rocker, 1.0, 0.0, "drive"));
+  EXPECT_EQ(f.rfind("independent: calibration holds a mean rate in rev/s", 0), 0u) << f;
+  EXPECT_NE(f.find("dead points"), std::string::npos) << f;
 }
 
 // --write-scene writes the adjusted value of the named load (and nothing of the resistance in
