@@ -95,6 +95,18 @@ double calc_length_scale(const models::Scene& s) {
     for (const auto& [n, p] : b.points) add(p);
   }
   for (const auto& j : s.joints) add(j.parent_point), add(j.child_point);
+  for (const auto& l : s.loops) add(l.point_a), add(l.point_b);
+  for (const auto& sp : s.springs) add(sp.point_a), add(sp.point_b);
+  // A prismatic joint's own travel is part of the size: a lone slider whose points all sit at
+  // its origin would otherwise get 1 mm, and continuation over a 1 m stroke would need 2·10⁴
+  // moves (over the approach budget).
+  for (const auto& j : s.joints)
+    if (j.type == models::JointType::Prismatic) L = std::max(L, std::abs(j.guess));
+  if (const auto* jt = s.find_joint(s.independent); jt && jt->type == models::JointType::Prismatic) {
+    L = std::max(L, std::abs(s.initial.q));
+    if (s.independent_range)
+      L = std::max({L, std::abs(s.independent_range->min), std::abs(s.independent_range->max)});
+  }
   return L;
 }
 

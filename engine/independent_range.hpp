@@ -41,7 +41,7 @@ struct IndependentDomain {
 IndependentDomain calc_independent_domain(const FullModel& model);
 
 // Size of the mechanism [m]: the largest distance of any point (ground points, body points,
-// centres of mass, joint locations) from its frame's origin; at least 1 mm. Sets the
+// centres of mass, joint locations) from its frame's origin, and the travel of prismatic joints (guesses; the independent one's initial q and declared range); at least 1 mm. Sets the
 // continuation moves of a prismatic coordinate.
 double calc_length_scale(const models::Scene& scene);
 

@@ -553,6 +553,31 @@ void read_mechanism(const Fields& top, Scene& s) {
       if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
       if (br.joint == top.str_or("independent", ""))
         b.fail("joint", "the independent coordinate is set by `initial`, not by assembly: name another joint");
+      // Only a joint the loop closes over can tell its branches apart: the joints on exactly one
+      // of the two tree paths from body_a and body_b down to ground.
+      auto path_to_ground = [&](std::string body) {
+        std::vector<std::string> joints;
+        for (size_t guard = 0; guard <= s.joints.size() && body != "ground"; ++guard) {
+          const auto it = std::find_if(s.joints.begin(), s.joints.end(), [&](const Joint& jt) { return jt.child == body; });
+          if (it == s.joints.end()) break;
+          joints.push_back(it->name);
+          body = it->parent;
+        }
+        return joints;
+      };
+      const auto pa = path_to_ground(l.body_a), pb = path_to_ground(l.body_b);
+      std::vector<std::string> on_loop;
+      for (const auto& j : pa)
+        if (std::find(pb.begin(), pb.end(), j) == pb.end()) on_loop.push_back(j);
+      for (const auto& j : pb)
+        if (std::find(pa.begin(), pa.end(), j) == pa.end()) on_loop.push_back(j);
+      if (std::find(on_loop.begin(), on_loop.end(), br.joint) == on_loop.end()) {
+        std::string list;
+        for (const auto& j : on_loop) list += (list.empty() ? "" : ", ") + j;
+        b.fail("joint", fmt::format("'{}' is not a joint of loop '{}' (its joints: {}): only a joint the loop closes "
+                                    "over can pick its branch",
+                                    br.joint, l.name, list));
+      }
       const std::string sign = b.str("sign");
       if (sign == "positive" || sign == "+1" || sign == "1") br.sign = +1;
       else if (sign == "negative" || sign == "-1") br.sign = -1;
@@ -884,6 +909,8 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       // power_W absent: mean-speed mode (the resistances stay as given).
       s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
       s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
+      if (c.has("load") && s.validation.calibrate_load.empty())
+        c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
       // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
       if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
       if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");

@@ -18,7 +18,7 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     throw TableError(what + " does not record the scene it was extracted from; re-extract it with `rdyn extract`");
   const std::uint64_t h = models::scene_hash(scene);
   if (*s.scene_hash != h)
-    throw TableError(fmt::format("{} was extracted from a different scene (mechanism/loads differ: hash {} vs {}); "
+    throw TableError(fmt::format("{} was extracted from a different scene (its mechanism, where loads act, or the initial q that picks the assembly branch differ: hash {} vs {}); "
                                  "re-extract it for scene '{}'",
                                  what, models::scene_hash_hex(*s.scene_hash), models::scene_hash_hex(h), scene.name));
   ReducedModel m;

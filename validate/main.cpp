@@ -99,9 +99,13 @@ int main(int argc, char** argv) {
       "--power-w", cal.power_w,
       "Power the resistance dissipates at that cadence [W] (default: the scene's validation.calibrate; none: the "
       "resistances stay as given)");
+  // An empty --load would silently mean "no load named" (every joint torque): refuse it.
+  const CLI::Validator names_a_load(
+      [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
   calibrate->add_option("--load", cal.load,
                         "The joint_torque or motor to adjust (default: the scene's validation.calibrate.load, else "
-                        "every joint torque together)");
+                        "every joint torque together)")
+      ->check(names_a_load);
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
   calibrate->add_flag("--force", cal.force, kForceHelpFile);
   calibrate->add_option("--set", cal.sets, "Override a scalar of the scene: key.path=value (repeatable)");
@@ -160,7 +164,7 @@ int main(int argc, char** argv) {
   sweep->add_option("--power-w", sw.power_w,
                     "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as "
                     "given)");
-  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load");
+  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load);
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
 
   InspectArgs ins;

@@ -472,6 +472,27 @@ TEST(SceneYaml, LoopBranchNamesAJointAndASign) {
 }
 
 
+// A branch names a joint the loop closes over: a flywheel geared to the crank is not one (no
+// guess could move it to the other branch), and the refusal lists the loop's joints.
+TEST(SceneYaml, LoopBranchJointMustBeOnTheLoop) {
+  std::string yaml = kFourbar;
+  yaml.replace(yaml.find("  - {name: rocker, mass_kg"), 0,
+               "  - {name: wheel, mass_kg: 1.0, inertia_kgm2: 1.0e-2}\n");
+  yaml.replace(yaml.find("loops:"), 0,
+               "  - {name: wheel, type: revolute, parent: ground, parent_point: A, child: wheel}\n"
+               "gears:\n  - {name: g, driver: crank, driven: wheel, ratio: 2}\n");
+  const std::string on = std::string(yaml).replace(yaml.find("point_b: C}"), 11,
+                                                    "point_b: C, branch: {joint: rocker, sign: positive}}");
+  EXPECT_EQ(parse_scene(on, "t.yaml").loops[0].branch->joint, "rocker");
+  const std::string off = std::string(yaml).replace(yaml.find("point_b: C}"), 11,
+                                                     "point_b: C, branch: {joint: wheel, sign: positive}}");
+  const SceneError e = refusal(off);
+  EXPECT_EQ(e.field(), "loops[0].branch.joint") << e.what();
+  EXPECT_NE(e.message().find("'wheel' is not a joint of loop 'C' (its joints: coupler, crank, rocker)"),
+            std::string::npos)
+      << e.what();
+}
+
 TEST(SceneYaml, JointOutputsAllOrNames) {
   const auto all = load_scene("fourbar", {{"outputs.joints", "all"}, {"outputs.reactions", "all"},
                                           {"outputs.shaking", "true"}});

@@ -564,7 +564,8 @@ void found_later(std::vector<Case>& cs) {
            {"unknown", "nope", "field '--load': no joint_torque or motor named 'nope'"},
            {"resistance", "flywheel_resistance", "is a resistance"},
            {"bad_name", "a\nb", "field '--load'"},
-           {"generated_write", "hip_torque_r", "field '--write-scene'"}})
+           {"generated_write", "hip_torque_r", "field '--write-scene'"},
+           {"empty", "", "an empty name names no load"}})
     cs.push_back({"calibrate_load_" + tag, {"calibrate", "bicycle", "--load", load, "--write-scene", "cal.yaml"}, 2,
                   message, {}, nullptr, "cal.yaml"});
   cs.push_back({"sweep_load_unknown",
@@ -573,6 +574,9 @@ void found_later(std::vector<Case>& cs) {
   cs.push_back({"calibrate_load_in_scene_unknown", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
                 "field 'validation.calibrate.load': no joint_torque or motor named 'ghost'",
                 {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ghost}}\n"}}, nullptr, "cal.yaml"});
+  cs.push_back({"calibrate_load_in_scene_empty", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
+                "field 'validation.calibrate.load': an empty name names no load",
+                {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ''}}\n"}}, nullptr, "cal.yaml"});
   for (const std::string reserved : {"summary.json", "index.html"})
     cs.push_back({"suite_name_" + reserved.substr(0, reserved.find('.')), {"validate", "--suite", "s", "--out", "o"}, 2,
                   "suite's own output", {{"s/" + reserved + ".yaml", scene_text("fourbar")}}, nullptr, "o"});
