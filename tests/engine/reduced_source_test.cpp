@@ -315,11 +315,13 @@ namespace rdyn::engine {
 namespace {
 
 // Two routes on one mechanism: the four-bar's crank turns fully, so a periodic table and a range
-// table over [−170°, 170°] (more than half a turn from the initial 30°: walked directly, not by
+// table over [−190°, 190°] (more than half a turn from the initial 30°: walked directly, not by
 // its periodic image) must agree at their common grid points.
 TEST(ReducedSourceRange, ARangeTableOfAFullTurnCrankAgreesWithThePeriodicTable) {
   auto scene = models::load_scene("fourbar");
-  const double lo = -170 * M_PI / 180, hi = 170 * M_PI / 180;
+  // More than a turn, so that the range keeps the 10° step (a narrower range gets a full turn's
+  // 36 intervals, and its grid points would not coincide with the periodic table's).
+  const double lo = -190 * M_PI / 180, hi = 190 * M_PI / 180;
   scene.independent_range = models::IndependentRange{lo, hi};
   FullModel model(scene);
   reduced::ExtractOptions opt;
@@ -329,7 +331,7 @@ TEST(ReducedSourceRange, ARangeTableOfAFullTurnCrankAgreesWithThePeriodicTable) 
   opt.range = reduced::ExtractRange{lo, hi, "declared limit", "declared limit"};
   FullKinetostaticSource rng_src(model, false);
   const auto rng = reduced::extract_samples(rng_src, scene, opt);
-  ASSERT_EQ(rng.q.size(), 35u);
+  ASSERT_EQ(rng.q.size(), 39u);
   int matched = 0;
   for (size_t i = 0; i < rng.q.size(); ++i)
     for (size_t j = 0; j < per.q.size(); ++j)
@@ -340,7 +342,7 @@ TEST(ReducedSourceRange, ARangeTableOfAFullTurnCrankAgreesWithThePeriodicTable) 
                       1e-10 * (1 + std::abs(per.columns[per.require(c)][j])))
               << c << " at " << rng.q[i];
       }
-  EXPECT_EQ(matched, 35);
+  EXPECT_EQ(matched, 39);
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ TEST(Calibrate, WrittenSceneScalesProfiledLoadsWhereTheSceneListsThem) {
   text << in.rdbuf();
   const auto scene = models::parse_scene(text.str(), "bicycle-profile.yaml");
   CalibrationResult r;
-  r.torque_Nm = 12.5;
+  r.torque_Nm = r.load_value = 12.5;  // every joint torque together: the magnitude each gets
   r.steady_qdot = 6.0;
   const std::string out = calibrated_scene_yaml("bicycle-profile.yaml", text.str(), {}, scene, CalibrationOptions{}, r);
   const auto again = models::parse_scene(out, "written.yaml");
