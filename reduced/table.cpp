@@ -198,8 +198,11 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
     // At 0.25° or finer the resampling grid is the sample grid, where the trigonometric
     // interpolant equals the samples: skip the FFTs and build the cubic table from the samples
     // themselves.
-    if (refine == 1) return build_table(samples, Interpolation::CubicSpline, energy_consistent_m2);
-    return build_table(fourier_resample(samples, refine), Interpolation::CubicSpline, energy_consistent_m2);
+    Table t = refine == 1 ? build_table(samples, Interpolation::CubicSpline, energy_consistent_m2)
+                          : build_table(fourier_resample(samples, refine), Interpolation::CubicSpline,
+                                        energy_consistent_m2);
+    t.fit = interpolation_name(Interpolation::Fourier);
+    return t;
   }
   const Samples& s = samples;
   const int n = static_cast<int>(s.q.size());
@@ -212,6 +215,7 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
   t.intervals = s.periodic ? n : n - 1;
   t.cols = static_cast<int>(s.names.size());
   t.names = s.names;
+  t.fit = !s.periodic && interp == Interpolation::CubicSpline ? "cubic (not-a-knot)" : interpolation_name(interp);
   t.coef.assign(static_cast<size_t>(t.intervals) * t.cols * 4, 0.0);
 
   const gsl_interp_type* type = nullptr;

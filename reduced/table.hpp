@@ -27,6 +27,9 @@ struct Table {
   double period = 0.0;
   int intervals = 0;  // periodic: N (wrapping), otherwise N − 1
   int cols = 0;
+  // The interpolant actually built: a range table takes a not-a-knot cubic spline for `cubic`
+  // and in place of `fourier` (no period); `fourier` is resampled into the cubic table.
+  std::string fit;
   std::vector<std::string> names;
   std::vector<double> coef;  // [interval][col][4]
 

@@ -158,11 +158,9 @@ int run_simulate(const SimulateArgs& a) {
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
     if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(scene, model, ts);
-    // A range table cannot take the trigonometric interpolant (it needs a period): record the
-    // not-a-knot cubic spline it falls back to (reduced/table.cpp), not the option's name.
-    const bool range_fallback = !samples.periodic && a.interpolation == "fourier";
-    run.update({{"interpolation", range_fallback ? std::string("cubic (not-a-knot; fourier needs a period)")
-                                                 : a.interpolation},
+    // The interpolant the table was built with (a range table's not-a-knot spline stands in for
+    // fourier), not the option's name.
+    run.update({{"interpolation", model.table.fit},
                 {"energy_consistent_m2", a.energy_consistent},
                 {"integrator", a.reduced_integrator},
                 {"tolerance", a.reduced_tolerance},

@@ -40,6 +40,18 @@ double max_error(const Table& t, int col, double (*exact)(double)) {
 double f_exact(double q) { return std::exp(std::sin(q)); }
 double m1_exact(double q) { return 2.0 + 0.5 * std::sin(q) + 0.2 * std::cos(3 * q); }
 
+// The table records the interpolant it was built with: a range table (no period) takes the
+// not-a-knot cubic spline in place of fourier, and run.json reports that, not the option.
+TEST(Table, RecordsTheInterpolantItBuilt) {
+  Samples per = periodic_samples(36);
+  EXPECT_EQ(build_table(per, Interpolation::Fourier).fit, "fourier");
+  EXPECT_EQ(build_table(per, Interpolation::CubicSpline).fit, "cubic");
+  Samples range = per;
+  range.periodic = false;
+  EXPECT_EQ(build_table(range, Interpolation::Fourier).fit, "cubic (not-a-knot)");
+  EXPECT_EQ(build_table(range, Interpolation::Akima).fit, "akima");
+}
+
 TEST(Table, InterpolatesThroughSamplesAndWraps) {
   const auto s = periodic_samples(36);
   for (auto interp : {Interpolation::CubicSpline, Interpolation::Akima, Interpolation::Linear, Interpolation::Fourier}) {
