@@ -59,8 +59,9 @@ Walk walk(const FullModel& model, double dir, double h0, double limit, bool revo
   Walk out;
   while (std::abs(q - q0) < limit) {
     if (++moves > kMaxMoves)
-      throw EngineError(fmt::format("{}: the search for the dead points of '{}' took more than {} moves",
-                                    model.scene().source_file, model.scene().independent, kMaxMoves));
+      // A numerical failure (exit 1), not bad input: the scene was valid, the walk did not end.
+      throw models::NumericalError(fmt::format("{}: the search for the dead points of '{}' took more than {} moves",
+                                               model.scene().source_file, model.scene().independent, kMaxMoves));
     const double q_try = q + dir * std::min(h, limit - std::abs(q - q0) + 1e-12);
     if (try_reach(model, ws, q_try)) {
       q = q_try;
