@@ -49,7 +49,7 @@ const char* unit_of(const models::Scene& s, const std::string& joint) {
 // opt.load_field for an unknown load or one that is not a drive load.
 Selection select_load(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
   };
   auto candidates = [&] {
     std::string c;
@@ -218,7 +218,7 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
   };
   check_calibratable(scene, opt);
   const Selection sel = select_load(scene, opt);
