@@ -1,0 +1,28 @@
+// Writing a scene back as YAML: the expanded scene (generators already applied,
+// every value explicit) in the format models/scene_yaml.cpp reads
+// (models/README.md, "Writing a scene").
+#pragma once
+
+#include <string>
+
+#include "models/scene.hpp"
+
+namespace rdyn::models {
+
+// The scene as YAML text that parse_scene reads back to an equal Scene, field
+// by field and bit for bit: numbers in the shortest text that reads back to the
+// same double, angles in radians (offset_rad, guess_rad, table_rad, q; the
+// degrees follow as comments), points and directions as coordinates, every load
+// with its name, every default written out. Strings are written plain when YAML
+// reads them back as the same text, double-quoted and escaped otherwise. Not
+// kept: the original file's comments and layout, generator blocks (bicycle_leg:
+// the bodies and joints it made are written instead), named-point references
+// (their coordinates are written), `dissipates` (the coefficient it gave is
+// written).
+//
+// Throws SceneError (file: the scene's source_file) for a value no scene file
+// can hold: a non-finite or subnormal number, or text that is not valid UTF-8.
+// A scene that load_scene returned never has one.
+std::string scene_to_yaml(const Scene& scene);
+
+}  // namespace rdyn::models
