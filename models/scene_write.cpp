@@ -7,6 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "models/scene_hash.hpp"
+#include "models/scene_yaml.hpp"
+
 namespace rdyn::models {
 
 namespace {
@@ -396,6 +399,21 @@ std::string scene_to_yaml(const Scene& s) {
          ", tolerance: " + w.num(s.simulation.tolerance, "simulation.tolerance") + "}");
   write_validation(w, s);
   return w.take();
+}
+
+std::string scene_to_yaml_checked(const Scene& s) {
+  const std::string yaml = scene_to_yaml(s);
+  const Scene back = parse_scene(yaml, s.source_file);
+  if (scene_hash(back) != scene_hash(s))
+    throw NumericalError(
+        fmt::format("scene '{}' does not read back as written (its scene hash changes from {} to "
+                    "{}): it holds a "
+                    "value the scene format cannot express",
+                    s.name, scene_hash_hex(scene_hash(s)), scene_hash_hex(scene_hash(back))));
+  if (scene_to_yaml(back) != yaml)
+    throw NumericalError(fmt::format(
+        "scene '{}' does not read back as written (writing it again gives another text)", s.name));
+  return yaml;
 }
 
 }  // namespace rdyn::models

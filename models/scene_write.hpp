@@ -25,4 +25,11 @@ namespace rdyn::models {
 // A scene that load_scene returned never has one.
 std::string scene_to_yaml(const Scene& scene);
 
+// scene_to_yaml, then the text read back (parse_scene, as the scene's source_file) and written
+// again: returns the text when both writings and the scene hashes (models/scene_hash.hpp) agree.
+// Throws SceneError when the text does not load (a scene check_scene refuses) and
+// NumericalError when it loads as another scene (a field the format cannot express, such as
+// an axis on a revolute joint set in code). What `rdyn expand` writes.
+std::string scene_to_yaml_checked(const Scene& scene);
+
 }  // namespace rdyn::models

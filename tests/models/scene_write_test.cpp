@@ -515,5 +515,26 @@ TEST(SceneWrite, EveryFieldIsWrittenAndCompared) {
   }
 }
 
+// The checked writer returns the same text, and refuses a scene whose written form reads
+// back as another scene (fields the format has no key for, set in code) or does not load.
+TEST(SceneWrite, CheckedWriterRefusesWhatDoesNotReadBack) {
+  const Scene s = parse_scene(kSlider, "slider.yaml");
+  EXPECT_EQ(scene_to_yaml_checked(s), scene_to_yaml(s));
+  Scene axis = s;
+  axis.joints[0].axis = {0, 1};  // a revolute joint has no axis key
+  EXPECT_THROW(scene_to_yaml_checked(axis), NumericalError);
+  Scene offset = s;
+  offset.joints[2].offset_rad = 0.5;  // nor a prismatic one an offset
+  try {
+    scene_to_yaml_checked(offset);
+    ADD_FAILURE() << "written";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene hash"), std::string::npos) << e.what();
+  }
+  Scene invalid = s;
+  invalid.bodies[0].mass_kg = -1;
+  EXPECT_THROW(scene_to_yaml_checked(invalid), SceneError);
+}
+
 }  // namespace
 }  // namespace rdyn::models
