@@ -16,9 +16,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// One UTF-8 sequence at s[i]: its code point and length, or length 0 when the
-// bytes are not well-formed UTF-8 (overlong forms, surrogates and code points
-// above U+10FFFF included; Unicode 15, Table 3-7).
+// One UTF-8 sequence at s[i]: its code point and length, or length 0 when the bytes are not
+// well-formed UTF-8 (overlong forms, surrogates and code points above U+10FFFF included; Unicode
+// 15, Table 3-7).
 struct CodePoint {
   char32_t value = 0;
   size_t length = 0;
@@ -46,15 +46,13 @@ CodePoint decode_utf8(const std::string& s, size_t i) {
   return {cp, n};
 }
 
-// Writes the YAML text; every value goes through one of these so that each
-// reads back equal.
+// Writes the YAML text; every value goes through one of these so that each reads back equal.
 class Writer {
  public:
   explicit Writer(const Scene& s) : file_(s.source_file) {}
 
-  // The shortest text that reads back to the same double (fmt's "{}", Ryu-like
-  // shortest round trip); the reader refuses non-finite and subnormal values,
-  // so the writer does too.
+  // The shortest text that reads back to the same double (fmt's "{}", Ryu-like shortest round
+  // trip); the reader refuses non-finite and subnormal values, so the writer does too.
   std::string num(double v, const std::string& field) const {
     if (!std::isfinite(v))
       throw SceneError(file_, 0, field, "is not finite: a scene file cannot hold it");
@@ -68,20 +66,20 @@ class Writer {
   std::string vec(const Vec2& v, const std::string& field) const {
     return "[" + num(v.x, field + "[0]") + ", " + num(v.y, field + "[1]") + "]";
   }
-  // Text: plain when it is a name YAML reads back as the same string (not null,
-  // a boolean or empty), double-quoted otherwise, with every character YAML
-  // would fold, drop or misread escaped (YAML 1.2, §5.7 escape sequences; §5.4
-  // line breaks incl. NEL, LS, PS).
-  std::string text(const std::string& s, const std::string& field) const {
+  // Text: plain when it is a name YAML reads back as the same string (not null, a boolean or
+  // empty), double-quoted otherwise, with every character YAML would fold, drop or misread escaped
+  // (YAML 1.2, §5.7 escape sequences; §5.4 line breaks incl. NEL, LS, PS).
+  std::string text(const std::string& s) const {
     if (is_plain_safe(s)) return s;
     std::string out = "\"";
     for (size_t i = 0; i < s.size();) {
       const CodePoint c = decode_utf8(s, i);
-      if (c.length == 0)
-        throw SceneError(file_, 0, field,
-                         fmt::format("is not valid UTF-8 text (byte {} of {}): "
-                                     "a YAML file cannot hold it",
-                                     i + 1, s.size()));
+      if (c.length == 0) {
+        // Not UTF-8 (a Latin-1 file, say): the reader (yaml-cpp) takes such bytes as they are, so
+        // they are written as they are and read back equal.
+        out += s[i++];
+        continue;
+      }
       const char32_t cp = c.value;
       if (cp == '"')
         out += "\\\"";
@@ -103,8 +101,7 @@ class Writer {
     }
     return out + "\"";
   }
-  // The source file in the header comment: printable, one line, whatever bytes
-  // it holds.
+  // The source file in the header comment: printable, one line, whatever bytes it holds.
   static std::string comment_text(const std::string& s) {
     std::string out;
     for (size_t i = 0; i < s.size();) {
@@ -121,8 +118,7 @@ class Writer {
     }
     return out;
   }
-  // " # 30°" after an angle in radians, for the reader of the file (not read
-  // back).
+  // " # 30°" after an angle in radians, for the reader of the file (not read back).
   static std::string degrees_comment(double rad) {
     return fmt::format("  # {:.6g}°", rad * 180.0 / kPi);
   }
@@ -131,8 +127,8 @@ class Writer {
   std::string take() { return std::move(out_); }
 
  private:
-  // [A-Za-z_][A-Za-z0-9_-]* (every scene name) minus the words YAML 1.1 reads
-  // as null or a boolean (yaml-cpp reads `null` as a null node, not text).
+  // [A-Za-z_][A-Za-z0-9_-]* (every scene name) minus the words YAML 1.1 reads as null or a boolean
+  // (yaml-cpp reads `null` as a null node, not text).
   static bool is_plain_safe(const std::string& s) {
     if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
     for (const char ch : s)
@@ -162,7 +158,7 @@ void write_points(Writer& w, const std::string& indent, const std::string& key,
   }
   w.line(indent + key + ":");
   for (const auto& [name, p] : points)
-    w.line(indent + "  " + w.text(name, field) + ": " + w.vec(p, field + "." + name));
+    w.line(indent + "  " + w.text(name) + ": " + w.vec(p, field + "." + name));
 }
 
 void write_mechanism(Writer& w, const Scene& s) {
@@ -170,7 +166,7 @@ void write_mechanism(Writer& w, const Scene& s) {
   w.line(s.bodies.empty() ? "bodies: []" : "bodies:");
   for (const auto& b : s.bodies) {
     const std::string f = "bodies." + b.name;
-    w.line("  - name: " + w.text(b.name, f + ".name"));
+    w.line("  - name: " + w.text(b.name));
     w.line("    mass_kg: " + w.num(b.mass_kg, f + ".mass_kg"));
     w.line("    com_m: " + w.vec(b.com_m, f + ".com_m"));
     w.line("    inertia_kgm2: " + w.num(b.inertia_kgm2, f + ".inertia_kgm2"));
@@ -180,18 +176,17 @@ void write_mechanism(Writer& w, const Scene& s) {
   for (const auto& j : s.joints) {
     const std::string f = "joints." + j.name;
     const bool prismatic = j.type == JointType::Prismatic;
-    w.line("  - name: " + w.text(j.name, f + ".name"));
+    w.line("  - name: " + w.text(j.name));
     w.line(std::string("    type: ") + (prismatic ? "prismatic" : "revolute"));
-    w.line("    parent: " + w.text(j.parent, f + ".parent"));
+    w.line("    parent: " + w.text(j.parent));
     w.line("    parent_point: " + w.vec(j.parent_point, f + ".parent_point"));
-    w.line("    child: " + w.text(j.child, f + ".child"));
+    w.line("    child: " + w.text(j.child));
     w.line("    child_point: " + w.vec(j.child_point, f + ".child_point"));
     if (prismatic) {
       w.line("    axis: " + w.vec(j.axis, f + ".axis"));
       w.line("    guess_m: " + w.num(j.guess, f + ".guess"));
     } else {
-      // Radians: a degree value need not read back to the same double (x·π/180
-      // rounds).
+      // Radians: a degree value need not read back to the same double (x·π/180 rounds).
       w.line("    offset_rad: " + w.num(j.offset_rad, f + ".offset_rad") +
              Writer::degrees_comment(j.offset_rad));
       w.line("    guess_rad: " + w.num(j.guess, f + ".guess") + Writer::degrees_comment(j.guess));
@@ -200,23 +195,22 @@ void write_mechanism(Writer& w, const Scene& s) {
   w.line(s.loops.empty() ? "loops: []" : "loops:");
   for (const auto& l : s.loops) {
     const std::string f = "loops." + l.name;
-    w.line("  - name: " + w.text(l.name, f + ".name"));
-    w.line("    body_a: " + w.text(l.body_a, f + ".body_a"));
+    w.line("  - name: " + w.text(l.name));
+    w.line("    body_a: " + w.text(l.body_a));
     w.line("    point_a: " + w.vec(l.point_a, f + ".point_a"));
-    w.line("    body_b: " + w.text(l.body_b, f + ".body_b"));
+    w.line("    body_b: " + w.text(l.body_b));
     w.line("    point_b: " + w.vec(l.point_b, f + ".point_b"));
     if (l.branch)
-      w.line("    branch: {joint: " + w.text(l.branch->joint, f + ".branch.joint") +
+      w.line("    branch: {joint: " + w.text(l.branch->joint) +
              ", sign: " + (l.branch->sign > 0 ? "positive" : "negative") + "}");
   }
   w.line(s.gears.empty() ? "gears: []" : "gears:");
   for (const auto& g : s.gears) {
     const std::string f = "gears." + g.name;
-    w.line("  - {name: " + w.text(g.name, f + ".name") + ", driver: " +
-           w.text(g.driver, f + ".driver") + ", driven: " + w.text(g.driven, f + ".driven") +
-           ", ratio: " + w.num(g.ratio, f + ".ratio") + "}");
+    w.line("  - {name: " + w.text(g.name) + ", driver: " + w.text(g.driver) +
+           ", driven: " + w.text(g.driven) + ", ratio: " + w.num(g.ratio, f + ".ratio") + "}");
   }
-  w.line("independent: " + w.text(s.independent, "independent"));
+  w.line("independent: " + w.text(s.independent));
   if (s.independent_range) {
     const bool revolute = !is_prismatic(s, s.independent);
     w.line("independent_range: [" + w.num(s.independent_range->min, "independent_range[0]") + ", " +
@@ -229,7 +223,7 @@ void write_mechanism(Writer& w, const Scene& s) {
 
 void write_profile(Writer& w, const LoadProfile& p, const std::string& f) {
   w.line("    profile:");
-  w.line("      of: " + w.text(p.of, f + ".of"));
+  w.line("      of: " + w.text(p.of));
   if (!p.is_table()) {
     auto list = [&](const std::vector<double>& v, const std::string& key) {
       std::string t = "[";
@@ -241,8 +235,7 @@ void write_profile(Writer& w, const LoadProfile& p, const std::string& f) {
            ", b: " + list(p.b, "b") + "}");
     return;
   }
-  // Rows in radians, as the profile holds them: the spline is rebuilt from the
-  // same knots.
+  // Rows in radians, as the profile holds them: the spline is rebuilt from the same knots.
   w.line("      table_rad:  # [angle rad, value per unit amplitude]");
   for (size_t i = 0; i < p.table_theta_rad.size() && i < p.table_value.size(); ++i) {
     const std::string fi = fmt::format("{}.table_rad[{}]", f, i);
@@ -252,9 +245,8 @@ void write_profile(Writer& w, const LoadProfile& p, const std::string& f) {
   }
 }
 
-// Loads by kind (torques, resistances, springs, motors), each kind in scene
-// order: the reader keeps one list per kind, so this order reads back to the
-// same lists.
+// Loads by kind (torques, resistances, springs, motors), each kind in scene order: the reader keeps
+// one list per kind, so this order reads back to the same lists.
 void write_loads(Writer& w, const Scene& s) {
   const bool none =
       s.joint_torques.empty() && s.resistances.empty() && s.springs.empty() && s.motors.empty();
@@ -262,14 +254,14 @@ void write_loads(Writer& w, const Scene& s) {
   for (const auto& t : s.joint_torques) {
     const std::string f = "loads." + t.name;
     w.line("  - type: joint_torque");
-    w.line("    name: " + w.text(t.name, f + ".name"));
-    w.line("    joint: " + w.text(t.joint, f + ".joint"));
+    w.line("    name: " + w.text(t.name));
+    w.line("    joint: " + w.text(t.joint));
     const bool prismatic = is_prismatic(s, t.joint);
     const std::string key = prismatic ? "force_N" : "torque_Nm";
     w.line("    " + key + ": " + w.num(t.value, f + "." + key) +
            (t.profile ? "  # amplitude of the profile" : ""));
     if (t.active_when)
-      w.line("    active_when: {joint: " + w.text(t.active_when->joint, f + ".active_when.joint") +
+      w.line("    active_when: {joint: " + w.text(t.active_when->joint) +
              ", rate: " + (t.active_when->sign > 0 ? "positive" : "negative") + "}");
     if (t.profile) write_profile(w, *t.profile, f + ".profile");
   }
@@ -278,17 +270,16 @@ void write_loads(Writer& w, const Scene& s) {
     const char* law = r.law == ResistanceLaw::Constant  ? "constant"
                       : r.law == ResistanceLaw::Viscous ? "viscous"
                                                         : "quadratic";
-    w.line("  - {type: resistance, name: " + w.text(r.name, f + ".name") +
-           ", body: " + w.text(r.body, f + ".body") + ", law: " + law +
-           ", coefficient: " + w.num(r.coefficient, f + ".coefficient") + "}");
+    w.line("  - {type: resistance, name: " + w.text(r.name) + ", body: " + w.text(r.body) +
+           ", law: " + law + ", coefficient: " + w.num(r.coefficient, f + ".coefficient") + "}");
   }
   for (const auto& sp : s.springs) {
     const std::string f = "loads." + sp.name;
     w.line("  - type: spring");
-    w.line("    name: " + w.text(sp.name, f + ".name"));
-    w.line("    body_a: " + w.text(sp.body_a, f + ".body_a"));
+    w.line("    name: " + w.text(sp.name));
+    w.line("    body_a: " + w.text(sp.body_a));
     w.line("    point_a: " + w.vec(sp.point_a, f + ".point_a"));
-    w.line("    body_b: " + w.text(sp.body_b, f + ".body_b"));
+    w.line("    body_b: " + w.text(sp.body_b));
     w.line("    point_b: " + w.vec(sp.point_b, f + ".point_b"));
     w.line("    stiffness_N_per_m: " + w.num(sp.stiffness_N_per_m, f + ".stiffness_N_per_m"));
     w.line("    rest_length_m: " + w.num(sp.rest_length_m, f + ".rest_length_m"));
@@ -298,32 +289,29 @@ void write_loads(Writer& w, const Scene& s) {
     const bool prismatic = is_prismatic(s, m.joint);
     const std::string stall = prismatic ? "stall_force_N" : "stall_torque_Nm";
     const std::string speed = prismatic ? "no_load_speed_m_s" : "no_load_speed_rad_s";
-    w.line("  - {type: motor, name: " + w.text(m.name, f + ".name") +
-           ", joint: " + w.text(m.joint, f + ".joint") + ", " + stall + ": " +
-           w.num(m.stall_torque, f + "." + stall) + ", " + speed + ": " +
+    w.line("  - {type: motor, name: " + w.text(m.name) + ", joint: " + w.text(m.joint) + ", " +
+           stall + ": " + w.num(m.stall_torque, f + "." + stall) + ", " + speed + ": " +
            w.num(m.no_load_speed, f + "." + speed) + "}");
   }
 }
 
 void write_outputs(Writer& w, const Scene& s) {
   const Outputs& o = s.outputs;
-  auto names = [&](const std::vector<std::string>& v, const std::string& field) {
+  auto names = [&](const std::vector<std::string>& v) {
     std::string t = "[";
-    for (size_t i = 0; i < v.size(); ++i)
-      t += (i ? ", " : "") + w.text(v[i], fmt::format("{}[{}]", field, i));
+    for (size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + w.text(v[i]);
     return t + "]";
   };
   w.line("outputs:");
   w.line(o.constraint_forces.empty() ? "  constraint_forces: []" : "  constraint_forces:");
   for (const auto& c : o.constraint_forces) {
     const std::string f = "outputs.constraint_forces." + c.name;
-    w.line("    - {name: " + w.text(c.name, f + ".name") +
-           ", joint: " + w.text(c.joint, f + ".joint") +
+    w.line("    - {name: " + w.text(c.name) + ", joint: " + w.text(c.joint) +
            ", direction: " + w.vec(c.direction, f + ".direction") + "}");
   }
-  w.line("  bodies: " + names(o.bodies, "outputs.bodies"));
-  w.line("  joints: " + names(o.joints, "outputs.joints"));
-  w.line("  reactions: " + names(o.reactions, "outputs.reactions"));
+  w.line("  bodies: " + names(o.bodies));
+  w.line("  joints: " + names(o.joints));
+  w.line("  reactions: " + names(o.reactions));
   w.line(std::string("  shaking: ") + (o.shaking ? "true" : "false"));
 }
 
@@ -334,40 +322,35 @@ void write_validation(Writer& w, const Scene& s) {
          "  # 0: simulation.duration_s");
   w.line("  reference_tolerance: " +
          w.num(v.reference_tolerance, "validation.reference_tolerance"));
-  w.line("  reference_integrator: " +
-         w.text(v.reference_integrator, "validation.reference_integrator"));
-  if (!v.note.empty()) w.line("  note: " + w.text(v.note, "validation.note"));
+  w.line("  reference_integrator: " + w.text(v.reference_integrator));
+  if (!v.note.empty()) w.line("  note: " + w.text(v.note));
   w.line(v.thresholds.empty() ? "  thresholds: []" : "  thresholds:");
   for (size_t i = 0; i < v.thresholds.size(); ++i) {
     const Threshold& t = v.thresholds[i];
     const std::string f = fmt::format("validation.thresholds[{}]", i);
-    w.line("    - {quantity: " + w.text(t.quantity, f + ".quantity") +
+    w.line("    - {quantity: " + w.text(t.quantity) +
            ", grid_deg: " + w.num(t.grid_deg, f + ".grid_deg") +
-           (t.interpolation.empty()
-                ? ""
-                : ", interpolation: " + w.text(t.interpolation, f + ".interpolation")) +
+           (t.interpolation.empty() ? "" : ", interpolation: " + w.text(t.interpolation)) +
            ", max_error: " + w.num(t.max_error, f + ".max_error") + "}");
   }
-  // A calibrate block with a zero cadence is refused by the reader (it would
-  // silently mean "off"), so an unset calibration is left out; a partly set one
-  // is written and refused.
+  // A calibrate block with a zero cadence is refused by the reader (it would silently mean "off"),
+  // so an unset calibration is left out; a partly set one is written and refused.
   if (v.calibrate_cadence_Hz != 0.0 || v.calibrate_power_W != 0.0 || !v.calibrate_load.empty()) {
     w.line("  calibrate:");
     w.line("    cadence_Hz: " + w.num(v.calibrate_cadence_Hz, "validation.calibrate.cadence_Hz"));
     if (v.calibrate_power_W != 0.0)
       w.line("    power_W: " + w.num(v.calibrate_power_W, "validation.calibrate.power_W"));
-    if (!v.calibrate_load.empty())
-      w.line("    load: " + w.text(v.calibrate_load, "validation.calibrate.load"));
+    if (!v.calibrate_load.empty()) w.line("    load: " + w.text(v.calibrate_load));
   }
   if (!v.compare.empty()) w.line("  compare:");
   for (size_t i = 0; i < v.compare.size(); ++i) {
     const CompareValue& c = v.compare[i];
     const std::string f = fmt::format("validation.compare[{}]", i);
-    w.line("    - quantity: " + w.text(c.quantity, f + ".quantity"));
+    w.line("    - quantity: " + w.text(c.quantity));
     w.line("      value: " + w.num(c.value, f + ".value"));
-    w.line("      unit: " + w.text(c.unit, f + ".unit"));
-    w.line("      source: " + w.text(c.source, f + ".source"));
-    w.line("      explanation: " + w.text(c.explanation, f + ".explanation"));
+    w.line("      unit: " + w.text(c.unit));
+    w.line("      source: " + w.text(c.source));
+    w.line("      explanation: " + w.text(c.explanation));
   }
 }
 
@@ -383,8 +366,8 @@ std::string scene_to_yaml(const Scene& s) {
   w.line(
       "# angles in radians (degrees in comments). The original's comments "
       "are not kept.");
-  w.line("name: " + w.text(s.name, "name"));
-  if (!s.description.empty()) w.line("description: " + w.text(s.description, "description"));
+  w.line("name: " + w.text(s.name));
+  if (!s.description.empty()) w.line("description: " + w.text(s.description));
   write_mechanism(w, s);
   write_loads(w, s);
   w.line("gravity: {enabled: " + std::string(s.gravity.enabled ? "true" : "false") +
