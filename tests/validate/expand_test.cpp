@@ -96,6 +96,25 @@ TEST_F(ExpandCli, BadInputIsStatus2AndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 
+// Hostile destinations and sources: a full disk, an endless file as the scene, a link to a
+// foreign file; each is status 2 and leaves nothing behind.
+TEST_F(ExpandCli, HostileDestinationsAndSourcesAreStatus2) {
+  auto r = rdyn({"expand", "fourbar", "--out", "/dev/full"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("No space left"), std::string::npos) << r.err;
+  r = rdyn({"expand", "/dev/zero", "--out", "z.yaml"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("too large"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "z.yaml"));
+  { std::ofstream(dir_ / "foreign.txt") << "keep me\n"; }
+  fs::create_symlink("foreign.txt", dir_ / "link.yaml");
+  r = rdyn({"expand", "fourbar", "--out", "link.yaml"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(test::slurp(dir_ / "foreign.txt"), "keep me\n");
+  for (const auto& e : fs::directory_iterator(dir_))  // no temporary left behind
+    EXPECT_EQ(e.path().filename().string().find("tmp"), std::string::npos) << e.path();
+}
+
 TEST(ExpandedScene, IsRecognisedByItsFirstLine) {
   EXPECT_TRUE(
       is_rdyn_expanded_scene("# Written by rdyn from scene 'fourbar' (f.yaml).\nname: fourbar\n"));
