@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -185,30 +186,141 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
   return out;
 }
 
-double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
-  const auto& m = model.impl();
-  State& s = ws.impl().state;
-  m.system.realize(s, Stage::Position);
-  Matrix G;
-  m.matter.calcG(s, G);
-  if (G.nrow() == 0) return 1.0;
-  // Columns of the prescribed mobilities (independent coordinate, constraint actuators) go.
-  std::vector<bool> keep(G.ncol(), true);
+namespace {
+
+// The constraint Jacobian G (loop and unfolded gear rows × mobilities) at a state realized to
+// Position, split into the columns of the mobilities the constraints determine (`free`: all but
+// the independent coordinate and the constraint actuators) and G itself.
+struct SplitJacobian {
+  Matrix G, G_free;
+  std::vector<int> free_cols;
+};
+
+SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
+  SplitJacobian J;
+  m.matter.calcG(s, J.G);
+  std::vector<bool> keep(s.getNU(), true);
   keep[m.joint_mobod[m.independent].getFirstUIndex(s)] = false;
   for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
-  std::vector<int> cols;
-  for (int c = 0; c < G.ncol(); ++c)
-    if (keep[c]) cols.push_back(c);
-  Matrix Gf(G.nrow(), static_cast<int>(cols.size()));
-  for (int r = 0; r < G.nrow(); ++r)
-    for (size_t c = 0; c < cols.size(); ++c) Gf(r, static_cast<int>(c)) = G(r, cols[c]);
-  FactorSVD svd(Gf);
+  for (int c = 0; c < s.getNU(); ++c)
+    if (keep[c]) J.free_cols.push_back(c);
+  J.G_free.resize(J.G.nrow(), static_cast<int>(J.free_cols.size()));
+  for (int r = 0; r < J.G.nrow(); ++r)
+    for (size_t c = 0; c < J.free_cols.size(); ++c) J.G_free(r, static_cast<int>(c)) = J.G(r, J.free_cols[c]);
+  return J;
+}
+
+// Smallest over largest singular value of G_free (0 when rank is missing).
+double conditioning_of(FactorSVD& svd, const Matrix& G_free) {
   Vector sv;
   svd.getSingularValues(sv);
   if (sv.size() == 0 || !(sv[0] > 0)) return 0.0;
   // Rank deficiency shows as missing or tiny singular values (min(nrow, ncol) of them).
-  const int expected = std::min(Gf.nrow(), Gf.ncol());
+  const int expected = std::min(G_free.nrow(), G_free.ncol());
   return sv.size() < expected ? 0.0 : sv[sv.size() - 1] / sv[0];
+}
+
+// A scene joint's component of a mobility-space vector (folded joints through their gear).
+double joint_part(const FullModel::Impl& m, const State& s, const Vector& u, int j) {
+  if (const auto& f = m.joint_fold[j]) return f->ratio * joint_part(m, s, u, f->driver_joint);
+  return u[m.joint_mobod[j].getFirstUIndex(s)];
+}
+
+}  // namespace
+
+double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+  const auto& m = model.impl();
+  State& s = ws.impl().state;
+  m.system.realize(s, Stage::Position);
+  const auto J = calc_split_jacobian(m, s);
+  if (J.G.nrow() == 0) return 1.0;
+  FactorSVD svd(J.G_free);
+  return conditioning_of(svd, J.G_free);
+}
+
+KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspace& ws, double q,
+                                            double max_extrapolation, SampleParts parts) {
+  const auto& m = model.impl();
+  check_finite_input(m, {q, max_extrapolation});
+  if (m.options.route != ConstraintForceRoute::Actuator && !m.scene.outputs.constraint_forces.empty())
+    throw EngineError("calc_kinetostatic_sample needs the Actuator constraint-force route");
+  auto& w = ws.impl();
+  State& s = w.state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  // Call (i): q̇ = 1, q̈ = 0, loads off, every actuator at x = ẋ = ẍ = 0.
+  m.set_law(s, 0, poly_law(q, 1.0, 0.0));
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.set_load_mode(s, kLoadsOff);
+  if (w.anchor_set && w.anchor_q.size() == s.getNQ()) {
+    // Second-order predictor along the branch: Newton starts O(Δ³) from the solution.
+    const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+    const double d = revolute ? std::remainder(q - w.anchor_x, 2 * M_PI) : q - w.anchor_x;
+    if (std::abs(d) <= max_extrapolation) s.updQ() = w.anchor_q + w.anchor_dq * d + w.anchor_ddq * (0.5 * d * d);
+  }
+  const long singular_before = m.near_singular_projections;
+  project(m, s, q);
+  m.system.realize(s, Stage::Acceleration);
+  const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
+  KinetostaticSample out;
+  out.near_singular = m.near_singular_projections > singular_before;
+  const Vector& u = s.getU();  // r: the velocity ratios in mobility space
+  const Vector& udot = s.getUDot();  // dr/dq: at q̇ = 1 and q̈ = 0, u̇ = (dr/dq) q̇²
+  out.joint_q.resize(nj);
+  out.ratio_q.resize(nj);
+  out.ratio_slope.resize(nj);
+  for (int j = 0; j < nj; ++j) {
+    out.joint_q[j] = m.joint_q(s, j);
+    out.ratio_q[j] = joint_part(m, s, u, j);
+    out.ratio_slope[j] = joint_part(m, s, udot, j);
+  }
+  // Motion multipliers sit on the left (M u̇ + Gᵀλ + τ = f): the actuator supplies −τ.
+  out.m2 = -m.joint_mobod[m.independent].getOneTau(s, MobilizerUIndex(0));
+  out.me2 = m.constraint_forces(s);
+  bool finite = std::isfinite(out.m2);
+  for (double f : out.me2) finite &= std::isfinite(f);
+  for (int j = 0; j < nj; ++j)
+    finite &= std::isfinite(out.joint_q[j]) && std::isfinite(out.ratio_q[j]) && std::isfinite(out.ratio_slope[j]);
+  if (parts == SampleParts::All) {
+    // The call (ii) by virtual power: T = rᵀ M r, F_k = r_x,kᵀ M r.
+    Vector Mr;
+    m.matter.multiplyByM(s, u, Mr);
+    out.m1 = ~u * Mr;
+    finite &= std::isfinite(out.m1);
+    // r_x,k: ẋ_k = 1, q̇ = 0, the other x fixed; G r_x,k = 0 fixes the free mobilities:
+    // G_free u_free = −G e_k (least squares: G may carry redundant rows).
+    const auto J = calc_split_jacobian(m, s);
+    std::optional<FactorSVD> svd;
+    if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
+    out.conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
+    for (int k = 0; k < nx; ++k) {
+      const int col = m.actuator_slider[k].getFirstUIndex(s);
+      Vector rx(s.getNU(), 0.0);
+      rx[col] = 1.0;
+      if (svd) {
+        Vector rhs(J.G.nrow()), x;
+        for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
+        svd->solve(rhs, x);
+        for (size_t c = 0; c < J.free_cols.size(); ++c) rx[J.free_cols[c]] = x[static_cast<int>(c)];
+      }
+      std::vector<double> rates(nj);
+      for (int j = 0; j < nj; ++j) finite &= std::isfinite(rates[j] = joint_part(m, s, rx, j));
+      out.ratio_x.push_back(std::move(rates));
+      out.me1.push_back(~rx * Mr);
+      finite &= std::isfinite(out.me1.back());
+    }
+    // This point anchors the next prediction.
+    w.anchor_set = true;
+    w.anchor_x = q;
+    w.anchor_q = s.getQ();
+    w.anchor_dq = s.getQDot();
+    w.anchor_ddq = s.getQDotDot();
+  }
+  if (!finite)
+    throw models::NumericalError(fmt::format("{}: the full model returned a non-finite reduced parameter or velocity "
+                                             "ratio at {} = {:.6g}",
+                                             m.scene.source_file, m.scene.independent, q));
+  return out;
 }
 
 KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws, const double c[5],
