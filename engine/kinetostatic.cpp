@@ -259,62 +259,100 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
     if (std::abs(d) <= max_extrapolation) s.updQ() = w.anchor_q + w.anchor_dq * d + w.anchor_ddq * (0.5 * d * d);
   }
   const long singular_before = m.near_singular_projections;
-  project(m, s, q);
-  m.system.realize(s, Stage::Acceleration);
+  // Position: the Newton projection of the loops, the only iterative step. Velocities and
+  // accelerations follow from linear solves with the Jacobian at the converged configuration.
+  try {
+    m.system.realize(s, Stage::Time);
+    m.system.prescribeQ(s);
+    try {
+      m.system.projectQ(s, 1e-12);
+    } catch (const std::exception&) {
+      m.system.projectQ(s, 1e-9);  // singular configuration: as project()
+      ++m.near_singular_projections;
+    }
+  } catch (const std::exception& e) {
+    throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                  "(dead point or a loop that cannot close): {}",
+                                  m.scene.source_file, m.scene.independent, q, e.what()));
+  }
+  m.system.realize(s, Stage::Position);
   const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
+  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
   KinetostaticSample out;
   out.near_singular = m.near_singular_projections > singular_before;
-  const Vector& u = s.getU();  // r: the velocity ratios in mobility space
-  const Vector& udot = s.getUDot();  // dr/dq: at q̇ = 1 and q̈ = 0, u̇ = (dr/dq) q̇²
+  // G_free u_free = −(G u)_prescribed: the free mobilities from the prescribed ones (least
+  // squares: G may carry redundant rows; the system is consistent).
+  const auto J = calc_split_jacobian(m, s);
+  std::optional<FactorSVD> svd;
+  if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
+  if (parts == SampleParts::All) out.conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
+  auto complete = [&](Vector& v, const Vector& rhs) {  // v: prescribed entries set, free ones solved
+    if (!svd) return;
+    Vector x;
+    svd->solve(rhs, x);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
+  };
+  auto column = [&](int col) {
+    Vector rhs(J.G.nrow());
+    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
+    return rhs;
+  };
+  // r: q̇ = 1, ẋ = 0 (the velocity projection of call (i)).
+  Vector u(nu, 0.0);
+  u[ind] = 1.0;
+  complete(u, column(ind));
+  s.updU() = u;
+  m.system.realize(s, Stage::Velocity);
+  // b = dr/dq: the accelerations of call (i) (q̇ = 1, q̈ = 0, ẍ = 0), from G b = −bias
+  // (Simbody: acceleration constraint errors G u̇ + bias, bias = −Ġu at this velocity).
+  Vector b(nu, 0.0);
+  if (J.G.nrow() > 0) {
+    Vector bias;
+    m.matter.calcBiasForAccelerationConstraints(s, bias);
+    complete(b, -bias);
+  }
   out.joint_q.resize(nj);
   out.ratio_q.resize(nj);
   out.ratio_slope.resize(nj);
   for (int j = 0; j < nj; ++j) {
     out.joint_q[j] = m.joint_q(s, j);
     out.ratio_q[j] = joint_part(m, s, u, j);
-    out.ratio_slope[j] = joint_part(m, s, udot, j);
+    out.ratio_slope[j] = joint_part(m, s, b, j);
   }
-  // Motion multipliers sit on the left (M u̇ + Gᵀλ + τ = f): the actuator supplies −τ.
-  out.m2 = -m.joint_mobod[m.independent].getOneTau(s, MobilizerUIndex(0));
-  out.me2 = m.constraint_forces(s);
-  bool finite = std::isfinite(out.m2);
-  for (double f : out.me2) finite &= std::isfinite(f);
+  bool finite = true;
   for (int j = 0; j < nj; ++j)
     finite &= std::isfinite(out.joint_q[j]) && std::isfinite(out.ratio_q[j]) && std::isfinite(out.ratio_slope[j]);
   if (parts == SampleParts::All) {
-    // The call (ii) by virtual power: T = rᵀ M r, F_k = r_x,kᵀ M r.
-    Vector Mr;
+    // Virtual power with r and r_x,k (both satisfy G v = 0, zero on the other prescribed
+    // mobilities), loads off, M u̇ + c + Gᵀλ + τ = 0 and the actuators supplying −τ:
+    // call (i): m2 = rᵀ(M b + c), me2_k = r_x,kᵀ(M b + c); call (ii), where q̇ = 0 and u̇ = r:
+    // m1 = rᵀ M r, me1_k = r_x,kᵀ M r.
+    Vector Mr, inertial;
     m.matter.multiplyByM(s, u, Mr);
+    m.matter.calcResidualForceIgnoringConstraints(s, Vector(), Vector_<SpatialVec>(), b, inertial);  // M b + c
     out.m1 = ~u * Mr;
-    finite &= std::isfinite(out.m1);
-    // r_x,k: ẋ_k = 1, q̇ = 0, the other x fixed; G r_x,k = 0 fixes the free mobilities:
-    // G_free u_free = −G e_k (least squares: G may carry redundant rows).
-    const auto J = calc_split_jacobian(m, s);
-    std::optional<FactorSVD> svd;
-    if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
-    out.conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
+    out.m2 = ~u * inertial;
+    finite &= std::isfinite(out.m1) && std::isfinite(out.m2);
     for (int k = 0; k < nx; ++k) {
+      // r_x,k: ẋ_k = 1, q̇ = 0, the other x fixed.
       const int col = m.actuator_slider[k].getFirstUIndex(s);
-      Vector rx(s.getNU(), 0.0);
+      Vector rx(nu, 0.0);
       rx[col] = 1.0;
-      if (svd) {
-        Vector rhs(J.G.nrow()), x;
-        for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
-        svd->solve(rhs, x);
-        for (size_t c = 0; c < J.free_cols.size(); ++c) rx[J.free_cols[c]] = x[static_cast<int>(c)];
-      }
+      complete(rx, column(col));
       std::vector<double> rates(nj);
       for (int j = 0; j < nj; ++j) finite &= std::isfinite(rates[j] = joint_part(m, s, rx, j));
       out.ratio_x.push_back(std::move(rates));
       out.me1.push_back(~rx * Mr);
-      finite &= std::isfinite(out.me1.back());
+      out.me2.push_back(~rx * inertial);
+      finite &= std::isfinite(out.me1.back()) && std::isfinite(out.me2.back());
     }
-    // This point anchors the next prediction.
+    // This point anchors the next prediction: q' = N r, q'' = N b (Ṅ = 0 for the pins and
+    // sliders rdyn builds).
     w.anchor_set = true;
     w.anchor_x = q;
     w.anchor_q = s.getQ();
-    w.anchor_dq = s.getQDot();
-    w.anchor_ddq = s.getQDotDot();
+    m.matter.multiplyByN(s, false, u, w.anchor_dq);
+    m.matter.multiplyByN(s, false, b, w.anchor_ddq);
   }
   if (!finite)
     throw models::NumericalError(fmt::format("{}: the full model returned a non-finite reduced parameter or velocity "

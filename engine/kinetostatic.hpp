@@ -52,13 +52,15 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
 // the mechanism has no loop or gear constraint.
 double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws);
 
-// One grid point of the kinetostatic method from one position projection and one realization
-// (issue #11 item 3). The call (i) itself — q̇ = 1, q̈ = 0, loads off — gives m2, me2, the
-// velocity ratios r (the joint rates) and their slopes dr/dq (the joint accelerations). The
-// call (ii) (q̇ = 0, q̈ = 1) is not made: at q̇ = 0 the bias terms vanish and u̇ = r, so virtual
-// power with r turns it into m1 = rᵀ M r exactly, and with r_x,k (ẋ_k = 1, q̇ = 0, solved from
-// the same constraint Jacobian G) into me1_k = r_x,kᵀ M r (docs/theory.md, "One realization per
-// grid point"). Constraint forces must use the Actuator route (one prescribed slider each).
+// One grid point of the kinetostatic method from one position projection (Newton, the only
+// iterative step) and linear solves with the constraint Jacobian G of that configuration
+// (issue #11 item 3). Velocities of call (i) (q̇ = 1, ẋ = 0): r from G r = 0; its accelerations
+// (q̈ = ẍ = 0): b = dr/dq from G b = −Ġr; r_x,k (ẋ_k = 1, q̇ = 0) from G r_x,k = 0. Virtual power
+// with r and r_x,k (loads off, M u̇ + c + Gᵀλ + τ = 0, actuators supplying −τ) gives call (i),
+// m2 = rᵀ(M b + c) and me2_k = r_x,kᵀ(M b + c), and call (ii), where q̇ = 0 makes u̇ = r and the
+// bias vanish, m1 = rᵀ M r and me1_k = r_x,kᵀ M r: the same quantities as the separate calls,
+// without their projections and forward-dynamics realizations (docs/theory.md §4). Constraint
+// forces must use the Actuator route (one prescribed slider each).
 struct KinetostaticSample {
   double m1 = 0.0;                           // [kg·m² or kg]
   double m2 = 0.0;                           // ½ dm1/dq [kg·m² or kg/m]
@@ -67,7 +69,7 @@ struct KinetostaticSample {
   std::vector<double> ratio_q;               // joint rates per unit q̇, x fixed [joint]
   std::vector<std::vector<double>> ratio_x;  // joint rates per unit ẋ_k, q̇ = 0 [force][joint]
   std::vector<double> ratio_slope;           // d ratio_q / dq [joint]
-  double conditioning = 1.0;                 // as calc_loop_conditioning, at this configuration
+  double conditioning = 1.0;                 // as calc_loop_conditioning (SampleParts::All only)
   bool near_singular = false;                // the projection needed its fallback tolerance
 };
 enum class SampleParts {
