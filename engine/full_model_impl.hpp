@@ -96,6 +96,11 @@ struct FullWorkspace::Impl {
   double hist_x[2] = {0, 0};
   SimTK::Vector hist_q[2];
   int hist_n = 0;
+  // The anchor of calc_kinetostatic_sample's predictor: the last grid point's independent
+  // coordinate, all q, and their derivatives along the branch q' and q'' (per unit q̇, q̈ = 0).
+  bool anchor_set = false;
+  double anchor_x = 0.0;
+  SimTK::Vector anchor_q, anchor_dq, anchor_ddq;
   explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
 };
 

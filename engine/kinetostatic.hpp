@@ -52,6 +52,38 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
 // the mechanism has no loop or gear constraint.
 double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws);
 
+// One grid point of the kinetostatic method from one position projection (Newton, the only
+// iterative step) and linear solves with the constraint Jacobian G of that configuration
+// (issue #11 item 3). Velocities of call (i) (q̇ = 1, ẋ = 0): r from G r = 0; its accelerations
+// (q̈ = ẍ = 0): b = dr/dq from G b = −Ġr; r_x,k (ẋ_k = 1, q̇ = 0) from G r_x,k = 0. Virtual power
+// with r and r_x,k (loads off, M u̇ + c + Gᵀλ + τ = 0, actuators supplying −τ) gives call (i),
+// m2 = rᵀ(M b + c) and me2_k = r_x,kᵀ(M b + c), and call (ii), where q̇ = 0 makes u̇ = r and the
+// bias vanish, m1 = rᵀ M r and me1_k = r_x,kᵀ M r: the same quantities as the separate calls,
+// without their projections and forward-dynamics realizations (docs/theory.md §4). Constraint
+// forces must use the Actuator route (one prescribed slider each).
+struct KinetostaticSample {
+  double m1 = 0.0;                           // [kg·m² or kg]
+  double m2 = 0.0;                           // ½ dm1/dq [kg·m² or kg/m]
+  std::vector<double> me1, me2;              // per constraint force [kg·m or kg]
+  std::vector<double> joint_q;               // every scene joint's coordinate [rad or m]
+  std::vector<double> ratio_q;               // joint rates per unit q̇, x fixed [joint]
+  std::vector<std::vector<double>> ratio_x;  // joint rates per unit ẋ_k, q̇ = 0 [force][joint]
+  std::vector<double> ratio_slope;           // d ratio_q / dq [joint]
+  double conditioning = 1.0;                 // as calc_loop_conditioning (SampleParts::All only)
+  bool near_singular = false;                // the projection needed its fallback tolerance
+};
+enum class SampleParts {
+  All,        // a grid point: everything above; becomes the anchor of the next prediction
+  RatesOnly,  // joint_q, ratio_q and ratio_slope (root finding); the anchor is kept
+};
+// The projection starts from the anchor (the last grid point of this workspace) extrapolated to
+// second order, q_anchor + q' Δ + ½ q'' Δ² (q', q'' from its own realization), when
+// |Δ| ≤ max_extrapolation; otherwise from the workspace's configuration, as calc_kinetostatic.
+// Throws EngineError when the configuration cannot be reached, NumericalError when a result is
+// not finite.
+KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspace& ws, double q,
+                                            double max_extrapolation, SampleParts parts);
+
 // Sample of a prescribed time law q(t) = c1 + c2 t + c3 cos(c4 t + c5) at time t (the
 // original authors' sweep); same outputs as calc_kinetostatic.
 KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspace& ws,

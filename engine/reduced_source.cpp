@@ -39,12 +39,13 @@ int FullKinetostaticSource::num_constraint_forces() const {
 int FullKinetostaticSource::num_joints() const { return static_cast<int>(model_.scene().joints.size()); }
 
 template <typename F>
-auto FullKinetostaticSource::at(double q, F&& call) {
+auto FullKinetostaticSource::at(double q, F&& call, bool from_anchor) {
   const double q_start = q_now_;
   const Vector q_backup = ws_.impl().state.getQ();  // the last good configuration
   for (double jump : {max_jump_, max_jump_ / 5, max_jump_ / 50}) {
     try {
-      approach(q, jump);
+      // Retries walk from the last good configuration in finer moves, without the predictor.
+      approach(q, jump, from_anchor && jump == max_jump_);
       ++calls_;
       return call();
     } catch (const EngineError& e) {
@@ -65,14 +66,23 @@ auto FullKinetostaticSource::at(double q, F&& call) {
   throw EngineError("unreachable");
 }
 
-void FullKinetostaticSource::approach(double q, double max_jump) {
+void FullKinetostaticSource::approach(double q, double max_jump, bool from_anchor) {
+  const auto& jt = *model_.scene().find_joint(model_.scene().independent);
+  const bool turns = jt.type == models::JointType::Revolute && wrap_turns_;
+  extrapolation_ = 0.0;
+  if (from_anchor && anchor_) {
+    const double d = turns ? std::remainder(q - *anchor_, 2 * M_PI) : q - *anchor_;
+    if (std::abs(d) <= max_jump * (1 + 1e-9)) {
+      extrapolation_ = max_jump * (1 + 1e-9);
+      q_now_ = q;
+      return;
+    }
+  }
   // A revolute independent coordinate repeats the configuration every turn: walk to the
   // periodic image of q nearest the current configuration, then the call itself prescribes q
   // (the same configuration; the projection only relabels the angle).
   double target = q;
-  const auto& jt = *model_.scene().find_joint(model_.scene().independent);
-  if (jt.type == models::JointType::Revolute && wrap_turns_)
-    target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
+  if (turns) target = q + 2 * M_PI * std::round((q_now_ - q) / (2 * M_PI));
   const double moves = std::ceil(std::abs(target - q_now_) / max_jump - 1e-9);
   if (!(moves <= kMaxApproachMoves))  // also NaN
     throw models::NumericalError(fmt::format(
@@ -94,7 +104,30 @@ reduced::ForcePoint FullKinetostaticSource::inertial(double q, double qdot, doub
 }
 
 reduced::GridSample FullKinetostaticSource::sample(double q, bool with_conservative) {
-  return at(q, [&] { return sample_here(q, with_conservative); });
+  if (model_.options().route != ConstraintForceRoute::Actuator && num_constraint_forces() > 0)
+    return at(q, [&] { return sample_here(q, with_conservative); });
+  auto g = at(q, [&] { return sample_fast(q, with_conservative); }, true);
+  anchor_ = q;
+  return g;
+}
+
+reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_conservative) {
+  const long singular_before = model_.impl().near_singular_projections;
+  const auto k = calc_kinetostatic_sample(model_, ws_, q, extrapolation_, SampleParts::All);
+  reduced::GridSample g;
+  g.velocity = {k.m2, k.me2, k.ratio_q};
+  g.acceleration = {k.m1, k.me1, {}};
+  g.ratios = {k.ratio_q, k.ratio_x, k.joint_q, k.ratio_slope};
+  if (with_conservative) {
+    // The static call at the same configuration (its projection only checks the loops).
+    const auto c = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
+    g.conservative = {{c.driving_force, c.constraint_forces, {}}, c.potential_energy};
+  } else {
+    g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
+  }
+  // Singular configuration: as sample_here.
+  g.singular = model_.impl().near_singular_projections > singular_before || k.conditioning < 1e-5;
+  return g;
 }
 
 reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_conservative) {
@@ -126,6 +159,16 @@ double FullKinetostaticSource::ratio(double q, int joint) {
   return at(q, [&] { return calc_velocity_ratios(model_, ws_, q, true, false).wrt_q[joint]; });
 }
 
+std::optional<std::pair<double, double>> FullKinetostaticSource::ratio_and_slope(double q, int joint) {
+  return at(
+      q,
+      [&] {
+        const auto k = calc_kinetostatic_sample(model_, ws_, q, extrapolation_, SampleParts::RatesOnly);
+        return std::optional<std::pair<double, double>>({k.ratio_q[joint], k.ratio_slope[joint]});
+      },
+      true);
+}
+
 std::optional<double> FullKinetostaticSource::joint_coordinate(double q, int joint) {
   // A position projection only (the sweep already stands at q, so it is one Newton solve).
   return at(q, [&] {
@@ -146,7 +189,7 @@ reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
     const auto v = calc_velocity_ratios(model_, ws_, q);
     std::vector<double> joint_q(model_.scene().joints.size());
     for (size_t j = 0; j < joint_q.size(); ++j) joint_q[j] = model_.impl().joint_q(ws_.impl().state, static_cast<int>(j));
-    return reduced::RatioPoint{v.wrt_q, v.wrt_x, joint_q};
+    return reduced::RatioPoint{v.wrt_q, v.wrt_x, joint_q, {}};
   });
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <gsl/gsl_errno.h>
@@ -139,6 +140,49 @@ double refine_root(KinetostaticSource& src, int j, double a, double ra, double b
   return brent(a, b);
 }
 
+// The zero of joint j's velocity ratio inside one grid interval [a, b] (ra, rb of opposite
+// signs, sa, sb the slopes dr/dq there) by Newton's method on the full model: started from the
+// zero of the cubic Hermite interpolant of the two samples (error O(h⁴)), each step one
+// evaluation of r and dr/dq; a step leaving the shrinking bracket bisects it. Converged when
+// the step is ≤ 1e-13 (Brent's interval tolerance in refine_root) or when quadratic
+// convergence, e_next ≈ K dx² with K ≈ |dx| / dx_prev², puts the next error below 1e-15.
+// Empty after 8 evaluations without convergence (the caller falls back to refine_root).
+std::optional<double> newton_root(KinetostaticSource& src, int j, double a, double ra, double sa, double b, double rb,
+                                  double sb) {
+  if (ra == 0.0) return a;
+  if (rb == 0.0) return b;
+  const double h = b - a;
+  auto hermite = [&](double t) {  // the cubic Hermite interpolant at a + t h
+    const double t2 = t * t, t3 = t2 * t;
+    return (2 * t3 - 3 * t2 + 1) * ra + (t3 - 2 * t2 + t) * h * sa + (-2 * t3 + 3 * t2) * rb + (t3 - t2) * h * sb;
+  };
+  double lo = 0, hi = 1;  // bisection of the interpolant (its end values have opposite signs)
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if ((hermite(mid) > 0) == (ra > 0)) lo = mid;
+    else hi = mid;
+  }
+  double x = a + 0.5 * (lo + hi) * h, xa = a, xb = b, prev = NAN;
+  for (int it = 0; it < 8; ++it) {
+    const auto e = src.ratio_and_slope(x, j);
+    if (!e) return std::nullopt;
+    const auto [f, fp] = *e;
+    if (f == 0.0) return x;
+    if ((f > 0) == (ra > 0)) xa = x;
+    else xb = x;
+    const double dx = -f / fp;
+    if (!std::isfinite(dx) || !(x + dx > xa && x + dx < xb)) {
+      x = 0.5 * (xa + xb), prev = NAN;
+      continue;
+    }
+    if (std::abs(dx) <= 1e-13 || (std::isfinite(prev) && std::abs(dx) <= 1e-6 && std::abs(dx) / (prev * prev) * dx * dx <= 1e-15))
+      return x + dx;
+    prev = std::abs(dx);
+    x += dx;
+  }
+  return std::nullopt;
+}
+
 // Zero of the quadratic through three samples (x0 < x1 < x2) inside [x1, x2], else the chord.
 double quadratic_zero(double x0, double y0, double x1, double y1, double x2, double y2) {
   const double chord = x1 - y1 * (x2 - x1) / (y2 - y1);
@@ -260,6 +304,8 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   std::vector<std::vector<double>> me1(nk, std::vector<double>(n)), me2 = me1, Qx = me1;
   std::vector<std::vector<double>> r(nj, std::vector<double>(n));
   std::vector<std::vector<std::vector<double>>> rx(nk, r);
+  std::vector<std::vector<double>> slope = r;  // d r_j/dq, when every sample gives it
+  bool slopes = true;
 
   // Inertial parameters.
   if (opt.method == Method::PaperSweep) {
@@ -330,7 +376,9 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       // A range table has no sample before its first point: the chord there.
       const double est = !periodic && i0 == 0 ? a - ra * (b - a) / (rb - ra)
                                                : quadratic_zero(xm, r[j][im], a, ra, b, rb);
-      gate_roots[g].push_back(refine_root(src, j, a, ra, b, rb, est));
+      std::optional<double> root;
+      if (slopes) root = newton_root(src, j, a, ra, slope[j][i0], b, rb, slope[j][i1]);
+      gate_roots[g].push_back(root ? *root : refine_root(src, j, a, ra, b, rb, est));
     }
   };
   for (long i = 0; i < n; ++i) {
@@ -356,8 +404,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
                          "outputs.reactions and outputs.shaking need");
       for (int j = 0; j < nj; ++j) p[j][i] = g.ratios.joint_q[j];
     }
+    slopes &= static_cast<int>(g.ratios.wrt_q_slope.size()) == nj;
     for (int j = 0; j < nj; ++j) {
       r[j][i] = g.ratios.wrt_q[j];
+      if (slopes) slope[j][i] = g.ratios.wrt_q_slope[j];
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
     }
     singular[i] = g.singular;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace rdyn::reduced {
@@ -28,6 +29,9 @@ struct RatioPoint {
   // Every joint's coordinate at this q (optional: empty when the source does not give it; the
   // joint-output columns p_<joint> need it) [rad or m].
   std::vector<double> joint_q;
+  // d(wrt_q)/dq per joint (optional: empty when the source does not give it; root finding of
+  // switch angles then uses Brent's method on `ratio`) [rad/rad², m/m² …].
+  std::vector<double> wrt_q_slope;
 };
 
 // The cross-check of issue 3, route "direct": m1 = uᵀMu, me1 = u_xᵀMu, m2 = uᵀ(M b + c),
@@ -81,6 +85,12 @@ class KinetostaticSource {
   }
   // Rate of one joint per unit q̇ at q (root finding of switch angles).
   virtual double ratio(double q, int joint) { return ratios(q).wrt_q[joint]; }
+  // The same with its slope d(rate)/dq at q, for Newton's method; empty when the source
+  // cannot give slopes.
+  virtual std::optional<std::pair<double, double>> ratio_and_slope(double q, int joint) {
+    (void)q, (void)joint;
+    return std::nullopt;
+  }
   // Coordinate of one joint at q [rad or m] on the branch the sweep follows (the angle a
   // profiled drive load reads). Empty when the source cannot give positions.
   virtual std::optional<double> joint_coordinate(double q, int joint) {

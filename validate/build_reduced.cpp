@@ -9,14 +9,20 @@
 namespace rdyn::validate {
 
 Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method) {
-  const auto start = std::chrono::steady_clock::now();
+  using clock = std::chrono::steady_clock;
+  auto ms = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  const auto start = clock::now();
   engine::FullModel model(scene);
+  const auto built = clock::now();
   reduced::ExtractOptions opt;
   opt.step_rad = grid_deg * 3.14159265358979323846 / 180.0;
   opt.method = method;
   Extraction e;
+  e.stages.system_build_ms = ms(start, built);
   auto finish = [&](const engine::FullKinetostaticSource& source) {
-    e.extraction_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const auto end = clock::now();
+    e.extraction_ms = ms(start, end);
+    e.stages.kinetostatics_ms = e.extraction_ms - e.stages.system_build_ms - e.stages.assembly_ms;
     e.calls = source.calls();
     return e;
   };
@@ -26,7 +32,9 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
   std::optional<engine::IndependentDomain> domain;
   if (ind.type == models::JointType::Revolute && !scene.independent_range) {
     try {
+      const auto t = clock::now();
       engine::FullKinetostaticSource source(model);
+      e.stages.assembly_ms = ms(t, clock::now());
       e.samples = reduced::extract_samples(source, scene, opt);
       return finish(source);
     } catch (const engine::EngineError&) {
@@ -41,7 +49,9 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
   e.range = opt.range;
   e.dead_min = domain->dead_min;
   e.dead_max = domain->dead_max;
+  const auto t = clock::now();
   engine::FullKinetostaticSource source(model, /*wrap_turns=*/false);
+  e.stages.assembly_ms = ms(t, clock::now());  // a failed full-turn attempt counts as kinetostatics
   e.samples = reduced::extract_samples(source, scene, opt);
   return finish(source);
 }

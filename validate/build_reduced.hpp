@@ -9,9 +9,17 @@
 
 namespace rdyn::validate {
 
+// Wall time of extract_from_full by stage [ms] (issue #11 item 3).
+struct ExtractionStages {
+  double system_build_ms = 0.0;   // the Simbody system (engine::FullModel: topology, model stage)
+  double assembly_ms = 0.0;       // the workspace: assembly at the initial q, one-DOF and branch checks
+  double kinetostatics_ms = 0.0;  // the sweep over the grid (and a dead-point search for a range)
+};
+
 struct Extraction {
   reduced::Samples samples;
   double extraction_ms = 0.0;  // wall time of the kinetostatic calls [ms]
+  ExtractionStages stages;     // extraction_ms by stage
   long calls = 0;              // kinetostatic calls made
   // Range tables: the range sampled and the dead points found (when not declared) [rad or m].
   std::optional<reduced::ExtractRange> range;

@@ -195,14 +195,18 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
   const long total = plan.reduced_runs();
   for (double grid : plan.grids_deg) {
     Extraction e;
-    std::vector<double> ms;
+    std::vector<double> ms, build_ms, assembly_ms, kinetostatics_ms;
     for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
       e = extract_from_full(scene, grid, reduced::Method::Kinetostatic);
       ms.push_back(e.extraction_ms);
+      build_ms.push_back(e.stages.system_build_ms);
+      assembly_ms.push_back(e.stages.assembly_ms);
+      kinetostatics_ms.push_back(e.stages.kinetostatics_ms);
     }
     v.extractions.push_back({grid, median(ms), e.calls, static_cast<int>(e.samples.q.size())});
     if (grid == 10) {
       v.extraction_ms = median(ms);
+      v.extraction_stages = {median(build_ms), median(assembly_ms), median(kinetostatics_ms)};
       v.samples10 = e.samples;
     }
     for (const auto& var : plan.variants) {

@@ -10,6 +10,7 @@
 #include "models/scene.hpp"
 #include "models/timeseries.hpp"
 #include "reduced/samples.hpp"
+#include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
 #include "validate/compare.hpp"
 #include "validate/convergence.hpp"
@@ -56,6 +57,7 @@ struct ValidationResult {
   std::vector<double> peer_steps;  // peer ladders' fixed steps before fitting the output grid [s]
   std::vector<ExtractionRecord> extractions;
   double extraction_ms = 0.0;  // the 10° table
+  ExtractionStages extraction_stages;  // the 10° table, median of each stage over the repeats
   double tightest_tolerance = 0.0;  // of the reduced rk8pd ladder
   std::string headline_quantity;  // the error that matches: first constraint force, else qdot
   std::vector<std::string> quantities;  // qdot, the constraint forces, mean_qdot

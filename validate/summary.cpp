@@ -168,6 +168,9 @@ nlohmann::json summary_json(const ValidationResult& v) {
                         {"whole_run", v.window.whole_run},
                         {"how", v.window.how}};
   j["extraction_ms"] = v.extraction_ms;
+  j["extraction_stages_ms"] = {{"system_build", v.extraction_stages.system_build_ms},
+                               {"assembly", v.extraction_stages.assembly_ms},
+                               {"kinetostatics", v.extraction_stages.kinetostatics_ms}};
   nlohmann::json ex = nlohmann::json::array();
   for (const auto& e : v.extractions)
     ex.push_back({{"grid_deg", e.grid_deg},

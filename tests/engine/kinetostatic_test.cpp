@@ -101,6 +101,66 @@ TEST(Kinetostatic, ReducedInertiaEqualsTwiceKineticEnergyAtUnitSpeed) {
   }
 }
 
+// calc_kinetostatic_sample makes the call (i) only and turns (ii) into virtual power
+// (m1 = rᵀMr, me1 = r_xᵀMr); here every part against the separate calls it replaces, and the
+// slopes dr/dq against central differences of the ratios, on both scenes with a constraint force.
+TEST(Kinetostatic, OneRealizationPerGridPointAgreesWithTheSeparateCalls) {
+  for (const char* name : {"fourbar", "bicycle"}) {
+    const auto scene = models::load_scene(name);
+    FullModel model(scene);
+    FullWorkspace fast(model), ref(model);
+    const int nj = static_cast<int>(scene.joints.size());
+    double peak_m1 = 0, peak_me1 = 0, peak_slope = 0;
+    for (int deg = 0; deg <= 360; deg += 10) {  // continuing from point to point: the predictor
+      const double q = deg * kPi / 180.0;
+      const auto k = calc_kinetostatic_sample(model, fast, q, 11 * kPi / 180, SampleParts::All);
+      const auto i = calc_kinetostatic(model, ref, q, 1.0, 0.0, Loads::Off);
+      const auto ii = calc_kinetostatic(model, ref, q, 0.0, 1.0, Loads::Off);
+      const auto vr = calc_velocity_ratios(model, ref, q);
+      EXPECT_NEAR(k.m1, ii.driving_force, 1e-10 * std::abs(ii.driving_force)) << name << " " << deg;
+      EXPECT_NEAR(k.m2, i.driving_force, 1e-10 * std::abs(k.m1)) << name << " " << deg;
+      ASSERT_EQ(k.me1.size(), 1u);
+      EXPECT_NEAR(k.me1[0], ii.constraint_forces[0], 1e-10 * std::abs(k.m1)) << name << " " << deg;
+      EXPECT_NEAR(k.me2[0], i.constraint_forces[0], 1e-10 * std::abs(k.m1)) << name << " " << deg;
+      for (int j = 0; j < nj; ++j) {
+        EXPECT_NEAR(wrap(k.joint_q[j] - i.joint_q[j]), 0.0, 1e-11) << name << " " << deg << " " << j;
+        EXPECT_NEAR(k.ratio_q[j], vr.wrt_q[j], 1e-11) << name << " " << deg << " " << j;
+        EXPECT_NEAR(k.ratio_x[0][j], vr.wrt_x[0][j], 1e-11) << name << " " << deg << " " << j;
+        const double h = 1e-5;
+        const double dr = (calc_velocity_ratios(model, ref, q + h).wrt_q[j] -
+                           calc_velocity_ratios(model, ref, q - h).wrt_q[j]) / (2 * h);
+        EXPECT_NEAR(k.ratio_slope[j], dr, 1e-7 * std::max(1.0, std::abs(dr))) << name << " " << deg << " " << j;
+        peak_slope = std::max(peak_slope, std::abs(dr));
+      }
+      EXPECT_GT(k.conditioning, 1e-3);
+      peak_m1 = std::max(peak_m1, std::abs(k.m1));
+      peak_me1 = std::max(peak_me1, std::abs(k.me1[0]));
+    }
+    // Not a comparison of zeros.
+    EXPECT_GT(peak_m1, 1e-3) << name;
+    EXPECT_GT(peak_me1, 1e-3) << name;
+    EXPECT_GT(peak_slope, 0.1) << name;
+  }
+}
+
+// Without an anchor within reach the projection starts from the workspace's configuration;
+// both starts reach the same configuration.
+TEST(Kinetostatic, SamplePredictorReachesTheSameConfigurationAsAWalk) {
+  const auto scene = models::load_scene("bicycle");
+  FullModel model(scene);
+  FullWorkspace a(model), b(model);
+  calc_kinetostatic_sample(model, a, 0.0, 0.2, SampleParts::All);
+  const auto predicted = calc_kinetostatic_sample(model, a, 0.17, 0.2, SampleParts::All);  // from the anchor
+  for (double q = 0.0; q < 0.17; q += 0.01) calc_kinetostatic(model, b, q, 0, 0, Loads::Off);
+  const auto walked = calc_kinetostatic_sample(model, b, 0.17, 0.0, SampleParts::All);  // no extrapolation
+  for (size_t j = 0; j < scene.joints.size(); ++j)
+    EXPECT_NEAR(wrap(predicted.joint_q[j] - walked.joint_q[j]), 0.0, 1e-11) << j;
+  EXPECT_NEAR(predicted.m1, walked.m1, 1e-12 * walked.m1);
+  const auto rates = calc_kinetostatic_sample(model, a, 0.1, 0.2, SampleParts::RatesOnly);
+  EXPECT_TRUE(rates.ratio_x.empty());  // rates only
+  EXPECT_EQ(rates.ratio_q.size(), scene.joints.size());
+}
+
 TEST(Kinetostatic, KneeForceFromActuatorEqualsJointReaction) {
   const auto scene = models::load_scene("bicycle");
   FullModelOptions reaction;

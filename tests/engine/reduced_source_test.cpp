@@ -10,6 +10,7 @@
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/extract.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "test_scenes.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "engine/forward_dynamics.hpp"
@@ -30,6 +31,66 @@ double max_abs(const std::vector<double>& v) {
   double m = 0;
   for (double x : v) m = std::max(m, std::abs(x));
   return m;
+}
+
+// The reference route: the kinetostatic calls (i), (ii), the static call and the velocity ratios
+// made one by one (KinetostaticSource's default sample), switch angles by Brent's method on the
+// ratio alone — the extraction before one realization per grid point.
+class SeparateCallsSource : public FullKinetostaticSource {
+ public:
+  using FullKinetostaticSource::FullKinetostaticSource;
+  reduced::GridSample sample(double q, bool with_conservative) override {
+    return KinetostaticSource::sample(q, with_conservative);
+  }
+  std::optional<std::pair<double, double>> ratio_and_slope(double, int) override { return std::nullopt; }
+};
+
+// Every column and switch angle of the fast route (one projection and one realization per grid
+// point, Newton's method for switch angles) against the separate calls, to 1e-10 of each
+// column's peak; columns that are zero by symmetry (a leg the other knee does not move) to 1e-12.
+void expect_routes_agree(const models::Scene& scene, double deg) {
+  FullModel model(scene);
+  FullKinetostaticSource fast(model);
+  SeparateCallsSource slow(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = deg * M_PI / 180;
+  const auto a = reduced::extract_samples(fast, scene, opt);
+  const auto b = reduced::extract_samples(slow, scene, opt);
+  ASSERT_EQ(a.names, b.names);
+  ASSERT_EQ(a.q, b.q);
+  for (size_t c = 0; c < a.columns.size(); ++c) {
+    const double scale = max_abs(b.columns[c]);
+    for (size_t i = 0; i < a.q.size(); ++i)
+      EXPECT_NEAR(a.columns[c][i], b.columns[c][i], scale < 1e-12 ? 1e-12 : 1e-10 * scale)
+          << scene.name << " " << a.names[c] << " at " << a.q[i];
+  }
+  ASSERT_EQ(a.roots.size(), b.roots.size());
+  for (size_t g = 0; g < a.roots.size(); ++g) {
+    ASSERT_EQ(a.roots[g].second.size(), b.roots[g].second.size()) << a.roots[g].first;
+    for (size_t k = 0; k < a.roots[g].second.size(); ++k)
+      EXPECT_NEAR(a.roots[g].second[k], b.roots[g].second[k], 1e-10) << a.roots[g].first;
+  }
+  EXPECT_LT(fast.calls(), slow.calls());  // the point of the fast route
+}
+
+TEST(ReducedSource, OneRealizationPerGridPointAgreesWithSeparateCallsOnTheBicycle) {
+  const auto scene = models::load_scene("bicycle");
+  expect_routes_agree(scene, 10);
+  expect_routes_agree(scene, 5);
+  // Its switch angles are there to compare.
+  reduced::ExtractOptions opt;
+  FullModel model(scene);
+  FullKinetostaticSource src(model);
+  EXPECT_EQ(reduced::extract_samples(src, scene, opt).roots.size(), 2u);
+}
+
+TEST(ReducedSource, OneRealizationPerGridPointAgreesWithSeparateCallsOnTheFourBarWithJointOutputs) {
+  // Joint outputs add the reaction lines (constraint forces on every joint) and the p_/k_
+  // columns; gravity adds Q_cons, V and Qx_cons_.
+  const auto scene = reduced::with_reaction_requests(
+      models::load_scene("fourbar", {{"outputs.joints", "all"}, {"outputs.reactions", "all"}}));
+  ASSERT_GT(scene.outputs.constraint_forces.size(), 2u);
+  expect_routes_agree(scene, 10);
 }
 
 TEST(ReducedSource, SliderCrankInertiaMatchesClosedForm) {

@@ -18,6 +18,16 @@ void expect_finite(const nlohmann::json& j, const std::string& path = "") {
       expect_finite(*it, path + "/" + (j.is_object() ? it.key() : "[]"));
 }
 
+TEST(Summary, BreaksTheExtractionTimeIntoStages) {
+  auto v = test::synthetic_validation();
+  v.extraction_stages = {0.5, 1.25, 10.25};
+  const auto s = summary_json(v);
+  EXPECT_DOUBLE_EQ(s["extraction_ms"].get<double>(), 12.0);
+  EXPECT_DOUBLE_EQ(s["extraction_stages_ms"]["system_build"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(s["extraction_stages_ms"]["assembly"].get<double>(), 1.25);
+  EXPECT_DOUBLE_EQ(s["extraction_stages_ms"]["kinetostatics"].get<double>(), 10.25);
+}
+
 TEST(Summary, HoldsTheVerdictsBaselinesAndFigureData) {
   const auto v = test::synthetic_validation();
   const auto s = summary_json(v);
