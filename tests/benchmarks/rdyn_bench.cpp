@@ -175,6 +175,25 @@ void BM_ReducedPerSimulatedSecond(benchmark::State& st) {
 }
 BENCHMARK(BM_ReducedPerSimulatedSecond)->Args({10, 0})->Args({5, 0})->Args({2, 1})->Args({1, 1})->Unit(benchmark::kMicrosecond);
 
+// The reduced settings `rdyn validate bicycle` matches at the knee errors of its baselines, timed
+// like every engine there (5 s, one output at the end): range(0) 0 — 1° fourier with energy-
+// consistent m2, RK4 at period/35 (28.2 ms; knee 3.2e-5, within Simbody's 5.8e-5); 1 — 5° cubic,
+// RK4 at period/25 (39.4 ms; knee 2.3e-4, within MuJoCo Euler's 8.1e-4 at 0.83 ms). The period
+// is the reference's one revolution at its peak speed, 0.98569 s.
+void BM_ReducedMatchedSetting(benchmark::State& st) {
+  const bool simbody_match = st.range(0) == 0;
+  static const reduced::ReducedModel fine_ec =
+      reduced::make_reduced_model(samples(1), bicycle(), reduced::Interpolation::Fourier, true);
+  const auto& m = simbody_match ? fine_ec : cubic_model(5);
+  reduced::ReducedOptions o;
+  o.duration_s = 5.0;
+  o.output_interval_s = 5.0;
+  o.integrator = "rk4-fixed";
+  o.fixed_step_s = 0.98569 / (simbody_match ? 35 : 25);
+  for (auto _ : st) benchmark::DoNotOptimize(reduced::simulate_reduced(m, 0, 2 * M_PI, o).q.back());
+}
+BENCHMARK(BM_ReducedMatchedSetting)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // One crank revolution of the reduced model (no outputs): the steady-cycle unit of work.
 void BM_ReducedPerRevolution(benchmark::State& st) {
   const auto& m = model(10);
@@ -278,8 +297,8 @@ void BM_FullFairPerSimulatedSecond(benchmark::State& st) {
 }
 BENCHMARK(BM_FullFairPerSimulatedSecond)->Arg(4)->Arg(5)->Arg(6)->Unit(benchmark::kMillisecond);
 
-// MuJoCo (peer) on the bicycle, 5 s with 5 ms outputs, per simulated second: range(0) 0 Euler,
-// 1 RK4; range(1) the step in µs.
+// MuJoCo (peer) on the bicycle, 5 s with 5 ms outputs (range(2) 1: one output at the end, as
+// `rdyn validate` times it), per simulated second: range(0) 0 Euler, 1 RK4; range(1) the step in µs.
 void BM_MujocoPerSimulatedSecond(benchmark::State& st) {
   if (!engine::mujoco_available()) {
     st.SkipWithError("rdyn was built without MuJoCo");
@@ -294,17 +313,19 @@ void BM_MujocoPerSimulatedSecond(benchmark::State& st) {
   const engine::MujocoModel m(bicycle(), k.joint_q, ms);
   engine::MujocoRunOptions o;
   o.duration_s = 5.0;
-  o.output_interval_s = 0.005;
+  o.output_interval_s = st.range(2) != 0 ? 5.0 : 0.005;  // range(2): one output at the end
   o.initial_u = k.joint_u;
   for (auto _ : st) benchmark::DoNotOptimize(engine::simulate_mujoco(m, o).q.back());
   st.counters["s_per_simulated_s"] = benchmark::Counter(o.duration_s * st.iterations(),
                                                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MujocoPerSimulatedSecond)
-    ->Args({0, 1000})
-    ->Args({0, 100})
-    ->Args({1, 1000})
-    ->Args({1, 100})
+    ->Args({0, 1000, 0})
+    ->Args({0, 1000, 1})
+    ->Args({0, 100, 0})
+    ->Args({1, 1000, 0})
+    ->Args({1, 1000, 1})
+    ->Args({1, 100, 0})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
