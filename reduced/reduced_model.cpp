@@ -100,6 +100,8 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     }
   m.record_cols = m.rhs_cols;
   m.record_cols.insert(m.record_cols.end(), m.out_cols.begin(), m.out_cols.end());
+  m.rhs_block = make_column_block(m.table, m.rhs_cols);
+  m.record_block = make_column_block(m.table, m.record_cols);
   return m;
 }
 
@@ -150,7 +152,7 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
 void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                        double& power_nc) {
   double* v = ws.scratch.data();
-  m.table.eval_cols(q, m.rhs_cols.data(), static_cast<int>(m.rhs_cols.size()), v);
+  eval_block(m.table, m.rhs_block, q, v);
   acceleration_from(m, ws, v, qdot, qddot, power_nc);
 }
 
@@ -188,7 +190,7 @@ double calc_energy(const ReducedModel& m, double q, double qdot) {
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces) {
   double* v = ws.scratch_rec.data();
-  m.table.eval_cols(q, m.record_cols.data(), static_cast<int>(m.record_cols.size()), v);
+  eval_block(m.table, m.record_block, q, v);
   acceleration_from(m, ws, v, qdot, qddot, power_nc);
   return outputs_from(m, ws, v + m.rhs_cols.size(), qdot, qddot, forces);
 }
@@ -224,11 +226,15 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
 
 namespace {
 
-// Classical RK4 on y = (q, q̇, W) with frozen gates.
-void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
+// Classical RK4 on y = (q, q̇, W) with frozen gates. k1: (q̈, power) at the step's start with
+// these gates when the caller already has them (else null).
+void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, const double* k1 = nullptr) {
   const double q = ws.q, v = ws.qdot;
   double a1, p1, a2, p2, a3, p3, a4, p4;
-  calc_acceleration(m, ws, q, v, a1, p1);
+  if (k1)
+    a1 = k1[0], p1 = k1[1];
+  else
+    calc_acceleration(m, ws, q, v, a1, p1);
   calc_acceleration(m, ws, q + 0.5 * h * v, v + 0.5 * h * a1, a2, p2);
   calc_acceleration(m, ws, q + 0.5 * h * (v + 0.5 * h * a1), v + 0.5 * h * a2, a3, p3);
   calc_acceleration(m, ws, q + h * (v + 0.5 * h * a2), v + h * a3, a4, p4);
@@ -240,7 +246,9 @@ void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
 
 }  // namespace
 
-double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
+double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) { return step_fixed_rk4(m, ws, h, nullptr); }
+
+double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, const double* k1) {
   // Switches are handled one after another inside the step: a gate needs a flip in the
   // remaining interval exactly when it disagrees with the sign of its switching function at
   // the interval's end (as the full model's gates agree with their witnesses after events).
@@ -253,7 +261,9 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
     const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
     double s0[32], fr[32];
     for (size_t g = 0; g < ng; ++g) s0[g] = calc_switching(m, static_cast<int>(g), q0, v0);
-    rk4(m, ws, remaining);
+    // The given start derivative holds until a gate flips (pass 0 and its shortened step).
+    const double* k1_now = pass == 0 ? k1 : nullptr;
+    rk4(m, ws, remaining, k1_now);
     double frac = 2.0;
     for (size_t g = 0; g < ng; ++g) {
       const double s1 = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
@@ -268,7 +278,7 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) {
     }
     ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
     const double h1 = std::max(0.0, std::min(1.0, frac)) * remaining;
-    if (h1 > 0) rk4(m, ws, h1);
+    if (h1 > 0) rk4(m, ws, h1, k1_now);
     if (std::isnan(t_first)) t_first = ws.t;
     for (size_t g = 0; g < ng; ++g)
       if (fr[g] <= frac + 1e-9) ws.gate_on[g] = !ws.gate_on[g];

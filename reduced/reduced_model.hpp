@@ -67,6 +67,8 @@ struct ReducedModel {
   // me1, me2, Qx_cons, each torque's rx (and tau), each motor's r and rx, each brake's w and wx.
   std::vector<int> out_cols;
   std::vector<int> record_cols;  // rhs_cols then out_cols: one lookup per output sample
+  // rhs_cols and record_cols packed for one fused evaluation each (table.hpp, ColumnBlock).
+  ColumnBlock rhs_block, record_block;
 };
 
 // Joins the sampled parameters with the scene's loads. Throws TableError when the samples were
@@ -123,5 +125,9 @@ inline bool energy_balance_diverged(double E, double E0, double work, double E_s
 // split there (at most 8 splits; the step always advances t by h). Returns the time of the
 // first switch, or NaN when none happened.
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
+// The same with the start derivative k1 = (q̈, power) at (ws.q, ws.q̇) under ws's gates when
+// the caller has it already (simulate_reduced keeps each step's end point): one right-hand
+// side fewer per step, the same numbers. k1 may be null.
+double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, const double* k1);
 
 }  // namespace rdyn::reduced

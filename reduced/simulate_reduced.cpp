@@ -114,6 +114,74 @@ struct AdaptiveIntegrator::Impl {
     pending.assign(m.gates.size(), 0);
   }
 
+  // One step of gsl_odeiv2_evolve_apply (GSL 2.7, ode-initval2/evolve.c), statement for
+  // statement, except for the derivative at the step's start: GSL evaluates it on every call,
+  // here it is the start point's (q̈ and power from calc_acceleration, as ode_rhs computes them),
+  // which the previous step's end already holds; and that end point is GSL's dydt_out (rk8pd
+  // evaluates it for the error control). The same numbers with two right-hand sides fewer per
+  // step (13 instead of 15 for rk8pd). Bounded: a step is halved at most kMaxRetries times.
+  int evolve_apply(double* t, double t1, double* h_io, double yy[]) {
+    gsl_odeiv2_evolve* e = evolve.get();
+    const double t0 = *t;
+    double h0 = *h_io;
+    const double dt = t1 - t0;
+    if ((dt < 0.0 && h0 > 0.0) || (dt > 0.0 && h0 < 0.0)) return GSL_EINVAL;
+    for (int k = 0; k < 3; ++k) e->y0[k] = yy[k];
+    const bool use_in = step->type->can_use_dydt_in;
+    if (use_in) {
+      e->dydt_in[0] = start.qdot, e->dydt_in[1] = start.qddot, e->dydt_in[2] = start.power;
+      if (!std::isfinite(start.qddot)) return GSL_EBADFUNC;  // as ode_rhs would report it
+    }
+    constexpr int kMaxRetries = 2200;  // halving a double from 1 to below its ulp takes < 1100
+    for (int attempt = 0; attempt < kMaxRetries; ++attempt) {
+      bool final_step = false;
+      if ((dt >= 0.0 && h0 > dt) || (dt < 0.0 && h0 < dt)) {
+        h0 = dt;
+        final_step = true;
+      }
+      const int st = gsl_odeiv2_step_apply(step.get(), t0, h0, yy, e->yerr, use_in ? e->dydt_in : nullptr,
+                                           e->dydt_out, &sys);
+      if (st == GSL_EFAULT || st == GSL_EBADFUNC) return st;
+      if (st != GSL_SUCCESS) {  // the stepper could not take the step: halve it
+        const double h_old = h0;
+        h0 *= 0.5;
+        const volatile double t_curr = *t, t_next = *t + h0;
+        if (std::abs(h0) < std::abs(h_old) && t_next != t_curr) {
+          for (int k = 0; k < 3; ++k) yy[k] = e->y0[k];
+          ++e->failed_steps;
+          continue;
+        }
+        *h_io = h0;
+        *t = t0;
+        return st;
+      }
+      ++e->count;
+      e->last_step = h0;
+      *t = final_step ? t1 : t0 + h0;
+      const double h_old = h0;
+      if (gsl_odeiv2_control_hadjust(control.get(), step.get(), yy, e->yerr, e->dydt_out, &h0) ==
+          GSL_ODEIV_HADJ_DEC) {
+        const volatile double t_curr = *t, t_next = *t + h0;
+        if (std::abs(h0) < std::abs(h_old) && t_next != t_curr) {  // rejected: retry smaller
+          for (int k = 0; k < 3; ++k) yy[k] = e->y0[k];
+          ++e->failed_steps;
+          continue;
+        }
+        *h_io = h0;
+        return GSL_FAILURE;
+      }
+      if (!final_step) *h_io = h0;
+      return GSL_SUCCESS;
+    }
+    return GSL_FAILURE;
+  }
+
+  // The step's end as point() would compute it, from the derivative the stepper evaluated there.
+  Point end_point(double t, const double yy[3]) const {
+    const double* f = evolve->dydt_out;
+    return Point{t, yy[0], yy[1], f[1], yy[2], f[2]};
+  }
+
   Point point(double t, const double yy[3]) {
     Point p{t, yy[0], yy[1], 0, yy[2], 0};
     calc_acceleration(m, ws, p.q, p.qdot, p.qddot, p.power);
@@ -265,11 +333,11 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   }
   d.flipped = false;
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
-  const int st = gsl_odeiv2_evolve_apply(d.evolve.get(), d.control.get(), d.step.get(), &d.sys, &t, t_end, &d.h, d.y);
+  const int st = d.evolve_apply(&t, t_end, &d.h, d.y);
   if (st != GSL_SUCCESS)
     throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
   ++d.steps;
-  d.end = d.point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)
+  d.end = d.end_point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)
   // What changed sign in this step: a gate's switching function (index ≥ 0) or q − q_stop (−2).
   // The earliest crossing, located on single steps from the start of the step, ends the step.
   const double H = t - t_prev;
@@ -335,18 +403,24 @@ void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, dou
             models::TimeSeries& ts, std::vector<double>& f) {
   double qdd, p;
   const double energy = calc_sample(m, ws, q, qdot, qdd, p, f.data());
-  // No NaN in an output: a sample that is not finite fails the run, naming what and when.
-  auto finite = [&](double v, const std::string& what) {
-    if (!std::isfinite(v))
-      throw models::NumericalError(
-          fmt::format("reduced model output {} is not finite ({}) at t = {:.6g} s", what, v, t));
-  };
-  finite(q, "q");
-  finite(qdot, "q̇");
-  finite(qdd, "q̈");
-  finite(energy, "energy");
-  finite(work, "work");
-  for (size_t k = 0; k < f.size(); ++k) finite(f[k], "constraint force '" + m.force_names[k] + "'");
+  // No NaN in an output: a sample that is not finite fails the run, naming what and when (the
+  // names are built only then: a string per force per row was a third of the row's cost).
+  bool all_finite = std::isfinite(q) && std::isfinite(qdot) && std::isfinite(qdd) && std::isfinite(energy) &&
+                    std::isfinite(work);
+  for (double fk : f) all_finite = all_finite && std::isfinite(fk);
+  if (!all_finite) {
+    auto finite = [&](double v, const std::string& what) {
+      if (!std::isfinite(v))
+        throw models::NumericalError(
+            fmt::format("reduced model output {} is not finite ({}) at t = {:.6g} s", what, v, t));
+    };
+    finite(q, "q");
+    finite(qdot, "q̇");
+    finite(qdd, "q̈");
+    finite(energy, "energy");
+    finite(work, "work");
+    for (size_t k = 0; k < f.size(); ++k) finite(f[k], "constraint force '" + m.force_names[k] + "'");
+  }
   ts.t.push_back(t);
   ts.q.push_back(q);
   ts.qdot.push_back(qdot);
@@ -442,7 +516,9 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
         throw models::NumericalError(fmt::format(
             "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps", ws.t,
             opt.max_wall_s, ts.stats.steps_taken));
-      const double t_switch = step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, opt.duration_s - ws.t));
+      // a: the step's start point, with the gates ws holds now: its q̈ and power are RK4's k1.
+      const double k1[2] = {a.qddot, a.power};
+      const double t_switch = step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, opt.duration_s - ws.t), k1);
       ++ts.stats.steps_taken;
       if (!std::isnan(t_switch)) ++ts.stats.events;
       if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot) || !std::isfinite(ws.work))
@@ -469,7 +545,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
           // One RK4 step of the row's length from the step's start (switches located as in
           // the step itself), with the gates that hold at the row's time.
           sub = at_start;
-          step_fixed_rk4(m, sub, t_out(i) - a.t);
+          step_fixed_rk4(m, sub, t_out(i) - a.t, k1);
           ws.gate_on.swap(sub.gate_on);
           record(m, ws, t_out(i), sub.q, sub.qdot, sub.work, ts, f);
           ws.gate_on.swap(sub.gate_on);

@@ -124,11 +124,16 @@ void not_a_knot_coefficients(const std::vector<double>& y, double h, int col, in
 
 int Table::locate(double q, double& dx) const {
   const double u = (q - q0) / step;
-  const double fl = std::floor(u);
-  long i = static_cast<long>(fl);
+  // floor(u) by truncation and one correction (exact for |u| < 2^63, the same value as
+  // std::floor, which without SSE4.1 is a library call on the hot path).
+  long i = static_cast<long>(u);
+  if (static_cast<double>(i) > u) --i;
+  const double fl = static_cast<double>(i);
   dx = (u - fl) * step;
   if (periodic) {
-    // Wrap the interval index (integer arithmetic: no fmod on the hot path).
+    // Wrap the interval index (integer arithmetic: no fmod; the division only past the first
+    // period).
+    if (i >= 0 && i < intervals) return static_cast<int>(i);
     i %= intervals;
     if (i < 0) i += intervals;
     return static_cast<int>(i);
@@ -167,6 +172,29 @@ void Table::eval_cols(double q, const int* idx, int n, double* out) const {
     const double* c = row + idx[k] * 4;
     out[k] = c[0] + dx * (c[1] + dx * (c[2] + dx * c[3]));
   }
+}
+
+ColumnBlock make_column_block(const Table& t, const std::vector<int>& cols) {
+  ColumnBlock b;
+  b.cols = cols;
+  const size_t n = cols.size();
+  b.coef.assign(static_cast<size_t>(t.intervals) * 4 * n, 0.0);
+  for (int iv = 0; iv < t.intervals; ++iv)
+    for (size_t k = 0; k < n; ++k)
+      for (int p = 0; p < 4; ++p)
+        b.coef[(static_cast<size_t>(iv) * 4 + p) * n + k] = t.coef[(static_cast<size_t>(iv) * t.cols + cols[k]) * 4 + p];
+  return b;
+}
+
+void eval_block(const Table& t, const ColumnBlock& b, double q, double* __restrict out) {
+  double dx;
+  const size_t n = b.cols.size();
+  const double* __restrict c0 = &b.coef[static_cast<size_t>(t.locate(q, dx)) * 4 * n];
+  const double* __restrict c1 = c0 + n;
+  const double* __restrict c2 = c1 + n;
+  const double* __restrict c3 = c2 + n;
+  // Horner, as Table::eval_cols: a + dx (b + dx (c + dx d)).
+  for (size_t k = 0; k < n; ++k) out[k] = c0[k] + dx * (c1[k] + dx * (c2[k] + dx * c3[k]));
 }
 
 int Table::column(const std::string& name) const {

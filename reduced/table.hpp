@@ -44,6 +44,18 @@ struct Table {
   int column(const std::string& name) const;  // −1 when absent
 };
 
+// A fixed list of a table's columns repacked for evaluating them together (the reduced
+// model's right-hand-side and output columns): coefficients [interval][power 0..3][k], so one
+// locate serves every column and the Horner sums run over contiguous memory, vectorized across
+// columns. The same arithmetic as Table::eval_cols, hence the same values bit for bit.
+struct ColumnBlock {
+  std::vector<int> cols;     // table columns, in output order (repeats allowed)
+  std::vector<double> coef;  // [interval][power][k]
+};
+ColumnBlock make_column_block(const Table& t, const std::vector<int>& cols);
+// Evaluates every column of the block at q into out[0 .. b.cols.size()). Allocation-free.
+void eval_block(const Table& t, const ColumnBlock& b, double q, double* out);
+
 // Builds the table. Throws TableError when the samples are inconsistent (fewer than 4 points,
 // a step that is not finite and positive, columns of another length than the grid).
 // energy_consistent_m2

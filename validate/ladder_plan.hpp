@@ -28,6 +28,13 @@ struct LadderPlan {
   // Full-model runs are timed with one output at the end (fair baseline: the output grid does
   // not cap the step); their errors come from one untimed run on the output grid.
   bool time_full_without_outputs = true;
+  // The same rule for the reduced model and the peer engines (issue #11 item 6: one rule for
+  // every engine in a matched-error ratio): timed with one output at the end of the run, errors
+  // from the same settings on the output grid. Their steps do not depend on the outputs (the
+  // reduced model's rows are interpolated or extra single steps; a peer's fixed step divides the
+  // output interval), so the timed and the compared runs take the same steps.
+  bool time_reduced_without_outputs = true;
+  bool time_peers_without_outputs = true;
   RepeatPolicy full_repeats, reduced_repeats, peer_repeats;
   int extraction_repeats_10deg = 1;  // median of this many for the 10° table
   double tightest_tolerance() const { return rk8pd_tolerances.back(); }

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "engine/full_model.hpp"
 #include "engine/kinetostatic.hpp"
 #include "engine/mujoco_peer.hpp"
@@ -47,9 +49,13 @@ PeerLadder run_mujoco_ladder(const models::Scene& scene, const JointState& start
       "MuJoCo {} ({} integrator) at fixed steps, each shortened to fill the {:g} s output interval with whole steps; "
       "the scene exported as MJCF (rdyn export-mjcf --fold), loops as connect equalities with solref = [2·step, 1], "
       "solimp = [{:g}, {:g}, 0.001]; loads applied at every evaluation; started from the full model's assembled state; "
-      "timed with its outputs, like the reduced model (its fixed step is not capped by them).",
+      "{}",
       ladder.version, integrator == "rk4" ? "RK4" : "semi-implicit Euler", v.output_interval_s, settings.impedance,
-      settings.impedance);
+      settings.impedance,
+      plan.time_peers_without_outputs
+          ? "timed with one output at the end like the full and reduced models (its fixed step is the same), errors "
+            "from the same settings on the output grid."
+          : "timed with its outputs (its fixed step is not capped by them).");
   for (double h0 : plan.peer_steps_s) {
     progress.count(scene.name + ": MuJoCo ladders", done++, total);
     RunRecord r;
@@ -63,9 +69,17 @@ PeerLadder run_mujoco_ladder(const models::Scene& scene, const JointState& start
     ro.initial_u = start.u;
     try {
       const engine::MujocoModel model(scene, start.q, settings);
-      models::TimeSeries ts;
-      const auto walls = time_repeats([&] { ts = engine::simulate_mujoco(model, ro); }, plan.peer_repeats);
-      r.timed_steps = ts.stats.steps_taken;
+      models::TimeSeries ts, timed;
+      auto ro_timed = ro;
+      // One output at the end when the run is a whole number of steps (else the grid's rows).
+      const double per_run = v.duration_s / settings.timestep_s;
+      const bool one_output =
+          plan.time_peers_without_outputs && std::abs(per_run - std::round(per_run)) <= 1e-9 * per_run;
+      if (one_output) ro_timed.output_interval_s = v.duration_s;
+      const auto walls = time_repeats([&] { timed = engine::simulate_mujoco(model, ro_timed); }, plan.peer_repeats);
+      r.timed_steps = timed.stats.steps_taken;
+      r.timed_output_interval_s = ro_timed.output_interval_s;
+      ts = one_output ? engine::simulate_mujoco(model, ro) : timed;
       finish_run(r, walls, ts, v);
     } catch (const models::NumericalError& e) {
       mark_stopped(r, e.what(), v.quantities);

@@ -125,8 +125,8 @@ nlohmann::json run_json(const RunRecord& r) {
                       {"pareto", r.pareto}};
   if (!r.failure.empty()) j["failure"] = r.failure;
   if (r.model == "full") j["constraint_violation_m"] = num(r.constraint_violation_m);
-  if (r.model == "full" && r.timed_output_interval_s > 0) j["timed_output_interval_s"] = r.timed_output_interval_s;
-  if (r.model == "full" || (r.model != "reduced" && r.failure.empty())) j["timed_steps"] = r.timed_steps;
+  if (r.timed_output_interval_s > 0) j["timed_output_interval_s"] = r.timed_output_interval_s;
+  if (r.model == "full" || r.failure.empty()) j["timed_steps"] = r.timed_steps;
   if (r.model != "full" && r.model != "reduced") {  // a peer engine's fixed-step run
     j["fixed_step_s"] = r.fixed_step_s;
     j["constraint_violation_m"] = num(r.constraint_violation_m);
@@ -139,7 +139,7 @@ nlohmann::json run_json(const RunRecord& r) {
     if (r.integrator == "rk4-fixed") j["fixed_step_s"] = r.fixed_step_s;
     nlohmann::json oi = nlohmann::json::object();
     for (const auto& e : r.output_interpolation.signals) oi[e.name] = num(e.max_rel);
-    j["output_interpolation_max_rel"] = oi;  // Hermite rows of the timed run vs the compared rows
+    j["output_interpolation_max_rel"] = oi;  // Hermite rows on the output grid vs the compared rows
     j["compared_run_wall_s"] = num(r.compared_run_wall_s);
   }
   j.update(comparison_json(r.errors));

@@ -51,7 +51,7 @@ std::vector<double> steps_from_fractions(const TimeScale& ts, const std::vector<
 }  // namespace
 
 std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
-  return steps_from_fractions(ts, quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 50, 25});
+  return steps_from_fractions(ts, quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 70, 50, 35, 25});
 }
 
 std::vector<double> calc_peer_step_ladder(const TimeScale& ts, bool quick) {

@@ -240,6 +240,39 @@ TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
   EXPECT_NEAR(ws.qdot, ts.qdot.back(), 5e-6 * std::abs(ts.qdot.back()));
 }
 
+// simulate_reduced hands each RK4 step the derivative it already has at the step's start (the
+// previous step's end point): the same steps bit for bit as computing it anew, through gate
+// switches (split steps) too, and still allocation-free; calc_sample allocates nothing either.
+TEST(ReducedModel, FixedStepWithKnownStartDerivativeIsTheSameStep) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
+  const auto s = analytic_samples(0.0, scene, 5);
+  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  ReducedWorkspace a(m), b(m);
+  a.q = b.q = 0.0, a.qdot = b.qdot = 10.0;
+  init_gates(m, a);
+  init_gates(m, b);
+  std::vector<double> forces(m.force_names.size());
+  long switches = 0;
+  const long before = g_allocations;
+  for (int i = 0; i < 2000; ++i) {
+    double k1[2];
+    calc_acceleration(m, b, b.q, b.qdot, k1[0], k1[1]);
+    const double t_a = step_fixed_rk4(m, a, 1e-3);
+    step_fixed_rk4(m, b, 1e-3, k1);
+    if (!std::isnan(t_a)) ++switches;
+    ASSERT_EQ(a.q, b.q) << "step " << i;
+    ASSERT_EQ(a.qdot, b.qdot) << "step " << i;
+    ASSERT_EQ(a.work, b.work) << "step " << i;
+    ASSERT_EQ(a.gate_on, b.gate_on) << "step " << i;
+    double qdd, p;
+    calc_sample(m, b, b.q, b.qdot, qdd, p, forces.data());
+  }
+  EXPECT_EQ(g_allocations - before, 0);
+  EXPECT_GE(switches, 5);  // the split steps were exercised
+}
+
 TEST(ReducedModel, RefusesATableFromAnotherScene) {
   auto scene = test::analytic_scene();
   scene.joint_torques.push_back({"drive", "lever", 2.0, models::RateGate{"lever", +1}});

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -192,6 +193,59 @@ TEST(Table, FusedEvaluationMatchesSingleColumns) {
   double out[3];
   t.eval_cols(1.2345, cols, 3, out);
   for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(out[k], t.eval(cols[k], 1.2345));
+}
+
+// The interval and offset as first written (std::floor, wrap by %): locate's faster floor and
+// wrap must give the same index and the same dx bit for bit.
+int locate_reference(const Table& t, double q, double& dx) {
+  const double u = (q - t.q0) / t.step;
+  const double fl = std::floor(u);
+  long i = static_cast<long>(fl);
+  dx = (u - fl) * t.step;
+  if (!t.periodic) {  // the first and last cubics extrapolate just outside the range
+    if (i < 0) dx = u * t.step;
+    if (i >= t.intervals) dx = (u - (t.intervals - 1)) * t.step;
+    return static_cast<int>(std::clamp(i, 0L, static_cast<long>(t.intervals - 1)));
+  }
+  i %= t.intervals;
+  if (i < 0) i += t.intervals;
+  return static_cast<int>(i);
+}
+
+// The packed evaluation (one locate, contiguous coefficients, vectorized across columns) is
+// the per-column evaluation bit for bit: at grid points and one ulp either side of them,
+// many periods away, negative q, and with a column listed twice; periodic and range tables.
+TEST(Table, ColumnBlockEqualsPerColumnEvaluationBitForBit) {
+  auto range = periodic_samples(36);
+  range.periodic = false;
+  for (const Table& t : {build_table(periodic_samples(36), Interpolation::Fourier),
+                         build_table(periodic_samples(36), Interpolation::Akima), build_table(range, Interpolation::CubicSpline)}) {
+    const std::vector<int> cols = {2, 0, 1, 0};
+    const ColumnBlock b = make_column_block(t, cols);
+    std::vector<double> qs;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> any(-60.0, 60.0);
+    for (int i = 0; i < 2000; ++i) qs.push_back(any(rng));
+    for (int k = -80; k <= 80; ++k) {
+      const double g = t.q0 + k * t.step;
+      qs.insert(qs.end(), {g, std::nextafter(g, -INFINITY), std::nextafter(g, INFINITY)});
+    }
+    if (!t.periodic)  // a range table is evaluated within its range only (callers check in_range)
+      qs.erase(std::remove_if(qs.begin(), qs.end(), [&](double q) { return !t.in_range(q); }), qs.end());
+    ASSERT_GT(qs.size(), 100u);
+    for (double q : qs) {
+      double out[4], fused[4];
+      eval_block(t, b, q, out);
+      t.eval_cols(q, cols.data(), 4, fused);
+      for (int k = 0; k < 4; ++k) {
+        ASSERT_EQ(out[k], t.eval(cols[k], q)) << "q = " << q << ", column " << cols[k] << ", fit " << t.fit;
+        ASSERT_EQ(out[k], fused[k]);
+      }
+      double dx, dx_ref;
+      ASSERT_EQ(t.locate(q, dx), locate_reference(t, q, dx_ref)) << "q = " << q;
+      ASSERT_EQ(dx, dx_ref) << "q = " << q;
+    }
+  }
 }
 
 TEST(Table, InconsistentSamplesAreRefused) {

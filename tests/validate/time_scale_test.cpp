@@ -25,9 +25,10 @@ TEST(TimeScale, OneRevolutionAtThePeakSpeed) {
   const auto s = calc_time_scale(spinning(2 * M_PI, 5.0), true);
   EXPECT_NEAR(s.period_s, 1.0, 1e-12);  // 1 rev/s
   EXPECT_NEAR(s.duration_s, 5.0, 1e-12);
-  // A 1 s cycle keeps the historical ladder: 1, 5, 10, 20, 40 ms.
+  // A 1 s cycle: the historical ladder 1, 5, 10, 20, 40 ms with 1/70 and 1/35 s between its
+  // coarse rungs (√2 apart, where the matched-error RK4 setting lies).
   const auto h = calc_fixed_step_ladder(s, false);
-  const std::vector<double> expected{1e-3, 5e-3, 1e-2, 2e-2, 4e-2};
+  const std::vector<double> expected{1e-3, 5e-3, 1e-2, 1.0 / 70, 2e-2, 1.0 / 35, 4e-2};
   ASSERT_EQ(h.size(), expected.size());
   for (size_t i = 0; i < h.size(); ++i) EXPECT_NEAR(h[i], expected[i], 1e-15);
   EXPECT_EQ(calc_fixed_step_ladder(s, true), std::vector<double>{5e-3});
