@@ -739,6 +739,28 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       sp.stiffness_N_per_m = f.num("stiffness_N_per_m");
       sp.rest_length_m = f.num("rest_length_m");
       s.springs.push_back(sp);
+    } else if (type == "point_force") {
+      // A muscle-like tension between two points; force_N is an amplitude with a profile.
+      Fields f(n, path, top.ctx(),
+               {"type", "name", "body_a", "point_a", "body_b", "point_b", "force_N", "active_when", "profile"});
+      PointForce pf;
+      pf.name = name;
+      pf.body_a = f.str("body_a");
+      pf.body_b = f.str("body_b");
+      for (const auto& [key, body] : {std::pair{"body_a", pf.body_a}, std::pair{"body_b", pf.body_b}})
+        if (body != kGround && !s.find_body(body)) f.fail(key, "unknown body '" + body + "'");
+      pf.point_a = read_point(f, "point_a", pf.body_a, s);
+      pf.point_b = read_point(f, "point_b", pf.body_b, s);
+      if (f.has("profile")) pf.profile = read_profile(f, "profile");
+      if (!f.has("profile") && !f.has("force_N")) f.fail("force_N", "give force_N (the tension, positive pulls the points together)");
+      pf.value = f.num_or("force_N", 1.0);
+      if (f.has("active_when")) {
+        Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
+        const std::string rate = g.str("rate");
+        if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+        pf.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
+      }
+      s.point_forces.push_back(pf);
     } else if (type == "motor") {
       Fields f(n, path, top.ctx(),
                {"type", "name", "joint", "stall_torque_Nm", "stall_force_N", "no_load_speed_rad_s",
@@ -751,7 +773,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
     } else {
       throw SceneError(
           top.file(), line_of(n["type"]), path + ".type",
-          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
+          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor, point_force)");
     }
   });
 }
@@ -1058,6 +1080,20 @@ bool find_path(YAML::Node root, const std::string& path, YAML::Node& parent, std
   return cur.IsMap() && static_cast<bool>(cur[last]);
 }
 }  // namespace
+
+int find_scene_field_line(const std::string& file, const std::string& field) {
+  try {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return 0;
+    std::string text(kMaxSceneBytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<size_t>(std::max<std::streamsize>(0, in.gcount())));
+    const YAML::Node n = locate_field(load_checked_yaml(text, file), field);
+    return n ? line_of(n) : 0;
+  } catch (const std::exception&) {  // unreadable or malformed: no line, the message still names the field
+    return 0;
+  }
+}
 
 bool scene_yaml_has(const std::string& text, const std::string& path) {
   try {

@@ -35,6 +35,11 @@ Scene parse_scene(const std::string& yaml_text, const std::string& file,
 // The text of a scene file (resolved like load_scene). Throws SceneError.
 std::string read_scene_text(const std::string& name_or_path);
 
+// The line of a field (a SceneError field path, "loads.gluteus_r.point_b") in scene file `file`,
+// or of its deepest ancestor there; 0 when the file cannot be read or parsed. For checks made
+// after reading (an assembly), so that their SceneError names the line too.
+int find_scene_field_line(const std::string& file, const std::string& field);
+
 // Whether a dotted key path (as in overrides) exists in the scene's YAML.
 bool scene_yaml_has(const std::string& yaml_text, const std::string& path);
 

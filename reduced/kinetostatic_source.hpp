@@ -28,6 +28,10 @@ struct RatioPoint {
   // Every joint's coordinate at this q (optional: empty when the source does not give it; the
   // joint-output columns p_<joint> need it) [rad or m].
   std::vector<double> joint_q;
+  // Rate of each scene point force's length per unit q̇ (dL/dq) and per unit ẋ_k (optional:
+  // empty when the source does not give them; point forces need them) [m per rad or m].
+  std::vector<double> length_wrt_q;
+  std::vector<std::vector<double>> length_wrt_x;  // [constraint force][point force]
 };
 
 // The cross-check of issue 3, route "direct": m1 = uᵀMu, me1 = u_xᵀMu, m2 = uᵀ(M b + c),

@@ -561,7 +561,7 @@ void found_later(std::vector<Case>& cs) {
   // Named drive loads (issue #14): a bad --load or validation.calibrate.load is bad input naming
   // its field, and --write-scene leaves nothing behind.
   for (const auto& [tag, load, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"unknown", "nope", "field '--load': no joint_torque or motor named 'nope'"},
+           {"unknown", "nope", "field '--load': no joint_torque, point_force or motor named 'nope'"},
            {"resistance", "flywheel_resistance", "is a resistance"},
            {"bad_name", "a\nb", "field '--load'"},
            {"generated_write", "hip_torque_r", "field '--write-scene'"},
@@ -572,7 +572,7 @@ void found_later(std::vector<Case>& cs) {
                 {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=60:70:2", "--load", "nope", "--out", "w.csv"},
                 2, "field '--load'", {}, nullptr, "w.csv"});
   cs.push_back({"calibrate_load_in_scene_unknown", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
-                "field 'validation.calibrate.load': no joint_torque or motor named 'ghost'",
+                "field 'validation.calibrate.load': no joint_torque, point_force or motor named 'ghost'",
                 {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ghost}}\n"}}, nullptr, "cal.yaml"});
   cs.push_back({"calibrate_load_in_scene_empty", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
                 "field 'validation.calibrate.load': an empty name names no load",
