@@ -669,6 +669,14 @@ LoadProfile read_profile(const Fields& parent, const std::string& key) {
   return make_table_profile(of, std::move(theta), std::move(value));
 }
 
+// A load's rate gate: active_when: {joint, rate: positive|negative} (the joint: check_scene).
+RateGate read_rate_gate(const Fields& f) {
+  Fields g(f.raw("active_when"), f.join("active_when"), f.ctx(), {"joint", "rate"});
+  const std::string rate = g.str("rate");
+  if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+  return RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
+}
+
 struct PendingDissipation {
   size_t index;
   double power_W, cadence_Hz;
@@ -701,13 +709,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       if (!f.has("profile") && !f.has("torque_Nm") && !f.has("force_N"))
         f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
       t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num_or("force_N", 1.0);
-      if (f.has("active_when")) {
-        Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
-        const std::string rate = g.str("rate");
-        if (rate != "positive" && rate != "negative")
-          g.fail("rate", "expected positive or negative");
-        t.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
-      }
+      if (f.has("active_when")) t.active_when = read_rate_gate(f);
       s.joint_torques.push_back(t);
     } else if (type == "resistance") {
       Fields f(n, path, top.ctx(), {"type", "name", "body", "law", "coefficient", "dissipates"});
@@ -754,12 +756,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       if (f.has("profile")) pf.profile = read_profile(f, "profile");
       if (!f.has("profile") && !f.has("force_N")) f.fail("force_N", "give force_N (the tension, positive pulls the points together)");
       pf.value = f.num_or("force_N", 1.0);
-      if (f.has("active_when")) {
-        Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
-        const std::string rate = g.str("rate");
-        if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
-        pf.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
-      }
+      if (f.has("active_when")) pf.active_when = read_rate_gate(f);
       s.point_forces.push_back(pf);
     } else if (type == "motor") {
       Fields f(n, path, top.ctx(),

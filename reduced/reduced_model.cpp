@@ -43,28 +43,25 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
   };
   m.rhs_cols = {m.c_m1, m.c_m2, m.c_Q};
   // The gate of a load: its index in m.gates, −1 when the load always acts.
-  auto add_gate = [&](const std::optional<models::RateGate>& gate) {
-    if (!gate) return -1;
-    const auto* active_when = &*gate;
-    {
-      ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0};
-      const auto* roots = s.roots_of("r_" + active_when->joint);
-      if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
-        // Orient the product of sines like r at the grid sample farthest from any root.
-        g.roots = *roots;
-        double best = -1, q_best = s.q[0];
-        for (double q : s.q) {
-          double d = INFINITY;
-          for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
-          if (d > best) best = d, q_best = q;
-        }
-        const double r_val = m.table.eval(g.c_r, q_best);
-        double prod = 1.0;
-        for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
-        g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
+  auto add_gate = [&](const std::optional<models::RateGate>& active_when) {
+    if (!active_when) return -1;
+    ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0};
+    const auto* roots = s.roots_of("r_" + active_when->joint);
+    if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
+      // Orient the product of sines like r at the grid sample farthest from any root.
+      g.roots = *roots;
+      double best = -1, q_best = s.q[0];
+      for (double q : s.q) {
+        double d = INFINITY;
+        for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
+        if (d > best) best = d, q_best = q;
       }
-      m.gates.push_back(std::move(g));
+      const double r_val = m.table.eval(g.c_r, q_best);
+      double prod = 1.0;
+      for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
+      g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
     }
+    m.gates.push_back(std::move(g));
     return static_cast<int>(m.gates.size()) - 1;
   };
   for (const auto& t : scene.joint_torques) {
