@@ -28,8 +28,8 @@ std::unique_ptr<Integrator> make_integrator(const FullModel::Impl& m, const std:
 // the acceleration the load would produce (switched on, it must push the right way).
 void initialize_gates(const FullModel::Impl& m, State& s) {
   const auto& sc = m.scene;
-  for (size_t i = 0; i < sc.joint_torques.size(); ++i) {
-    const auto& gate = sc.joint_torques[i].active_when;
+  for (size_t i = 0; i < num_load_slots(sc); ++i) {
+    const auto* gate = load_gate(sc, i);
     if (!gate) continue;
     const int j = sc.joint_index(gate->joint);
     m.system.realize(s, Stage::Velocity);
@@ -56,8 +56,8 @@ void record(const FullModel::Impl& m, const State& s, TimeSeries& ts) {
   ts.energy.push_back(m.system.calcEnergy(s));
   ts.work.push_back(m.work(s));
   std::uint32_t mask = 0;
-  for (size_t i = 0, g = 0; i < m.scene.joint_torques.size(); ++i)
-    if (m.scene.joint_torques[i].active_when) {
+  for (size_t i = 0, g = 0; i < num_load_slots(m.scene); ++i)
+    if (load_gate(m.scene, i)) {
       if (m.gate(s, static_cast<int>(i)) && g < 32) mask |= 1u << g;
       ++g;
     }
@@ -111,6 +111,27 @@ void check_finite_row(const TimeSeries& ts) {
   for (size_t k = 0; k < ts.forces.size(); ++k)
     check(ts.forces[k].back(), "constraint force '" + ts.force_names[k] + "'");
   for (size_t k = 0; k < ts.columns.size(); ++k) check(ts.columns[k].back(), "output '" + ts.column_names[k] + "'");
+}
+
+// A point force's line may not pass through zero length: there its direction is undefined (and
+// a muscle's attachments cannot cross). Exactly zero is caught where the force is applied; a
+// crossing between two evaluations shows as the line reversing within one step (e turning by
+// more than 90°, which no accurate step of a smooth motion does). e_prev: each line's direction
+// after the previous step.
+void check_point_force_lines(const FullModel::Impl& m, const State& s, std::vector<Vec3>& e_prev) {
+  const auto& pf = m.scene.point_forces;
+  for (size_t i = 0; i < pf.size(); ++i) {
+    const auto line = calc_point_force_line(m, s, pf[i], false);
+    if (!(line.length >= models::limits::kMinPointForceLength_m) ||
+        (e_prev.size() == pf.size() && dot(e_prev[i], line.e_G) < 0))
+      throw models::NumericalError(fmt::format(
+          "point force '{}': its points met (the line's length reached zero and its direction reversed) near t = "
+          "{:.6g} s, where the line of action has no direction; move the attachment points apart",
+          pf[i].name, s.getTime()));
+    if (e_prev.size() == pf.size()) e_prev[i] = line.e_G;
+  }
+  if (e_prev.size() != pf.size())
+    for (const auto& f : pf) e_prev.push_back(calc_point_force_line(m, s, f, false).e_G);
 }
 
 }  // namespace
@@ -180,6 +201,9 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   constexpr long kWindow = 1000;
   constexpr double kHopeless = 100.0;
   double window_t0 = 0.0;
+  std::vector<Vec3> line_dir;  // point forces' directions after the last step
+  m.system.realize(integ->getState(), Stage::Position);
+  check_point_force_lines(m, integ->getState(), line_dir);
   for (long i = 1; i <= n; ++i) {
     const double t = std::min(opt.duration_s, i * opt.output_interval_s);
     try {
@@ -187,6 +211,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
         const double t_before = integ->getTime(), q_before = m.joint_q(integ->getState(), m.independent);
         stepper.stepTo(t);
         const double h = integ->getPreviousStepSizeTaken();
+        if (!line_dir.empty()) check_point_force_lines(m, integ->getState(), line_dir);
         if (!domain.periodic) {
           const double q_now = m.joint_q(integ->getState(), m.independent);
           if (q_now < domain.min || q_now > domain.max) {
@@ -226,6 +251,13 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     } catch (const models::NumericalError&) {
       throw;
     } catch (const std::exception& e) {
+      // Simbody turns a force's refusal (a point force at zero length) into failed steps: name
+      // the point force when that is where the integrator got stuck.
+      if (!line_dir.empty()) {
+        State last = integ->getState();
+        m.system.realize(last, Stage::Position);
+        check_point_force_lines(m, last, line_dir);
+      }
       throw models::NumericalError(
           fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}", integ->getTime(),
                       integ->getPreviousStepSizeTaken(), e.what()));

@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "models/scene_yaml.hpp"
+
 namespace rdyn::engine {
 
 using namespace SimTK;
@@ -247,6 +249,21 @@ void check_branches(const FullModel::Impl& m, const State& s) {
   }
 }
 
+// Every point force has a direction where the mechanism assembles: its points are apart.
+void check_point_forces(const FullModel::Impl& m, const State& s) {
+  for (const auto& f : m.scene.point_forces) {
+    const double L = calc_point_force_line(m, s, f, false).length;
+    if (L >= models::limits::kMinPointForceLength_m) continue;
+    const std::string field = "loads." + f.name + ".point_b";
+    throw models::SceneError(
+        m.scene.source_file, m.scene.line_of(field), field,
+        fmt::format("point force '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled "
+                    "configuration (at {} = {:.6g}), closer than {:g} m: the line of action has no direction",
+                    f.name, f.body_b, L, f.body_a, m.scene.independent, m.scene.initial.q,
+                    models::limits::kMinPointForceLength_m));
+  }
+}
+
 }  // namespace
 
 void calc_mobility_count(const FullModel::Impl& m, const State& s, int& mobilities, int& rows, int& rank) {
@@ -296,6 +313,9 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     for (const auto& j : scene.joints) ok &= j.parent != body.name;
     for (const auto& l : scene.loops) ok &= l.body_a != body.name && l.body_b != body.name;
     for (const auto& sp : scene.springs) ok &= sp.body_a != body.name && sp.body_b != body.name;
+    for (const auto& pf : scene.point_forces)
+      ok &= pf.body_a != body.name && pf.body_b != body.name &&
+            (!pf.active_when || pf.active_when->joint != driven.name);
     for (const auto& t : scene.joint_torques) ok &= t.joint != driven.name && (!t.active_when || t.active_when->joint != driven.name);
     for (const auto& m : scene.motors) ok &= m.joint != driven.name;
     for (const auto& g2 : scene.gears) ok &= &g2 == &gear || (g2.driver != driven.name && g2.driven != driven.name);
@@ -520,6 +540,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   }
   check_one_dof(m, s);
   check_branches(m, s);
+  check_point_forces(m, s);
 }
 
 FullWorkspace::~FullWorkspace() = default;

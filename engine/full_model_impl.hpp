@@ -59,7 +59,8 @@ struct FullModel::Impl {
   // Indices allocated at realizeTopology (mutable: set by the const realize callbacks).
   mutable std::vector<SimTK::DiscreteVariableIndex> law_index;  // [0] independent, [1+k] slider k
   mutable SimTK::DiscreteVariableIndex load_mode_index;
-  mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;  // per joint torque (if gated)
+  // Per load slot (joint torques, then point forces: load_gate): its gate flag.
+  mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;
   mutable SimTK::ZIndex work_index;
   mutable long events_handled = 0;  // gate switches handled (forward dynamics statistics)
   mutable long near_singular_projections = 0;  // kinetostatic projections that needed 1e-9
@@ -112,6 +113,21 @@ void calc_mobility_count(const FullModel::Impl& m, const SimTK::State& s, int& m
 // The columns of reduced::joint_output_names (joint motions, reactions, shaking) at a state
 // realized to Acceleration (engine/joint_outputs.cpp).
 void calc_joint_outputs(const FullModel::Impl& m, const SimTK::State& s, std::vector<double>& out);
+
+// The rate gate of load slot k — joint torque k, then point force k − (joint torques) — or null
+// when that load always acts. Slots number the gate flags and the bits of TimeSeries::gates
+// (gated loads in slot order), the same order as the reduced model's gates.
+const models::RateGate* load_gate(const models::Scene& s, size_t k);
+inline size_t num_load_slots(const models::Scene& s) { return s.joint_torques.size() + s.point_forces.size(); }
+
+// Line of a point force at a state realized to Position (`rate` needs Velocity): the points in
+// ground [m], their distance L [m], the unit vector e from A to B, and L̇ = e·(v_B − v_A) [m/s].
+struct PointForceLine {
+  SimTK::Vec3 p_GA, p_GB, e_G;
+  double length = 0.0, rate = 0.0;
+};
+PointForceLine calc_point_force_line(const FullModel::Impl& m, const SimTK::State& s, const models::PointForce& f,
+                                     bool with_rate);
 
 // Adds the scene's loads as one custom force (engine/scene_loads.cpp).
 void add_scene_loads(FullModel::Impl& impl);

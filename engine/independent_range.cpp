@@ -98,6 +98,7 @@ double calc_length_scale(const models::Scene& s) {
   for (const auto& j : s.joints) add(j.parent_point), add(j.child_point);
   for (const auto& l : s.loops) add(l.point_a), add(l.point_b);
   for (const auto& sp : s.springs) add(sp.point_a), add(sp.point_b);
+  for (const auto& f : s.point_forces) add(f.point_a), add(f.point_b);
   // A prismatic joint's own travel is part of the size: a lone slider whose points all sit at
   // its origin would otherwise get 1 mm, and continuation over a 1 m stroke would need 2·10⁴
   // moves (over the approach budget).

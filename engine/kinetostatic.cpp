@@ -71,6 +71,22 @@ void project(const FullModel::Impl& m, State& s, double q_for_message) {
   }
 }
 
+// L̇ of every point force's line at a state realized to Velocity [m/s]. A line shorter than the
+// limit has no direction: NumericalError naming the load and q.
+std::vector<double> point_force_rates(const FullModel::Impl& m, const State& s) {
+  std::vector<double> out;
+  for (const auto& f : m.scene.point_forces) {
+    const auto line = calc_point_force_line(m, s, f, true);
+    if (!(line.length >= models::limits::kMinPointForceLength_m) || !std::isfinite(line.rate))
+      throw models::NumericalError(fmt::format("{}: point force '{}' has its points {:.3g} m apart at {} = {:.6g}: its "
+                                               "line of action has no direction there",
+                                               m.scene.source_file, f.name, line.length, m.scene.independent,
+                                               m.joint_q(s, m.independent)));
+    out.push_back(line.rate);
+  }
+  return out;
+}
+
 KinetostaticResult collect(const FullModel::Impl& m, const State& s) {
   m.system.realize(s, Stage::Acceleration);
   KinetostaticResult r;
@@ -84,6 +100,7 @@ KinetostaticResult collect(const FullModel::Impl& m, const State& s) {
     r.joint_q[j] = m.joint_q(s, static_cast<int>(j));
     r.joint_u[j] = m.joint_u(s, static_cast<int>(j));
   }
+  r.point_force_rate = point_force_rates(m, s);
   r.kinetic_energy = m.system.calcKineticEnergy(s);
   // Folded bodies: ½ r² I u² is already in the driver's inertia.
   r.potential_energy = m.system.calcPotentialEnergy(s);
@@ -175,12 +192,16 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
     for (size_t k = 0; k < nx; ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
     project(m, s, q);
     out.wrt_q = rates();
+    m.system.realize(s, Stage::Velocity);
+    out.length_wrt_q = point_force_rates(m, s);
   }
   for (size_t k = 0; k < nx && with_x; ++k) {
     m.set_law(s, 0, poly_law(q, 0.0, 0.0));
     for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, i == k ? 1.0 : 0.0, 0));
     project(m, s, q);
     out.wrt_x.push_back(rates());
+    m.system.realize(s, Stage::Velocity);
+    out.length_wrt_x.push_back(point_force_rates(m, s));
   }
   for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, 0, 0));
   return out;
@@ -303,6 +324,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   complete(u, column(ind));
   s.updU() = u;
   m.system.realize(s, Stage::Velocity);
+  if (parts == SampleParts::All) out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1
   // b = dr/dq: the accelerations of call (i) (q̇ = 1, q̈ = 0, ẍ = 0), from G b = −bias
   // (Simbody: acceleration constraint errors G u̇ + bias, bias = −Ġu at this velocity).
   Vector b(nu, 0.0);
@@ -344,6 +366,13 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       out.ratio_x.push_back(std::move(rates));
       out.me1.push_back(~rx * Mr);
       out.me2.push_back(~rx * inertial);
+      if (!m.scene.point_forces.empty()) {  // L̇ at ẋ_k = 1 (the state's velocities are not used again)
+        s.updU() = rx;
+        m.system.realize(s, Stage::Velocity);
+        out.length_wrt_x.push_back(point_force_rates(m, s));
+      } else {
+        out.length_wrt_x.emplace_back();
+      }
       finite &= std::isfinite(out.me1.back()) && std::isfinite(out.me2.back());
     }
     // This point anchors the next prediction: q' = N r, q'' = N b (Ṅ = 0 for the pins and

@@ -22,6 +22,7 @@ struct KinetostaticResult {
   std::vector<double> joint_u;            // every scene joint's rate [rad/s or m/s]
   double kinetic_energy = 0.0;            // [J]
   double potential_energy = 0.0;          // gravity + springs when loads are on [J]
+  std::vector<double> point_force_rate;   // L̇ of every scene point force's line [m/s]
 };
 
 // Continues from the workspace's previous configuration (Newton projection), so sweeps
@@ -39,6 +40,9 @@ void move_configuration(const FullModel& model, FullWorkspace& ws, double q);
 struct VelocityRatios {
   std::vector<double> wrt_q;
   std::vector<std::vector<double>> wrt_x;
+  // Rate of every point force's length per unit q̇ (dL/dq) and per unit ẋ_k [m per rad or m].
+  std::vector<double> length_wrt_q;
+  std::vector<std::vector<double>> length_wrt_x;  // [k][point force]
 };
 // `with_q` / `with_x` select which parts to compute (each part is one velocity projection
 // per coordinate).
@@ -69,6 +73,8 @@ struct KinetostaticSample {
   std::vector<double> ratio_q;               // joint rates per unit q̇, x fixed [joint]
   std::vector<std::vector<double>> ratio_x;  // joint rates per unit ẋ_k, q̇ = 0 [force][joint]
   std::vector<double> ratio_slope;           // d ratio_q / dq [joint]
+  std::vector<double> length_wrt_q;          // dL/dq of every scene point force's line (SampleParts::All)
+  std::vector<std::vector<double>> length_wrt_x;  // dL/dx_k [force][point force] (SampleParts::All)
   double conditioning = 1.0;                 // as calc_loop_conditioning (SampleParts::All only)
   bool near_singular = false;                // the projection needed its fallback tolerance
 };

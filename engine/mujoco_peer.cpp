@@ -177,6 +177,15 @@ struct Run {
     const double* o = d->xpos + 3 * body;
     return {o[0] + R[0] * p.x + R[1] * p.y, o[1] + R[3] * p.x + R[4] * p.y};
   }
+  // Velocity of a world point p fixed to a body [m/s]: the body origin's velocity (MuJoCo's
+  // mj_objectVelocity, world frame) plus ω × (p − origin).
+  models::Vec2 world_velocity(int body, models::Vec2 p) const {
+    if (body == 0) return {0, 0};
+    mjtNum v[6];
+    mj_objectVelocity(model.m, d, mjOBJ_XBODY, body, v, 0);  // XBODY: at the body frame's origin (xpos)
+    const double* o = d->xpos + 3 * body;
+    return {v[3] - v[2] * (p.y - o[1]), v[4] + v[2] * (p.x - o[0])};
+  }
   // A force at a world point of a body, as MuJoCo's Cartesian perturbation at the centre of mass,
   // so that mj_rnePostConstraint counts it in cfrc_ext (and the joint reactions stay right).
   void add_point_force(int body, models::Vec2 p, models::Vec2 f) {
@@ -219,6 +228,24 @@ struct Run {
         d->xfrc_applied[6 * model.body_id[b] + 5] += T;
       }
       P += T * w;
+    }
+    // Point forces (engine/scene_loads.cpp): tension T·e on A, −T·e on B (e from A to B); power −T·L̇.
+    for (const auto& f : sc.point_forces) {
+      if (f.active_when && !(f.active_when->sign * joint_u(sc.joint_index(f.active_when->joint)) > 0.0)) continue;
+      const int a = model.body_of(f.body_a), b = model.body_of(f.body_b);
+      const auto pa = world_point(a, f.point_a), pb = world_point(b, f.point_b);
+      const double dx = pb.x - pa.x, dy = pb.y - pa.y, L = std::hypot(dx, dy);
+      if (!(L >= models::limits::kMinPointForceLength_m))
+        throw models::NumericalError(fmt::format("MuJoCo: point force '{}': its points met at t = {:.6g} s, where the "
+                                                 "line of action has no direction",
+                                                 f.name, d->time));
+      const double T =
+          models::calc_point_force_tension(f, f.profile ? joint_q(sc.joint_index(f.profile->of)) : 0.0);
+      const double ex = dx / L, ey = dy / L;
+      add_point_force(a, pa, {T * ex, T * ey});
+      add_point_force(b, pb, {-T * ex, -T * ey});
+      const auto va = world_velocity(a, pa), vb = world_velocity(b, pb);
+      P -= T * (ex * (vb.x - va.x) + ey * (vb.y - va.y));
     }
     for (const auto& sp : sc.springs) {
       const int a = model.body_of(sp.body_a), b = model.body_of(sp.body_b);
@@ -398,6 +425,11 @@ models::TimeSeries simulate_mujoco(const MujocoModel& model, const MujocoRunOpti
     for (const auto& t : im.scene.joint_torques) {
       if (!t.active_when) continue;
       if (g < 32 && t.active_when->sign * run.joint_u(im.scene.joint_index(t.active_when->joint)) > 0.0) mask |= 1u << g;
+      ++g;
+    }
+    for (const auto& f : im.scene.point_forces) {  // after the torques, as the full model's slots
+      if (!f.active_when) continue;
+      if (g < 32 && f.active_when->sign * run.joint_u(im.scene.joint_index(f.active_when->joint)) > 0.0) mask |= 1u << g;
       ++g;
     }
     ts.gates.push_back(mask);

@@ -117,7 +117,7 @@ reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_cons
   reduced::GridSample g;
   g.velocity = {k.m2, k.me2, k.ratio_q};
   g.acceleration = {k.m1, k.me1, {}};
-  g.ratios = {k.ratio_q, k.ratio_x, k.joint_q, k.ratio_slope};
+  g.ratios = {k.ratio_q, k.ratio_x, k.joint_q, k.ratio_slope, k.length_wrt_q, k.length_wrt_x};
   if (with_conservative) {
     // The static call at the same configuration (its projection only checks the loops).
     const auto c = calc_kinetostatic(model_, ws_, q, 0, 0, Loads::Conservative);
@@ -137,6 +137,7 @@ reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_cons
   const auto vel = calc_kinetostatic(model_, ws_, q, 1.0, 0.0, Loads::Off);
   g.velocity = {vel.driving_force, vel.constraint_forces, vel.joint_u};
   g.ratios.wrt_q = vel.joint_u;
+  g.ratios.length_wrt_q = vel.point_force_rate;  // L̇ at q̇ = 1: dL/dq
   // (ii) q̇ = 0, q̈ = 1.
   const auto acc = calc_kinetostatic(model_, ws_, q, 0.0, 1.0, Loads::Off);
   g.acceleration = {acc.driving_force, acc.constraint_forces, acc.joint_u};
@@ -146,7 +147,9 @@ reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_cons
   } else {
     g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
   }
-  g.ratios.wrt_x = calc_velocity_ratios(model_, ws_, q, false, true).wrt_x;
+  auto vx = calc_velocity_ratios(model_, ws_, q, false, true);
+  g.ratios.wrt_x = std::move(vx.wrt_x);
+  g.ratios.length_wrt_x = std::move(vx.length_wrt_x);
   g.ratios.joint_q = vel.joint_q;
   // Singular configuration: the loop Jacobian lost rank (or the projection needed its
   // fallback tolerance). The constraints do not determine the velocities there.
@@ -189,7 +192,7 @@ reduced::RatioPoint FullKinetostaticSource::ratios(double q) {
     const auto v = calc_velocity_ratios(model_, ws_, q);
     std::vector<double> joint_q(model_.scene().joints.size());
     for (size_t j = 0; j < joint_q.size(); ++j) joint_q[j] = model_.impl().joint_q(ws_.impl().state, static_cast<int>(j));
-    return reduced::RatioPoint{v.wrt_q, v.wrt_x, joint_q, {}};
+    return reduced::RatioPoint{v.wrt_q, v.wrt_x, joint_q, {}, v.length_wrt_q, v.length_wrt_x};
   });
 }
 

@@ -18,12 +18,26 @@ int load_mode(const FullModel::Impl& m, const State& s) {
   return Value<int>::downcast(m.forces.getDiscreteVariable(s, m.load_mode_index));
 }
 
+// Whether load slot k (joint torques, then point forces) acts now.
+bool load_active(const FullModel::Impl& m, const State& s, size_t k, int mode) {
+  const models::RateGate* g = load_gate(m.scene, k);
+  if (!g) return true;
+  if (mode == kLoadsEvents) return m.gate(s, static_cast<int>(k));
+  const double rate = m.joint_u(s, m.scene.joint_index(g->joint));
+  return g->sign * rate > 0.0;
+}
 bool torque_active(const FullModel::Impl& m, const State& s, int i, int mode) {
-  const auto& t = m.scene.joint_torques[i];
-  if (!t.active_when) return true;
-  if (mode == kLoadsEvents) return m.gate(s, i);
-  const double rate = m.joint_u(s, m.scene.joint_index(t.active_when->joint));
-  return t.active_when->sign * rate > 0.0;
+  return load_active(m, s, static_cast<size_t>(i), mode);
+}
+
+// A point force's tension now [N] and its line. Where the points meet the direction is
+// undefined: forward dynamics stops a run whose line passes through zero length
+// (engine/forward_dynamics.cpp, checked between steps, since Simbody would only retry a step
+// whose force evaluation threw); at exactly zero length e = 0 and the force vanishes.
+double point_force_tension(const FullModel::Impl& m, const State& s, const models::PointForce& f,
+                           PointForceLine& line, bool with_rate) {
+  line = calc_point_force_line(m, s, f, with_rate);
+  return models::calc_point_force_tension(f, f.profile ? m.joint_q(s, m.scene.joint_index(f.profile->of)) : 0.0);
 }
 
 // A joint torque's load now [N·m or N]: value, or value·τ(θ) of its profile's joint angle.
@@ -47,7 +61,7 @@ class SceneLoads : public Force::Custom::Implementation {
     auto& mm = const_cast<FullModel::Impl&>(m_);
     mm.load_mode_index = m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<int>(kLoadsEvents));
     mm.gate_index.clear();
-    for (size_t i = 0; i < m_.scene.joint_torques.size(); ++i)
+    for (size_t i = 0; i < num_load_slots(m_.scene); ++i)
       mm.gate_index.push_back(m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<bool>(true)));
     mm.work_index = m_.forces.allocateZ(s, Vector(1, 0.0));
   }
@@ -87,6 +101,15 @@ class SceneLoads : public Force::Custom::Implementation {
       if (torque_active(m_, s, static_cast<int>(i), mode))
         add_joint_force(m_, s, sc.joint_index(sc.joint_torques[i].joint), torque_value(m_, s, static_cast<int>(i)),
                         mobility);
+    for (size_t i = 0; i < sc.point_forces.size(); ++i) {
+      if (!load_active(m_, s, sc.joint_torques.size() + i, mode)) continue;
+      // Tension T pulls B toward A and A toward B: −T e on B, +T e on A (e from A to B).
+      const auto& f = sc.point_forces[i];
+      PointForceLine line;
+      const double T = point_force_tension(m_, s, f, line, false);
+      m_.mobod_of(f.body_a).applyForceToBodyPoint(s, v3(f.point_a), T * line.e_G, body_forces);
+      m_.mobod_of(f.body_b).applyForceToBodyPoint(s, v3(f.point_b), -T * line.e_G, body_forces);
+    }
     for (const auto& mo : sc.motors) {
       const int j = sc.joint_index(mo.joint);
       add_joint_force(m_, s, j, mo.stall_torque * (1.0 - m_.joint_u(s, j) / mo.no_load_speed), mobility);
@@ -130,7 +153,7 @@ class SceneLoads : public Force::Custom::Implementation {
 // so the discontinuous torque never sits inside a step).
 class GateSwitch : public TriggeredEventHandler {
  public:
-  GateSwitch(const FullModel::Impl& m, int torque)
+  GateSwitch(const FullModel::Impl& m, int torque)  // torque: the load slot
       : TriggeredEventHandler(Stage::Velocity), m_(m), torque_(torque) {
     getTriggerInfo().setTriggerOnRisingSignTransition(true);
     getTriggerInfo().setTriggerOnFallingSignTransition(true);
@@ -138,11 +161,11 @@ class GateSwitch : public TriggeredEventHandler {
     getTriggerInfo().setRequiredLocalizationTimeWindow(1e-9);
   }
   Real getValue(const State& s) const override {
-    const auto& gate = *m_.scene.joint_torques[torque_].active_when;
+    const auto& gate = *load_gate(m_.scene, static_cast<size_t>(torque_));
     return m_.joint_u(s, m_.scene.joint_index(gate.joint));
   }
   void handleEvent(State& s, Real, bool&) const override {
-    const auto& gate = *m_.scene.joint_torques[torque_].active_when;
+    const auto& gate = *load_gate(m_.scene, static_cast<size_t>(torque_));
     const double rate = getValue(s);
     // The state handed over is just past the crossing; at an exact zero keep toggling.
     const bool on = rate != 0.0 ? gate.sign * rate > 0.0 : !m_.gate(s, torque_);
@@ -166,6 +189,11 @@ double non_conservative_power(const FullModel::Impl& m, const State& s) {
     const int j = sc.joint_index(sc.joint_torques[i].joint);
     if (torque_active(m, s, static_cast<int>(i), mode)) P += torque_value(m, s, static_cast<int>(i)) * m.joint_u(s, j);
   }
+  for (size_t i = 0; i < sc.point_forces.size(); ++i) {
+    if (!load_active(m, s, sc.joint_torques.size() + i, mode)) continue;
+    PointForceLine line;
+    P -= point_force_tension(m, s, sc.point_forces[i], line, true) * line.rate;  // tension works against L̇
+  }
   for (const auto& mo : sc.motors) {
     const double u = m.joint_u(s, sc.joint_index(mo.joint));
     P += mo.stall_torque * (1.0 - u / mo.no_load_speed) * u;
@@ -177,11 +205,32 @@ double non_conservative_power(const FullModel::Impl& m, const State& s) {
   return P;
 }
 
+const models::RateGate* load_gate(const models::Scene& s, size_t k) {
+  const auto& g = k < s.joint_torques.size() ? s.joint_torques[k].active_when
+                                             : s.point_forces.at(k - s.joint_torques.size()).active_when;
+  return g ? &*g : nullptr;
+}
+
+PointForceLine calc_point_force_line(const FullModel::Impl& m, const State& s, const models::PointForce& f,
+                                     bool with_rate) {
+  const auto& a = m.mobod_of(f.body_a);
+  const auto& b = m.mobod_of(f.body_b);
+  PointForceLine line;
+  line.p_GA = a.findStationLocationInGround(s, v3(f.point_a));
+  line.p_GB = b.findStationLocationInGround(s, v3(f.point_b));
+  const Vec3 d = line.p_GB - line.p_GA;
+  line.length = d.norm();
+  line.e_G = line.length > 0 ? d / line.length : Vec3(0);
+  if (with_rate)
+    line.rate = dot(line.e_G, b.findStationVelocityInGround(s, v3(f.point_b)) -
+                                  a.findStationVelocityInGround(s, v3(f.point_a)));  // L̇ = e·(v_B − v_A)
+  return line;
+}
+
 void add_scene_loads(FullModel::Impl& impl) {
   Force::Custom(impl.forces, new SceneLoads(impl));
-  for (size_t i = 0; i < impl.scene.joint_torques.size(); ++i)
-    if (impl.scene.joint_torques[i].active_when)
-      impl.system.addEventHandler(new GateSwitch(impl, static_cast<int>(i)));
+  for (size_t k = 0; k < num_load_slots(impl.scene); ++k)
+    if (load_gate(impl.scene, k)) impl.system.addEventHandler(new GateSwitch(impl, static_cast<int>(k)));
 }
 
 }  // namespace rdyn::engine

@@ -109,7 +109,8 @@ class Writer {
                          num(s_.gears[g].ratio));
     c += fmt::format("Independent coordinate: joint '{}', initial q = {}, qdot = {}.\n", s_.independent,
                      num(s_.initial.q), num(s_.initial.qdot));
-    const bool any = !s_.joint_torques.empty() || !s_.resistances.empty() || !s_.motors.empty() || !s_.springs.empty();
+    const bool any = !s_.joint_torques.empty() || !s_.resistances.empty() || !s_.motors.empty() ||
+                     !s_.springs.empty() || !s_.point_forces.empty();
     if (any)
       c += "Loads MJCF cannot express, applied at every evaluation by rdyn's runner (engine/mujoco_peer.cpp)\n"
            "with the formulas of the full model (engine/scene_loads.cpp):\n";
@@ -130,6 +131,16 @@ class Writer {
       c += fmt::format("  spring '{}': {} N/m, rest length {} m, between {} [{}] and {} [{}] (xfrc_applied)\n",
                        sp.name, num(sp.stiffness_N_per_m), num(sp.rest_length_m), sp.body_a, vec3(sp.point_a),
                        sp.body_b, vec3(sp.point_b));
+    for (const auto& pf : s_.point_forces) {
+      c += fmt::format("  point_force '{}': tension {} N{} along the line between {} [{}] and {} [{}], pulling the "
+                       "points together (xfrc_applied)",
+                       pf.name, num(pf.value), pf.profile ? " x profile of joint '" + pf.profile->of + "'" : "",
+                       pf.body_a, vec3(pf.point_a), pf.body_b, vec3(pf.point_b));
+      if (pf.active_when)
+        c += fmt::format(", only while joint '{}' turns {}", pf.active_when->joint,
+                         pf.active_when->sign > 0 ? "positively" : "negatively");
+      c += "\n";
+    }
     for (const auto& f : s_.outputs.constraint_forces)
       c += fmt::format("Requested constraint force '{}': reaction of joint '{}' on its child along [{}] (child "
                        "frame).\n",
@@ -231,6 +242,9 @@ std::vector<bool> calc_foldable_gears(const Scene& s) {
     for (const auto& j : s.joints) ok &= j.parent != body->name;
     for (const auto& l : s.loops) ok &= l.body_a != body->name && l.body_b != body->name;
     for (const auto& sp : s.springs) ok &= sp.body_a != body->name && sp.body_b != body->name;
+    for (const auto& pf : s.point_forces)
+      ok &= pf.body_a != body->name && pf.body_b != body->name &&
+            (!pf.active_when || pf.active_when->joint != driven->name);
     for (const auto& t : s.joint_torques)
       ok &= t.joint != driven->name && (!t.active_when || t.active_when->joint != driven->name);
     for (const auto& m : s.motors) ok &= m.joint != driven->name;

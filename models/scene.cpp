@@ -148,14 +148,14 @@ struct Checker {
 
 // A joint torque's profile (models/load_profile.hpp): a revolute `of` joint, bounded counts,
 // finite coefficients or rows, and an applied load |value|·max|τ| within limits::kMaxForce.
-void check_profile(const Checker& c, const std::string& f, bool prismatic, const JointTorque& t) {
-  const LoadProfile& p = *t.profile;
+// `value_key` names the amplitude's key (torque_Nm, force_N), `unit` the load's unit.
+void check_profile(const Checker& c, const std::string& f, const LoadProfile& p, double value,
+                   const std::string& value_key, const char* unit) {
   const std::string pf = f + ".profile";
   const Joint* of = c.s.find_joint(p.of);
   if (!of) c.fail(pf + ".of", "unknown joint '" + printable(p.of) + "'");
   if (of->type != JointType::Revolute)
     c.fail(pf + ".of", "a profile reads the angle of a revolute joint ('" + p.of + "' is prismatic)");
-  const char* unit = prismatic ? "N" : "N·m";
   if (!p.is_table()) {
     if (p.a.size() > limits::kMaxProfileHarmonics || p.b.size() > limits::kMaxProfileHarmonics)
       c.fail(pf + ".fourier", fmt::format("at most {} harmonics", limits::kMaxProfileHarmonics));
@@ -182,11 +182,11 @@ void check_profile(const Checker& c, const std::string& f, bool prismatic, const
                                         limits::kMinProfileSpacing_deg));
     }
   }
-  const double bound = std::abs(t.value) * calc_profile_bound(p);
+  const double bound = std::abs(value) * calc_profile_bound(p);
   if (!(bound <= limits::kMaxForce))
-    c.fail(f + (prismatic ? ".force_N" : ".torque_Nm"),
+    c.fail(f + "." + value_key,
            fmt::format("the profiled load can reach {:g} {} (|amplitude {:g}| × profile bound {:g}); at most {:g}",
-                       bound, unit, t.value, calc_profile_bound(p), limits::kMaxForce));
+                       bound, unit, value, calc_profile_bound(p), limits::kMaxForce));
 }
 
 }  // namespace
@@ -206,7 +206,8 @@ void check_scene(const Scene& s) {
   c.count("loops", s.loops.size());
   c.count("gears", s.gears.size());
   c.count("loads",
-          s.joint_torques.size() + s.resistances.size() + s.springs.size() + s.motors.size());
+          s.joint_torques.size() + s.resistances.size() + s.springs.size() + s.motors.size() +
+              s.point_forces.size());
   c.count("outputs.constraint_forces", s.outputs.constraint_forces.size());
   c.count("outputs.bodies", s.outputs.bodies.size());
   c.count("validation.thresholds", s.validation.thresholds.size());
@@ -232,6 +233,7 @@ void check_scene(const Scene& s) {
     for (const auto& r : s.resistances) load_names.push_back(r.name);
     for (const auto& sp : s.springs) load_names.push_back(sp.name);
     for (const auto& m : s.motors) load_names.push_back(m.name);
+    for (const auto& pf : s.point_forces) load_names.push_back(pf.name);
     for (const auto& n : load_names) c.name("loads", n, names);
   }
   names.clear();
@@ -332,7 +334,23 @@ void check_scene(const Scene& s) {
     c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce,
                   prismatic ? "N" : "N·m");
     if (t.active_when) check_joint_ref(f + ".active_when.joint", t.active_when->joint);
-    if (t.profile) check_profile(c, f, prismatic, t);
+    if (t.profile)
+      check_profile(c, f, *t.profile, t.value, prismatic ? "force_N" : "torque_Nm", prismatic ? "N" : "N·m");
+  }
+  for (const auto& pf : s.point_forces) {
+    // Coincident points in the assembled configuration (no direction) are the engine's check:
+    // only an assembly knows where the points are (engine/full_model.cpp).
+    const std::string f = "loads." + pf.name;
+    if (!is_body_or_ground(pf.body_a)) fail(f + ".body_a", "unknown body '" + printable(pf.body_a) + "'");
+    if (!is_body_or_ground(pf.body_b)) fail(f + ".body_b", "unknown body '" + printable(pf.body_b) + "'");
+    if (pf.body_a == pf.body_b)
+      fail(f + ".body_b", "a point force between two points of one body ('" + pf.body_a +
+                              "') keeps its length and does nothing: give two different bodies");
+    c.point(f + ".point_a", pf.point_a);
+    c.point(f + ".point_b", pf.point_b);
+    c.abs_at_most(f + ".force_N", pf.value, limits::kMaxForce, "N");
+    if (pf.active_when) check_joint_ref(f + ".active_when.joint", pf.active_when->joint);
+    if (pf.profile) check_profile(c, f, *pf.profile, pf.value, "force_N", "N");
   }
   for (const auto& r : s.resistances) {
     const std::string f = "loads." + r.name;

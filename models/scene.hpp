@@ -84,6 +84,9 @@ inline constexpr double kMaxReferenceTolerance = 1e-3;  // validation.reference_
 inline constexpr double kMinGrid_deg = 0.05, kMaxGrid_deg = 90.0;
 inline constexpr double kMaxCadence_Hz = 20.0;  // dissipates / calibrate cadence
 inline constexpr double kMaxPower_W = 1e5;
+// A point force's line shorter than this has no direction: refused at assembly (SceneError),
+// a run that reaches it stops (NumericalError). 1 µm, far below any muscle or cable.
+inline constexpr double kMinPointForceLength_m = 1e-6;
 }  // namespace limits
 
 // Whether `name` matches [A-Za-z_][A-Za-z0-9_-]{0,63}.
@@ -166,6 +169,25 @@ struct JointTorque {  // torque on a revolute joint, force on a prismatic one
 // (ignored without a profile): value·τ(θ) or value.
 inline double calc_joint_torque(const JointTorque& t, double theta_of) {
   return t.profile ? t.value * calc_profile(*t.profile, theta_of) : t.value;
+}
+
+// Force between two points, a muscle-like actuator: a tension along the current line from
+// point_a (on body_a) to point_b (on body_b), equal and opposite at the two points; positive
+// pulls the points together. With a profile the tension is value·τ(θ_of), else value.
+struct PointForce {
+  std::string name;
+  std::string body_a;  // a body or ground
+  Vec2 point_a;        // [m] in body_a's frame
+  std::string body_b;
+  Vec2 point_b;
+  double value = 0.0;  // tension [N] (with a profile: amplitude multiplier, 1 unless given)
+  std::optional<RateGate> active_when;
+  std::optional<LoadProfile> profile;
+};
+// The tension a point force applies now [N], given the angle of its profile's joint (ignored
+// without a profile): value·τ(θ) or value.
+inline double calc_point_force_tension(const PointForce& f, double theta_of) {
+  return f.profile ? f.value * calc_profile(*f.profile, theta_of) : f.value;
 }
 
 // Resistance torque on a body that turns at a fixed ratio to the independent coordinate
@@ -294,6 +316,7 @@ struct Scene {
   std::vector<Resistance> resistances;
   std::vector<Spring> springs;
   std::vector<Motor> motors;
+  std::vector<PointForce> point_forces;
   Gravity gravity;
   Outputs outputs;
   Initial initial;
@@ -302,7 +325,7 @@ struct Scene {
 
   // Lines (1-based) of the keys whose checks need the assembled model or a table, so that their
   // refusals name the line too: "independent_range" (or _deg), "initial", "loops.<name>.branch",
-  // "validation.calibrate.load", "outputs.reactions". Filled by the YAML reader; where the key
+  // "validation.calibrate.load", "outputs.reactions", "loads.<point force>.point_b". Filled by the YAML reader; where the key
   // came from, not part of the description (not hashed, not written back).
   std::map<std::string, int> key_lines;
 

@@ -37,6 +37,14 @@ class Canon {
   std::string text_;
 };
 
+// A load profile's shape (what extraction tabulates as tau_<load>).
+void put_profile(Canon& c, const LoadProfile& p) {
+  c.str("profile_of", p.of).num("a0", p.a0);
+  for (double v : p.a) c.num("a", v);
+  for (double v : p.b) c.num("b", v);
+  for (size_t i = 0; i < p.table_theta_rad.size(); ++i) c.num("row_deg", p.table_theta_rad[i]).num("row", p.table_value[i]);
+}
+
 }  // namespace
 
 std::string canonical_scene_text(const Scene& s) {
@@ -78,12 +86,18 @@ std::string canonical_scene_text(const Scene& s) {
   for (const auto& t : s.joint_torques) {
     c.str("joint", t.joint).integer("gated", t.active_when ? 1 : 0);
     if (t.active_when) c.str("gate_joint", t.active_when->joint).integer("gate_sign", t.active_when->sign);
-    if (t.profile) {  // its shape is tabulated (the amplitude, t.value, is not)
-      const auto& p = *t.profile;
-      c.str("profile_of", p.of).num("a0", p.a0);
-      for (double v : p.a) c.num("a", v);
-      for (double v : p.b) c.num("b", v);
-      for (size_t i = 0; i < p.table_theta_rad.size(); ++i) c.num("row_deg", p.table_theta_rad[i]).num("row", p.table_value[i]);
+    if (t.profile) put_profile(c, *t.profile);  // its shape is tabulated (the amplitude, t.value, is not)
+  }
+  // Only when present, so the hashes of scenes without point forces stay what they were. The
+  // geometry, gate and profile shape are tabulated (Qpf_/tau_ columns); the tension, pf.value,
+  // is not, so a calibration rescales it without re-extraction.
+  if (!s.point_forces.empty()) {
+    c.open("point_forces", s.point_forces.size());
+    for (const auto& pf : s.point_forces) {
+      c.str("name", pf.name).str("a", pf.body_a).vec("pa", pf.point_a).str("b", pf.body_b).vec("pb", pf.point_b);
+      c.integer("gated", pf.active_when ? 1 : 0);
+      if (pf.active_when) c.str("gate_joint", pf.active_when->joint).integer("gate_sign", pf.active_when->sign);
+      if (pf.profile) put_profile(c, *pf.profile);
     }
   }
   c.open("motors", s.motors.size());

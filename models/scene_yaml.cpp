@@ -690,6 +690,14 @@ LoadProfile read_profile(const Fields& parent, const std::string& key) {
   return make_table_profile(of, std::move(theta), std::move(value));
 }
 
+// A load's rate gate: active_when: {joint, rate: positive|negative} (the joint: check_scene).
+RateGate read_rate_gate(const Fields& f) {
+  Fields g(f.raw("active_when"), f.join("active_when"), f.ctx(), {"joint", "rate"});
+  const std::string rate = g.str("rate");
+  if (rate != "positive" && rate != "negative") g.fail("rate", "expected positive or negative");
+  return RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
+}
+
 struct PendingDissipation {
   size_t index;
   double power_W, cadence_Hz;
@@ -722,13 +730,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       if (!f.has("profile") && !f.has("torque_Nm") && !f.has("force_N"))
         f.fail("torque_Nm", "give torque_Nm (revolute) or force_N (prismatic)");
       t.value = f.has("torque_Nm") ? f.num("torque_Nm") : f.num_or("force_N", 1.0);
-      if (f.has("active_when")) {
-        Fields g(f.raw("active_when"), f.join("active_when"), top.ctx(), {"joint", "rate"});
-        const std::string rate = g.str("rate");
-        if (rate != "positive" && rate != "negative")
-          g.fail("rate", "expected positive or negative");
-        t.active_when = RateGate{g.str("joint"), rate == "positive" ? +1 : -1};
-      }
+      if (f.has("active_when")) t.active_when = read_rate_gate(f);
       s.joint_torques.push_back(t);
     } else if (type == "resistance") {
       Fields f(n, path, top.ctx(), {"type", "name", "body", "law", "coefficient", "dissipates"});
@@ -760,6 +762,24 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       sp.stiffness_N_per_m = f.num("stiffness_N_per_m");
       sp.rest_length_m = f.num("rest_length_m");
       s.springs.push_back(sp);
+    } else if (type == "point_force") {
+      // A muscle-like tension between two points; force_N is an amplitude with a profile.
+      Fields f(n, path, top.ctx(),
+               {"type", "name", "body_a", "point_a", "body_b", "point_b", "force_N", "active_when", "profile"});
+      PointForce pf;
+      pf.name = name;
+      pf.body_a = f.str("body_a");
+      pf.body_b = f.str("body_b");
+      for (const auto& [key, body] : {std::pair{"body_a", pf.body_a}, std::pair{"body_b", pf.body_b}})
+        if (body != kGround && !s.find_body(body)) f.fail(key, "unknown body '" + body + "'");
+      pf.point_a = read_point(f, "point_a", pf.body_a, s);
+      pf.point_b = read_point(f, "point_b", pf.body_b, s);
+      s.key_lines["loads." + pf.name + ".point_b"] = line_of(f.raw("point_b"));  // checked at assembly
+      if (f.has("profile")) pf.profile = read_profile(f, "profile");
+      if (!f.has("profile") && !f.has("force_N")) f.fail("force_N", "give force_N (the tension, positive pulls the points together)");
+      pf.value = f.num_or("force_N", 1.0);
+      if (f.has("active_when")) pf.active_when = read_rate_gate(f);
+      s.point_forces.push_back(pf);
     } else if (type == "motor") {
       Fields f(n, path, top.ctx(),
                {"type", "name", "joint", "stall_torque_Nm", "stall_force_N", "no_load_speed_rad_s",
@@ -772,7 +792,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
     } else {
       throw SceneError(
           top.file(), line_of(n["type"]), path + ".type",
-          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor)");
+          "unknown load type '" + type + "' (joint_torque, resistance, spring, motor, point_force)");
     }
   });
 }

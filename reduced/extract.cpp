@@ -274,8 +274,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   // w and wx per resistance) and refuse before allocating.
   long profiled = 0;  // joint torques with a profile: one tau_<load> column each
   for (const auto& t : scene.joint_torques) profiled += t.profile ? 1 : 0;
+  for (const auto& f : scene.point_forces) profiled += f.profile ? 1 : 0;
+  const long npf = static_cast<long>(scene.point_forces.size());  // Qpf_ and Qxpf_ columns each
   const long cols = 4 + 3L * nk + nj + static_cast<long>(nk) * nj + static_cast<long>(scene.resistances.size()) * (1 + nk) +
-                    profiled + (wants_joint_outputs(scene) ? 2L * nj : 0L);  // p_, k_ (reduced/joint_outputs.hpp)
+                    profiled + npf * (1 + nk) + (wants_joint_outputs(scene) ? 2L * nj : 0L);  // p_, k_ (reduced/joint_outputs.hpp)
   if (cols + 1 > kMaxTableColumns || (cols + 1) * n > kMaxTableValues)
     throw TableError(fmt::format("a {:g}° table of this scene would have {} points × {} columns, more than the limits "
                                  "of {} columns and {} values: use a coarser grid or request fewer constraint forces",
@@ -306,6 +308,9 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   std::vector<std::vector<std::vector<double>>> rx(nk, r);
   std::vector<std::vector<double>> slope = r;  // d r_j/dq, when every sample gives it
   bool slopes = true;
+  // Point forces: the rate of each line's length per unit q̇ and per unit ẋ_k (dL/dq, dL/dx_k).
+  std::vector<std::vector<double>> Lq(npf, std::vector<double>(n));
+  std::vector<std::vector<std::vector<double>>> Lx(nk, Lq);
 
   // Inertial parameters.
   if (opt.method == Method::PaperSweep) {
@@ -350,21 +355,24 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   std::vector<std::vector<double>> p(joint_outputs ? nj : 0, std::vector<double>(n));
   // Joints gating loads: their ratio's zeros are the switch angles (refined during the sweep).
   std::vector<int> gate_joints;
-  for (const auto& t : scene.joint_torques)
-    if (t.active_when) {
-      const int j = scene.joint_index(t.active_when->joint);
-      if (std::find(gate_joints.begin(), gate_joints.end(), j) == gate_joints.end()) gate_joints.push_back(j);
-    }
+  auto add_gate_joint = [&](const std::optional<models::RateGate>& g) {
+    if (!g) return;
+    const int j = scene.joint_index(g->joint);
+    if (std::find(gate_joints.begin(), gate_joints.end(), j) == gate_joints.end()) gate_joints.push_back(j);
+  };
+  for (const auto& t : scene.joint_torques) add_gate_joint(t.active_when);
+  for (const auto& f : scene.point_forces) add_gate_joint(f.active_when);
   std::vector<std::vector<double>> gate_roots(gate_joints.size());
   // Joints whose angle a profiled load reads: their coordinate along the grid.
   std::vector<int> profile_joints;
-  for (const auto& t : scene.joint_torques)
-    if (t.profile) {
-      const int j = scene.joint_index(t.profile->of);
-      if (j < 0) throw TableError("profile of load '" + t.name + "' reads unknown joint '" + t.profile->of + "'");
-      if (std::find(profile_joints.begin(), profile_joints.end(), j) == profile_joints.end())
-        profile_joints.push_back(j);
-    }
+  auto add_profile_joint = [&](const std::string& load, const std::optional<models::LoadProfile>& p) {
+    if (!p) return;
+    const int j = scene.joint_index(p->of);
+    if (j < 0) throw TableError("profile of load '" + load + "' reads unknown joint '" + p->of + "'");
+    if (std::find(profile_joints.begin(), profile_joints.end(), j) == profile_joints.end()) profile_joints.push_back(j);
+  };
+  for (const auto& t : scene.joint_torques) add_profile_joint(t.name, t.profile);
+  for (const auto& f : scene.point_forces) add_profile_joint(f.name, f.profile);
   std::vector<std::vector<double>> theta(profile_joints.size(), std::vector<double>(n));
   auto bracket = [&](size_t g, long i0, long i1, double x1_offset) {
     // Sign change of gate joint g between samples i0 and i1 (i1 may wrap to 0 + 2π).
@@ -409,6 +417,15 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       r[j][i] = g.ratios.wrt_q[j];
       if (slopes) slope[j][i] = g.ratios.wrt_q_slope[j];
       for (int k = 0; k < nk; ++k) rx[k][j][i] = g.ratios.wrt_x[k][j];
+    }
+    if (npf > 0) {
+      if (static_cast<long>(g.ratios.length_wrt_q.size()) != npf || static_cast<int>(g.ratios.length_wrt_x.size()) != nk)
+        throw TableError("this kinetostatic source does not give the length rates of point forces, which the "
+                         "reduced model needs for them");
+      for (long f = 0; f < npf; ++f) {
+        Lq[f][i] = g.ratios.length_wrt_q[f];
+        for (int k = 0; k < nk; ++k) Lx[k][f][i] = g.ratios.length_wrt_x[k].at(f);
+      }
     }
     singular[i] = g.singular;
     for (size_t p = 0; p < profile_joints.size(); ++p) {
@@ -458,6 +475,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       repair(r[j]);
       for (int k = 0; k < nk; ++k) repair(rx[k][j]);
     }
+    for (long f = 0; f < npf; ++f) {
+      repair(Lq[f]);
+      for (int k = 0; k < nk; ++k) repair(Lx[k][f]);
+    }
   }
 
   s.add("m1", m1);
@@ -483,6 +504,27 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
       for (long i = 0; i < n; ++i) tau[i] = models::calc_profile(*t.profile, theta[pj][i]);
       s.add("tau_" + t.name, tau);
     }
+  // Point forces: generalized force per unit tension by virtual power. A tension T pulling the
+  // points together does power −T·L̇ = −T·(dL/dq)·q̇, so Q = −T·dL/dq on q and −T·dL/dx_k along
+  // x_k (docs/theory.md §3); with a profile, T = value·τ(θ_of(q)) (tau_<load> as for torques).
+  for (long f = 0; f < npf; ++f) {
+    const auto& pf = scene.point_forces[f];
+    std::vector<double> Q1(n);
+    for (long i = 0; i < n; ++i) Q1[i] = -Lq[f][i];
+    s.add("Qpf_" + pf.name, Q1);
+    for (int k = 0; k < nk; ++k) {
+      std::vector<double> Qk(n);
+      for (long i = 0; i < n; ++i) Qk[i] = -Lx[k][f][i];
+      s.add("Qxpf_" + forces[k].name + "_" + pf.name, Qk);
+    }
+    if (pf.profile) {
+      const auto pj = std::find(profile_joints.begin(), profile_joints.end(), scene.joint_index(pf.profile->of)) -
+                      profile_joints.begin();
+      std::vector<double> tau(n);
+      for (long i = 0; i < n; ++i) tau[i] = models::calc_profile(*pf.profile, theta[pj][i]);
+      s.add("tau_" + pf.name, tau);
+    }
+  }
   // Switch angles of rate-gated loads: the zeros located during the sweep.
   for (size_t gj = 0; gj < gate_joints.size(); ++gj) {
     auto roots = gate_roots[gj];

@@ -45,11 +45,13 @@ std::pair<std::string, int> loop_balance_body(const models::Scene& s, const mode
     for (const auto& j : s.joints)
       if ((j.child == body || j.parent == body) && j.type != models::JointType::Revolute) ok = false;
     for (const auto& sp : s.springs) ok &= sp.body_a != body && sp.body_b != body;
+    for (const auto& pf : s.point_forces) ok &= pf.body_a != body && pf.body_b != body;
     for (const auto& o : s.loops) ok &= &o == &l || (o.body_a != body && o.body_b != body);
     if (ok) return {body, sign};
   }
   throw TableError(fmt::format("{}: the reduced model cannot give the reaction of loop '{}': neither of its bodies "
-                               "hangs from revolute joints only, free of springs and other loops (use --model full)",
+                               "hangs from revolute joints only, free of springs, point forces and other loops (use "
+                               "--model full)",
                                models::where(s, "outputs.reactions"), l.name));
 }
 
@@ -76,6 +78,8 @@ void check_prismatic_balance(const models::Scene& s, const models::Joint& jt) {
     if (sp.body_a == c || sp.body_b == c) refuse("carries spring '" + sp.name + "'");
   for (const auto& r : s.resistances)
     if (r.body == c) refuse("carries resistance '" + r.name + "'");
+  for (const auto& pf : s.point_forces)
+    if (pf.body_a == c || pf.body_b == c) refuse("carries point force '" + pf.name + "'");
   for (const auto& l : s.loops)
     if ((l.body_a == c || l.body_b == c) && loop_balance_body(s, l).first == c)
       refuse("is the only body that can balance loop '" + l.name + "'");

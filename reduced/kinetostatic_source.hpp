@@ -32,6 +32,10 @@ struct RatioPoint {
   // d(wrt_q)/dq per joint (optional: empty when the source does not give it; root finding of
   // switch angles then uses Brent's method on `ratio`) [rad/rad², m/m² …].
   std::vector<double> wrt_q_slope;
+  // Rate of each scene point force's length per unit q̇ (dL/dq) and per unit ẋ_k (optional:
+  // empty when the source does not give them; point forces need them) [m per rad or m].
+  std::vector<double> length_wrt_q;
+  std::vector<std::vector<double>> length_wrt_x;  // [constraint force][point force]
 };
 
 // The cross-check of issue 3, route "direct": m1 = uᵀMu, me1 = u_xᵀMu, m2 = uᵀ(M b + c),

@@ -42,28 +42,31 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     return c;
   };
   m.rhs_cols = {m.c_m1, m.c_m2, m.c_Q};
+  // The gate of a load: its index in m.gates, −1 when the load always acts.
+  auto add_gate = [&](const std::optional<models::RateGate>& active_when) {
+    if (!active_when) return -1;
+    ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0};
+    const auto* roots = s.roots_of("r_" + active_when->joint);
+    if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
+      // Orient the product of sines like r at the grid sample farthest from any root.
+      g.roots = *roots;
+      double best = -1, q_best = s.q[0];
+      for (double q : s.q) {
+        double d = INFINITY;
+        for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
+        if (d > best) best = d, q_best = q;
+      }
+      const double r_val = m.table.eval(g.c_r, q_best);
+      double prod = 1.0;
+      for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
+      g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
+    }
+    m.gates.push_back(std::move(g));
+    return static_cast<int>(m.gates.size()) - 1;
+  };
   for (const auto& t : scene.joint_torques) {
     ReducedModel::Torque tq{t.value, s.require("r_" + t.joint), rx_cols("rx_", t.joint), -1};
-    if (t.active_when) {
-      tq.gate = static_cast<int>(m.gates.size());
-      ReducedModel::Gate g{s.require("r_" + t.active_when->joint), t.active_when->sign, {}, 1.0};
-      const auto* roots = s.roots_of("r_" + t.active_when->joint);
-      if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
-        // Orient the product of sines like r at the grid sample farthest from any root.
-        g.roots = *roots;
-        double best = -1, q_best = s.q[0];
-        for (double q : s.q) {
-          double d = INFINITY;
-          for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
-          if (d > best) best = d, q_best = q;
-        }
-        const double r_val = m.table.eval(g.c_r, q_best);
-        double prod = 1.0;
-        for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
-        g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
-      }
-      m.gates.push_back(std::move(g));
-    }
+    tq.gate = add_gate(t.active_when);
     if (t.profile) tq.c_tau = s.require("tau_" + t.name);
     m.torques.push_back(tq);
     m.rhs_cols.push_back(tq.c_r);
@@ -77,6 +80,15 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     m.brakes.push_back({r.law, r.coefficient, s.require("w_" + r.body), rx_cols("wx_", r.body)});
     m.rhs_cols.push_back(m.brakes.back().c_w);
   }
+  for (const auto& f : scene.point_forces) {
+    std::vector<int> cx;
+    for (const auto& c : scene.outputs.constraint_forces) cx.push_back(s.require("Qxpf_" + c.name + "_" + f.name));
+    ReducedModel::Torque pf{f.value, s.require("Qpf_" + f.name), cx, add_gate(f.active_when)};
+    if (f.profile) pf.c_tau = s.require("tau_" + f.name);
+    m.point_forces.push_back(pf);
+    m.rhs_cols.push_back(pf.c_r);
+    if (pf.c_tau >= 0) m.rhs_cols.push_back(pf.c_tau);
+  }
   m.out_cols = {m.c_m1, m.c_V};
   for (size_t k = 0; k < m.c_me1.size(); ++k) {
     m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
@@ -86,6 +98,10 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     }
     for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
     for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
+    for (const auto& f : m.point_forces) {
+      m.out_cols.push_back(f.c_rx[k]);
+      if (f.c_tau >= 0) m.out_cols.push_back(f.c_tau);
+    }
   }
   // The interpolated reduced inertia must stay positive (Eksergian divides by it); a coarse
   // grid over a sharp inertia peak can undershoot.
@@ -137,6 +153,11 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
   for (const auto& b : m.brakes) {
     F_nc += models::resistance_torque(b.law, b.coefficient, *r * qdot) * *r;
     ++r;
+  }
+  for (const auto& f : m.point_forces) {  // T·[τ]·(−dL/dq), the Qpf column next to its tau
+    const double tau = f.c_tau >= 0 ? r[1] : 1.0;
+    if (f.gate < 0 || ws.gate_on[f.gate]) F_nc += f.value * tau * *r;
+    r += f.c_tau >= 0 ? 2 : 1;
   }
   // Eksergian: m1 q̈ + m2 q̇² = Q_cons + F_nc
   qddot = (v[2] + F_nc - m2 * qdot * qdot) / m1;
@@ -217,6 +238,11 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
     for (const auto& b : m.brakes) {
       Qx += models::resistance_torque(b.law, b.coefficient, c[0] * qdot) * c[1];
       c += 2;
+    }
+    for (const auto& f : m.point_forces) {
+      const double tau = f.c_tau >= 0 ? c[1] : 1.0;
+      if (f.gate < 0 || ws.gate_on[f.gate]) Qx += f.value * tau * *c;
+      c += f.c_tau >= 0 ? 2 : 1;
     }
     forces[k] = me1 * qddot + me2 * qdot * qdot - Qx;  // me1 q̈ + me2 q̇² = F_E + Q_x
   }

@@ -5,6 +5,7 @@
 //   constraint line:  me1_k(q) q̈ + me2_k(q) q̇² = F*_x,k = F_E,k + Q_x,k(loads)
 //
 // F* = Q_cons(q) + Σ torques T·[τ(q)]·r_j(q)·[gate] + Σ motors τ(r_j q̇)·r_j + Σ brakes T(w_b q̇)·w_b
+//      + Σ point forces T·[τ(q)]·(−dL/dq)·[gate]
 // (virtual power), and likewise Q_x,k with the ratios along x_k.
 #pragma once
 
@@ -55,16 +56,21 @@ struct ReducedModel {
     int c_w = -1;
     std::vector<int> c_wx;
   };
-  std::vector<Gate> gates;
+  std::vector<Gate> gates;  // gated joint torques, then gated point forces (the full model's slot order)
   std::vector<Torque> torques;
+  // Point forces, as torques whose "ratio" is the generalized force per unit tension: c_r the
+  // column Qpf_<load> (−dL/dq), c_rx the Qxpf_<k>_<load> columns; value the tension [N] (no
+  // runtime drive command changes it; calibration sets it here).
+  std::vector<Torque> point_forces;
   std::vector<Motor> motors;
   std::vector<Brake> brakes;
 
   // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r
-  // (and its tau when profiled), each motor's r, each brake's w.
+  // (and its tau when profiled), each motor's r, each brake's w, each point force's Qpf (and tau).
   std::vector<int> rhs_cols;
   // Columns the outputs need (one fused lookup): m1, V, then per constraint force k:
-  // me1, me2, Qx_cons, each torque's rx (and tau), each motor's r and rx, each brake's w and wx.
+  // me1, me2, Qx_cons, each torque's rx (and tau), each motor's r and rx, each brake's w and wx,
+  // each point force's Qxpf (and tau).
   std::vector<int> out_cols;
   std::vector<int> record_cols;  // rhs_cols then out_cols: one lookup per output sample
   // rhs_cols and record_cols packed for one fused evaluation each (table.hpp, ColumnBlock).

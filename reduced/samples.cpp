@@ -57,7 +57,7 @@ std::string token(const std::string& name) {
 // Column names a reduced table can carry (samples.hpp): fixed names and prefixed families.
 bool known_column(const std::string& n) {
   if (n == "m1" || n == "m2" || n == "Q_cons" || n == "V") return true;
-  for (const char* prefix : {"me1_", "me2_", "Qx_cons_", "rx_", "r_", "wx_", "w_", "p_", "k_", "tau_"}) {
+  for (const char* prefix : {"me1_", "me2_", "Qx_cons_", "rx_", "r_", "wx_", "w_", "p_", "k_", "tau_", "Qpf_", "Qxpf_"}) {
     const size_t len = std::char_traits<char>::length(prefix);
     if (n.size() > len && n.compare(0, len, prefix) == 0) return true;
   }
@@ -234,7 +234,7 @@ Samples parse_samples_csv(const std::string& text, const std::string& name) {
   const long header_line = ln;
   for (size_t c = 1; c < header.size(); ++c) {
     if (!known_column(header[c]))
-      fail(ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*, p_*, k_*, tau_*)",
+      fail(ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*, p_*, k_*, tau_*, Qpf_*, Qxpf_*)",
                            header[c].substr(0, 40)));
     if (s.column(header[c]) >= 0) fail(ln, "duplicate column '" + header[c].substr(0, 40) + "'");
     s.names.push_back(header[c]);

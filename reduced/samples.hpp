@@ -10,6 +10,9 @@
 //   r_<j>                  joint rate per unit q̇ (x fixed)
 //   rx_<k>_<j>             joint rate per unit ẋ_k (q̇ = 0)
 //   w_<b>, wx_<k>_<b>      body angular rate per unit q̇, per unit ẋ_k
+//   tau_<load>             a profiled load's τ(θ_of(q)) per unit amplitude
+//   Qpf_<f>, Qxpf_<k>_<f>  point force f: generalized force per unit tension on q (−dL/dq) and
+//                          along x_k (−dL/dx_k)
 #pragma once
 
 #include <cstdint>

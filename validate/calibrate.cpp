@@ -32,13 +32,28 @@ constexpr double kFullCadenceTolerance = 1e-2;
 // torque together. Each entry is applied as sign·T with T ≥ 0 the calibrated magnitude.
 struct Entry {
   bool motor = false;
-  size_t index = 0;    // into scene.joint_torques or scene.motors (same order in the reduced model)
+  size_t index = 0;    // into scene.joint_torques, scene.motors or scene.point_forces (same order in the reduced model)
   double sign = 1.0;   // the scene value's sign (a motor's: its no-load speed's)
+  bool point_force = false;  // a point force's tension (index into point_forces)
 };
 struct Selection {
   std::vector<Entry> entries;
   std::string name, kind, unit;
+  bool together = false;  // several loads, each set to sign·T: the result is the magnitude T
 };
+
+// The value of entry e in the scene / in the reduced model (its torques, motors and point
+// forces are the scene's, in order).
+double& value_of(models::Scene& s, const Entry& e) {
+  return e.motor ? s.motors[e.index].stall_torque
+                 : e.point_force ? s.point_forces[e.index].value : s.joint_torques[e.index].value;
+}
+double& value_of(reduced::ReducedModel& m, const Entry& e) {
+  return e.motor ? m.motors[e.index].stall : e.point_force ? m.point_forces[e.index].value : m.torques[e.index].value;
+}
+const std::string& name_of(const models::Scene& s, const Entry& e) {
+  return e.motor ? s.motors[e.index].name : e.point_force ? s.point_forces[e.index].name : s.joint_torques[e.index].name;
+}
 
 const char* unit_of(const models::Scene& s, const std::string& joint) {
   const auto* j = s.find_joint(joint);
@@ -55,6 +70,7 @@ Selection select_load(const models::Scene& scene, const CalibrationOptions& opt)
     std::string c;
     for (const auto& t : scene.joint_torques) c += (c.empty() ? "" : ", ") + t.name;
     for (const auto& m : scene.motors) c += (c.empty() ? "" : ", ") + m.name;
+    for (const auto& f : scene.point_forces) c += (c.empty() ? "" : ", ") + f.name;
     return c.empty() ? std::string("the scene has none") : "the scene has " + c;
   };
   Selection sel;
@@ -76,6 +92,36 @@ Selection select_load(const models::Scene& scene, const CalibrationOptions& opt)
     sel.unit = units;
     return sel;
   }
+  if (opt.load.find('+') != std::string::npos) {
+    // Several loads scaled together (a muscle on each leg): each is selected by its own name,
+    // all in one unit; each gets sign·T, the result is the magnitude T.
+    std::string rest = opt.load + "+";
+    std::string kinds;
+    for (size_t at; (at = rest.find('+')) != std::string::npos; rest.erase(0, at + 1)) {
+      CalibrationOptions one = opt;
+      one.load = rest.substr(0, at);
+      if (one.load.empty())
+        fail(opt.load_field, "'" + opt.load + "' has an empty name: give names joined by '+' (a+b)");
+      const Selection part = select_load(scene, one);
+      if (part.entries[0].motor)
+        fail(opt.load_field, "motor '" + one.load + "' is calibrated alone (its power depends on the speed): name "
+                             "joint torques or point forces with '+'");
+      for (const auto& e : sel.entries)
+        if (e.index == part.entries[0].index && e.motor == part.entries[0].motor &&
+            e.point_force == part.entries[0].point_force)
+          fail(opt.load_field, "'" + one.load + "' is named twice in '" + opt.load + "'");
+      if (!sel.unit.empty() && sel.unit != part.unit)
+        fail(opt.load_field, fmt::format("'{}' mixes units ({} and {}): loads calibrated together share one unit",
+                                         opt.load, sel.unit, part.unit));
+      sel.unit = part.unit;
+      sel.entries.push_back(part.entries[0]);
+      kinds = kinds.empty() || kinds == part.kind ? part.kind : "loads";
+    }
+    sel.name = opt.load;
+    sel.kind = kinds == "loads" ? kinds : kinds + "s";  // point_forces, joint_torques, ...
+    sel.together = true;
+    return sel;
+  }
   if (!models::is_valid_name(opt.load)) fail(opt.load_field, models::invalid_name_message(opt.load));
   sel.name = opt.load;
   for (size_t i = 0; i < scene.joint_torques.size(); ++i)
@@ -95,31 +141,38 @@ Selection select_load(const models::Scene& scene, const CalibrationOptions& opt)
       sel.kind = sel.unit == "N" ? "motor_stall_force" : "motor_stall_torque";
       return sel;
     }
+  for (size_t i = 0; i < scene.point_forces.size(); ++i)
+    if (scene.point_forces[i].name == opt.load) {
+      // Its tension [N] (the amplitude with a profile): work per revolution per newton, like a torque.
+      Entry e{false, i, scene.point_forces[i].value < 0 ? -1.0 : 1.0, true};
+      sel.entries.push_back(e);
+      sel.unit = "N";
+      sel.kind = "point_force";
+      return sel;
+    }
   for (const auto& r : scene.resistances)
     if (r.name == opt.load)
-      fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque or a "
-                           "motor (" + candidates() + "); the resistance follows from --power-w");
+      fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque, "
+                           "point_force or motor (" + candidates() + "); the resistance follows from --power-w");
   for (const auto& sp : scene.springs)
     if (sp.name == opt.load)
       fail(opt.load_field, "'" + opt.load + "' is a spring, which does no net work per revolution: calibrate adjusts "
                            "a joint_torque or a motor (" + candidates() + ")");
-  fail(opt.load_field, "no joint_torque or motor named '" + opt.load + "' (" + candidates() + ")");
+  fail(opt.load_field, "no joint_torque, point_force or motor named '" + opt.load + "' (" + candidates() + ")");
   return sel;
 }
 
 // The selected load set to magnitude T (signs kept) in a scene, and with a power the one
 // resistance's coefficient (NaN: unchanged).
 models::Scene with_load(models::Scene s, const Selection& sel, double T, double coefficient) {
-  for (const auto& e : sel.entries)
-    (e.motor ? s.motors[e.index].stall_torque : s.joint_torques[e.index].value) = e.sign * T;
+  for (const auto& e : sel.entries) value_of(s, e) = e.sign * T;
   if (std::isfinite(coefficient)) s.resistances[0].coefficient = coefficient;
   return s;
 }
 
 // The same in the reduced model (its torques and motors are the scene's, in order).
 void set_load(reduced::ReducedModel& m, const Selection& sel, double T) {
-  for (const auto& e : sel.entries)
-    (e.motor ? m.motors[e.index].stall : m.torques[e.index].value) = e.sign * T;
+  for (const auto& e : sel.entries) value_of(m, e) = e.sign * T;
 }
 
 struct Cycle {
@@ -180,7 +233,7 @@ std::string load_value_column(const models::Scene& scene, const CalibrationOptio
   const Selection sel = select_load(scene, opt);
   const bool joint = sel.kind.rfind("joint", 0) == 0;
   if (sel.unit == "N·m") return joint ? "drive_torque_Nm" : sel.kind + "_Nm";
-  if (sel.unit == "N") return sel.kind == "joint_torques" ? "drive_force_N" : sel.kind + "_N";
+  if (sel.unit == "N") return sel.kind == "joint_torques" && !sel.together ? "drive_force_N" : sel.kind + "_N";
   return "drive_load";
 }
 
@@ -246,8 +299,10 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
   const int n = 3600;
   const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
-  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0);
-  for (const auto& en : sel.entries) (en.motor ? selected_motor : selected_torque)[en.index] = 1;
+  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
+      selected_force(m.point_forces.size(), 0);
+  for (const auto& en : sel.entries)
+    (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
   double W_unit = 0.0, W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
   for (int i = 0; i < n; ++i) {
     const double q = scene.initial.q + (i + 0.5) * dq;
@@ -260,6 +315,15 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
       if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
       if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
       if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq;
+    }
+    // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
+    for (size_t k = 0; k < m.point_forces.size(); ++k) {
+      const auto& f = m.point_forces[k];
+      const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
+      const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
+      if (selected_force[k]) W_scale += std::abs(Q) * dq;
+      if (on) (selected_force[k] ? W_unit : W_other) += f.value * Q * dq;
+      if (on && !selected_force[k]) W_other_scale += std::abs(f.value * Q) * dq;
     }
     for (size_t k = 0; k < m.motors.size(); ++k) {
       const auto& mo = m.motors[k];
@@ -334,8 +398,8 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   }
   progress.note("");
   const double sign = sel.entries[0].sign;
-  r.load_value = sel.kind == "joint_torques" ? T : sign * T;
-  r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;
+  r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
+  r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
   set_load(m, sel, T);
   const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
   if (!cy.ok)
@@ -430,7 +494,9 @@ namespace {
 // The YAML key holding the value of load entry `e` (empty: not a key of the text, i.e. made
 // by the bicycle_leg generator).
 std::string value_key(const std::string& text, const models::Scene& scene, const Entry& e) {
-  const std::string base = "loads." + (e.motor ? scene.motors[e.index].name : scene.joint_torques[e.index].name) + ".";
+  const std::string base = "loads." + name_of(scene, e) + ".";
+  // A point force listed in the text: force_N (created when a profiled one leaves it at 1).
+  if (e.point_force) return models::scene_yaml_has(text, base + "type") ? base + "force_N" : "";
   for (const char* k : e.motor ? std::vector<const char*>{"stall_torque_Nm", "stall_force_N"}
                                : std::vector<const char*>{"torque_Nm", "force_N"})
     if (models::scene_yaml_has(text, base + k)) return base + k;

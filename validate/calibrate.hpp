@@ -19,7 +19,7 @@ namespace rdyn::validate {
 struct CalibrationOptions {
   double cadence_hz = 1.0;  // target mean rate of q [rev/s]
   double power_w = 0.0;     // 0: mean speed only (resistances as given); > 0: the resistance dissipates it at F
-  std::string load;         // a joint_torque or motor name; empty: every joint torque together
+  std::string load;         // a joint_torque, point_force or motor name, or names joined by '+'; empty: every joint torque together
   std::string load_field = "--load";  // where `load` came from (named in refusals)
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
@@ -29,7 +29,8 @@ struct CalibrationOptions {
 
 struct CalibrationResult {
   std::string load;       // the load's name; every joint torque: their names joined by '+'
-  std::string load_kind;  // joint_torque | joint_force | motor_stall_torque | motor_stall_force | joint_torques
+  std::string load_kind;  // joint_torque | joint_force | point_force | motor_stall_torque | motor_stall_force |
+                          // joint_torques; '+' lists: point_forces | joint_torques | loads
   std::string load_unit;  // N·m or N
   double load_value = 0.0;  // calibrated value, signed (joint_torques: the magnitude each gets, signs kept)
   double torque_Nm = 0.0;   // = |load_value| for joint torques on revolute joints, NaN for other kinds

@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
       "full multibody model (Simbody).\n"
-      "A SCENE is a shipped scene name (bicycle, bicycle-profile, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
+      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
   app.require_subcommand(1);
 
   SimulateArgs sim;
@@ -104,8 +104,8 @@ int main(int argc, char** argv) {
   const CLI::Validator names_a_load(
       [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
   calibrate->add_option("--load", cal.load,
-                        "The joint_torque or motor to adjust (default: the scene's validation.calibrate.load, else "
-                        "every joint torque together)")
+                        "The joint_torque, point_force or motor to adjust, or joint torques or point forces joined "
+                        "by + (default: the scene's validation.calibrate.load, else every joint torque together)")
       ->check(names_a_load);
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
   calibrate->add_flag("--force", cal.force, kForceHelpFile);

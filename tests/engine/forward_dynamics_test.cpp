@@ -366,5 +366,84 @@ TEST(ForwardDynamicsRange, ARunInsideTheRangeReversesAndKeepsItsEnergyBalance) {
   EXPECT_GT(ts.stats.events, 5);  // the friction gates switch at the reversals
 }
 
+// Energy balance with a point force: its work W(t) (the integral of −T·L̇) must equal the change
+// of kinetic energy (nothing else acts), and for a constant tension also the closed form
+// −T (L(t) − L(0)) from the crank angle alone.
+TEST(ForwardDynamicsPointForce, WorkOfAConstantTensionIsItsClosedFormAndTheEnergyChange) {
+  const double T = 20.0;
+  const auto scene = models::parse_scene(test::pulled_crank_yaml(T), "pulled.yaml");
+  FullModel model(scene);
+  ForwardOptions opt;
+  opt.duration_s = 2.0;
+  opt.output_interval_s = 0.01;
+  opt.tolerance = 1e-10;
+  const auto ts = simulate_full(model, opt);
+  double residual = 0, closed = 0, kinetic_scale = 0;
+  const double L0 = test::pulled_crank_length(ts.q[0]);
+  for (size_t i = 0; i < ts.t.size(); ++i) {
+    residual = std::max(residual, std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]));
+    closed = std::max(closed, std::abs(ts.work[i] + T * (test::pulled_crank_length(ts.q[i]) - L0)));
+    kinetic_scale = std::max(kinetic_scale, std::abs(ts.energy[i]));
+  }
+  EXPECT_GT(max_abs(ts.work), 0.5) << "the tension must do work";
+  EXPECT_LT(residual, 1e-7 * kinetic_scale);
+  EXPECT_LT(closed, 1e-7 * kinetic_scale);
+}
+
+// A profiled, gated point force on the four-bar (ground to coupler, reading the rocker's angle,
+// on while the crank turns forward) with the bearing: the energy balance closes and the gate
+// switches as events.
+TEST(ForwardDynamicsPointForce, EnergyBalanceClosesWithAProfiledGatedPointForce) {
+  const auto scene = models::parse_scene(
+      test::fourbar_with_loads("  - {type: point_force, name: m, body_a: ground, point_a: [0.1, 0.35], body_b: coupler,\n"
+                               "     point_b: [0.2, 0.03], force_N: 6, active_when: {joint: rocker, rate: negative},\n"
+                               "     profile: {of: rocker, fourier: {a0: 1, a: [0.4], b: [0.2]}}}\n",
+                               "0.05"),
+      "muscle.yaml");
+  FullModel model(scene);
+  ForwardOptions opt;
+  opt.duration_s = 3.0;
+  opt.output_interval_s = 0.01;
+  opt.tolerance = 1e-9;
+  const auto ts = simulate_full(model, opt);
+  double residual = 0;
+  for (size_t i = 0; i < ts.t.size(); ++i)
+    residual = std::max(residual, std::abs(ts.energy[i] - ts.energy[0] - ts.work[i]));
+  EXPECT_LT(residual, 1e-6 * max_abs(ts.energy));
+  EXPECT_GT(max_abs(ts.work), 0.05 * max_abs(ts.energy));
+  EXPECT_GT(ts.stats.events, 2) << "the gate switches where the rocker turns back";
+}
+
+// A block pulled along its slide toward a ground point passes through it: the line's length
+// reaches zero there, a numerical failure (exit 1), not a silent reversal.
+TEST(ForwardDynamicsPointForce, PointsThatMeetDuringARunStopItWithANumericalError) {
+  const auto scene = models::parse_scene(R"(
+name: slide
+ground_points: {O: [0, 0]}
+bodies:
+  - {name: block, mass_kg: 1.0, inertia_kgm2: 1.0e-3}
+joints:
+  - {name: s, type: prismatic, parent: ground, parent_point: O, child: block, axis: [1, 0], guess_m: 0.3}
+independent: s
+independent_range: [-1, 1]
+loads:
+  - {type: point_force, name: m, body_a: ground, point_a: O, body_b: block, point_b: [0, 0], force_N: 10}
+initial: {q: 0.3, qdot: 0}
+)",
+                                         "slide.yaml");
+  FullModel model(scene);
+  ForwardOptions opt;
+  opt.duration_s = 1.0;
+  opt.output_interval_s = 0.01;
+  try {
+    simulate_full(model, opt);
+    FAIL() << "ran through the point";
+  } catch (const models::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("point force 'm': its points met"), std::string::npos) << e.what();
+    // They meet at t = √(2·0.3/10) = 0.245 s (constant acceleration 10 m/s²).
+    EXPECT_NE(std::string(e.what()).find("t = 0.24"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace rdyn::engine

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -255,6 +256,36 @@ TEST(FullModelBranch, GuessesOfTheOtherBranchFailNamingTheLoop) {
   EXPECT_TRUE(has(m, "joint 'rocker' is at -109.9")) << m;
   EXPECT_TRUE(has(m, "loops.C.branch")) << m;
   EXPECT_TRUE(has(m, "fourbar.yaml")) << m;
+}
+
+// A point force whose points coincide where the mechanism assembles has no direction: refused
+// as bad input, naming the file, the line of its point_b and the field.
+TEST(FullModelPointForce, CoincidentPointsAtAssemblyAreASceneErrorWithItsLine) {
+  const std::string path = ::testing::TempDir() + "coincident_point_force.yaml";
+  const std::string load = "  - {type: point_force, name: m, body_a: ground, point_a: [0.1, 0], body_b: crank, "
+                           "point_b: B, force_N: 5}\n";
+  std::string yaml = test::pulled_crank_yaml(5);
+  yaml.replace(yaml.find("  - {type: point_force"), yaml.find("gravity:") - yaml.find("  - {type: point_force"), load);
+  yaml.replace(yaml.find("q_deg: 150"), 10, "q_deg: 0");  // B = (0.1, 0) = point_a
+  {
+    std::ofstream out(path);
+    out << yaml;
+  }
+  const auto scene = models::load_scene(path);
+  FullModel model(scene);
+  try {
+    FullWorkspace ws(model);
+    FAIL() << "assembled";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "loads.m.point_b");
+    const auto at = yaml.find(load);
+    EXPECT_EQ(e.line(), 1 + std::count(yaml.begin(), yaml.begin() + static_cast<long>(at), '\n')) << e.what();
+    EXPECT_NE(e.message().find("no direction"), std::string::npos) << e.what();
+  }
+  // A turn away they are 0.2 m apart: accepted.
+  yaml.replace(yaml.find("q_deg: 0"), 8, "q_deg: 180");
+  const FullModel ok(models::parse_scene(yaml, "ok.yaml"));
+  EXPECT_NO_THROW(FullWorkspace{ok});
 }
 
 }  // namespace

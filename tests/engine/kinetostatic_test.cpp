@@ -213,5 +213,54 @@ TEST(Kinetostatic, NonFinitePrescribedMotionIsANumericalError) {
   EXPECT_NEAR(calc_kinetostatic(model, ws, 0.7, 0.0, 1.0, Loads::Off).driving_force, test::parallelogram_m1(), 1e-10);
 }
 
+// A point force's generalized force by two routes against the closed form T·dL/dq: inverse
+// dynamics with the force applied (T_act + Q = 0 at rest: T_act = −Q = T·dL/dq) and the
+// velocity ratio of its line (L̇ at q̇ = 1).
+TEST(Kinetostatic, PointForceGeneralizedForceIsTensionTimesLengthRate) {
+  const double T = 37.5;
+  const auto scene = models::parse_scene(test::pulled_crank_yaml(T), "pulled.yaml");
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  for (double deg = -180; deg < 180; deg += 15) {
+    const double q = deg * kPi / 180, dL = test::pulled_crank_dL_dq(q);
+    EXPECT_NEAR(calc_kinetostatic(model, ws, q, 0, 0, Loads::All).driving_force, T * dL, 1e-10 * T) << deg;
+    EXPECT_NEAR(calc_kinetostatic(model, ws, q, 0, 0, Loads::Conservative).driving_force, 0.0, 1e-12) << deg;
+    const auto v = calc_velocity_ratios(model, ws, q);
+    ASSERT_EQ(v.length_wrt_q.size(), 1u);
+    EXPECT_NEAR(v.length_wrt_q[0], dL, 1e-12) << deg;
+  }
+}
+
+// On the four-bar (a point force from ground to the coupler, a closed loop in between) the two
+// Simbody routes must agree: inverse dynamics with only the force applied vs T·dL/dq from the
+// line's velocity ratio; and along the constraint actuator's x the same for the force request.
+TEST(Kinetostatic, PointForceOnALoopAgreesBetweenInverseDynamicsAndLengthRate) {
+  const double T = 12.0;
+  auto scene = models::load_scene("fourbar");
+  scene.gravity.enabled = false;
+  scene.resistances.clear();
+  models::PointForce pf;
+  pf.name = "m";
+  pf.body_a = "ground";
+  pf.point_a = {0.1, 0.35};
+  pf.body_b = "coupler";
+  pf.point_b = {0.2, 0.03};
+  pf.value = T;
+  scene.point_forces.push_back(pf);
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  for (double deg = 0; deg < 360; deg += 30) {
+    const double q = deg * kPi / 180;
+    const auto r = calc_kinetostatic(model, ws, q, 0, 0, Loads::All);
+    const auto v = calc_velocity_ratios(model, ws, q);
+    EXPECT_NEAR(r.driving_force, T * v.length_wrt_q.at(0), 1e-9 * T) << deg;
+    ASSERT_EQ(v.length_wrt_x.size(), scene.outputs.constraint_forces.size());
+    // Constraint actuator k at rest: F_E,k + Q_x,k = 0 with Q_x,k = −T·dL/dx_k.
+    for (size_t k = 0; k < v.length_wrt_x.size(); ++k)
+      EXPECT_NEAR(r.constraint_forces[k], T * v.length_wrt_x[k].at(0), 1e-9 * T) << deg;
+    EXPECT_GT(std::abs(r.driving_force), 1e-3 * T) << deg;
+  }
+}
+
 }  // namespace
 }  // namespace rdyn::engine

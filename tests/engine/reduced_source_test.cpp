@@ -238,6 +238,73 @@ TEST(ReducedSource, ProfiledTorquesAgreeBetweenReducedAndFullModels) {
   EXPECT_LT(dF, 1e-3 * peak_F);
 }
 
+// A point force's column Qpf_<load> is its generalized force per unit tension, −dL/dq, from the
+// velocity ratio of its line: the closed form of the pulled crank at every grid point; the
+// table keeps it through its CSV text.
+TEST(ReducedSource, PointForceColumnIsMinusTheLengthRateAndRoundTrips) {
+  const auto scene = models::parse_scene(test::pulled_crank_yaml(8.0), "pulled.yaml");
+  const auto samples = extract(scene, 10, reduced::Method::Kinetostatic);
+  const int c = samples.require("Qpf_m");
+  for (size_t i = 0; i < samples.q.size(); ++i)
+    EXPECT_NEAR(samples.columns[c][i], -test::pulled_crank_dL_dq(samples.q[i]), 1e-12) << samples.q[i];
+  const auto back = reduced::parse_samples_csv(reduced::format_samples_csv(samples), "pulled.csv");
+  ASSERT_GE(back.column("Qpf_m"), 0);
+  for (size_t i = 0; i < samples.q.size(); ++i)
+    EXPECT_EQ(back.columns[back.column("Qpf_m")][i], samples.columns[c][i]);
+  // The reduced model's F* at rest is T·Qpf (no other load): q̈ = T·(−dL/dq)/m1.
+  const auto m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Fourier);
+  reduced::ReducedWorkspace ws(m);
+  for (double q : {0.3, 2.0, -1.1}) {
+    double qdd, p;
+    reduced::calc_acceleration(m, ws, q, 0.0, qdd, p);
+    const double m1 = 2.0e-3 + 1.0 * 0.05 * 0.05;  // I about O
+    EXPECT_NEAR(qdd, -8.0 * test::pulled_crank_dL_dq(q) / m1, 1e-4 * 8.0 * 0.1 / m1) << q;
+  }
+}
+
+// The four-bar pulled by a profiled, gated point force from a ground point to the coupler (it
+// reads the rocker's angle, on while the rocker turns back) against a viscous bearing: the
+// reduced model's Qpf/Qxpf/tau columns against Simbody applying the tension along the current
+// line, over 3 s.
+TEST(ReducedSource, ProfiledGatedPointForceAgreesBetweenReducedAndFullModels) {
+  const char* loads =
+      "  - {type: point_force, name: m, body_a: ground, point_a: [0.1, 0.35], body_b: coupler, point_b: [0.2, 0.03],\n"
+      "     force_N: 6, active_when: {joint: rocker, rate: negative},\n"
+      "     profile: {of: rocker, fourier: {a0: 1, a: [0.4], b: [0.2]}}}\n";
+  const auto scene = models::parse_scene(test::fourbar_with_loads(loads, "0.05"), "muscle.yaml");
+  const auto samples = extract(scene, 5, reduced::Method::Kinetostatic);
+  const auto m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Fourier);
+  reduced::ReducedOptions ro;
+  ro.duration_s = 3.0;
+  ro.output_interval_s = 0.01;
+  ro.tolerance = 1e-10;
+  const auto red = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
+  ForwardOptions fo;
+  fo.duration_s = 3.0;
+  fo.output_interval_s = 0.01;
+  fo.tolerance = 1e-10;
+  const auto full = simulate_full(FullModel(scene), fo);
+  ASSERT_EQ(red.t.size(), full.t.size());
+  double dq = 0, dqdot = 0, dF = 0;
+  for (size_t i = 0; i < red.t.size(); ++i) {
+    dq = std::max(dq, std::abs(red.q[i] - full.q[i]));
+    dqdot = std::max(dqdot, std::abs(red.qdot[i] - full.qdot[i]));
+    dF = std::max(dF, std::abs(red.forces[0][i] - full.forces[0][i]));
+  }
+  const double peak_F = max_abs(full.forces[0]);
+  std::printf("four-bar with a point force, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| "
+              "%.3g N (of %.3g)\n",
+              dq, dqdot, max_abs(full.qdot), dF, peak_F);
+  double swing = 0;  // a large motion, not a twitch about the start
+  for (double q : full.q) swing = std::max(swing, std::abs(q - full.q.front()));
+  EXPECT_GT(swing, 2.0);
+  EXPECT_GT(full.stats.events, 2);
+  EXPECT_EQ(red.stats.events, full.stats.events);  // the same gate switches
+  EXPECT_LT(dq, 1e-4);
+  EXPECT_LT(dqdot, 1e-4 * max_abs(full.qdot));
+  EXPECT_LT(dF, 1e-3 * peak_F);
+}
+
 TEST(ReducedSource, RunawayContinuationTargetIsRefusedNotWalked) {
   // A prismatic independent coordinate (a block on a slide): the continuation walks the
   // configuration in moves of at most 0.17 m, so 1e9 m would be ~6e9 projections.

@@ -2,6 +2,7 @@
 // the geometry its closed form uses.
 #pragma once
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -52,6 +53,38 @@ inline std::string fourbar_with_loads(const std::string& loads, const std::strin
   if (c != std::string::npos) yaml.replace(c, 19, "coefficient: " + bearing);
   const auto at = yaml.find("loads:\n");
   return at == std::string::npos ? "" : yaml.insert(at + 7, loads);
+}
+
+}  // namespace rdyn::test
+
+namespace rdyn::test {
+
+// A crank turning about the ground origin O, pulled by a point force of tension `tension_N`
+// from ground point G = (0.25, 0.1) m to its point B = (0.1, 0) m (no gravity, no dissipation).
+// Closed form: B(q) = 0.1 (cos q, sin q), L = |B − G|, dL/dq = (B − G)·B'(q)/L.
+inline std::string pulled_crank_yaml(double tension_N, const std::string& extra = "") {
+  return R"(
+name: pulled_crank
+ground_points: {O: [0, 0], G: [0.25, 0.1]}
+bodies:
+  - {name: crank, mass_kg: 1.0, com_m: [0.05, 0], inertia_kgm2: 2.0e-3, points: {B: [0.1, 0]}}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: O, child: crank}
+independent: crank
+loads:
+  - {type: point_force, name: m, body_a: ground, point_a: G, body_b: crank, point_b: B, force_N: )" +
+         std::to_string(tension_N) + extra + R"(}
+gravity: {enabled: false}
+initial: {q_deg: 150, qdot: 2.0}
+simulation: {duration_s: 2, output_interval_s: 0.01}
+)";
+}
+inline double pulled_crank_length(double q) {
+  return std::hypot(0.1 * std::cos(q) - 0.25, 0.1 * std::sin(q) - 0.1);
+}
+inline double pulled_crank_dL_dq(double q) {
+  const double dx = 0.1 * std::cos(q) - 0.25, dy = 0.1 * std::sin(q) - 0.1;
+  return (dx * -0.1 * std::sin(q) + dy * 0.1 * std::cos(q)) / std::hypot(dx, dy);
 }
 
 }  // namespace rdyn::test

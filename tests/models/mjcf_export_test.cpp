@@ -247,5 +247,27 @@ TEST(MjcfExport, OptionsOutOfRangeAreSceneErrors) {
   }
 }
 
+// A point force is documented among the loads rdyn's runner applies (MJCF has no such load), and
+// a geared body it pulls is not folded (its point must exist as a body).
+TEST(MjcfExport, PointForceIsDocumentedAndKeepsItsBodyUnfolded) {
+  Scene s = load_scene("bicycle");
+  PointForce pf;
+  pf.name = "glute";
+  pf.body_a = "ground";
+  pf.point_a = {0.1, 0.5};
+  pf.body_b = "flywheel";
+  pf.point_b = {0.05, 0};
+  pf.value = 12.5;
+  pf.active_when = RateGate{"hip_r", +1};
+  s.point_forces.push_back(pf);
+  EXPECT_FALSE(calc_foldable_gears(s)[0]);
+  const Parsed p = parse(export_mjcf(s));
+  ASSERT_TRUE(p.ok) << p.error;
+  EXPECT_NE(p.comments.find("point_force 'glute': tension 12.5 N along the line between ground"), std::string::npos)
+      << p.comments;
+  EXPECT_NE(p.comments.find("only while joint 'hip_r' turns positively"), std::string::npos) << p.comments;
+}
+
 }  // namespace
 }  // namespace rdyn::models
+

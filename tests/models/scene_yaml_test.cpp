@@ -166,7 +166,7 @@ TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
         EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
         ++n;
       }
-  EXPECT_EQ(n, 15);  // 7 scenes (bicycle-profile included) + 8 hard ones
+  EXPECT_EQ(n, 16);  // 8 scenes (bicycle-profile and bicycle-muscle included) + 8 hard ones
 }
 
 TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
@@ -762,6 +762,75 @@ TEST(SceneYaml, UnitVectorsAreKeptAsWritten) {
   EXPECT_EQ(s.outputs.constraint_forces[0].direction.y, y);
   EXPECT_NEAR(s.outputs.constraint_forces[1].direction.x, 0.6, 1e-16);
   EXPECT_NEAR(s.outputs.constraint_forces[1].direction.y, 0.8, 1e-16);
+
+// Point forces (muscle-like tensions between two points): the fields, ground as a body, named
+// points, the profile and gate, the hash (geometry and shape in, tension out), and refusals.
+TEST(SceneYaml, PointForcesReadPointsProfileAndGate) {
+  const std::string yaml = std::string(kFourbar) +
+                           "  - {type: point_force, name: m, body_a: ground, point_a: D, body_b: crank, point_b: B,\n"
+                           "     force_N: 40, active_when: {joint: crank, rate: negative},\n"
+                           "     profile: {of: rocker, fourier: {a0: 1, b: [0.5]}}}\n"
+                           "  - {type: point_force, name: c, body_a: coupler, point_a: [0.1, 0.02], body_b: rocker, "
+                           "point_b: C, force_N: -3}\n";
+  const Scene s = parse_scene(yaml, "p.yaml");
+  ASSERT_EQ(s.point_forces.size(), 2u);
+  const auto& m = s.point_forces[0];
+  EXPECT_EQ(m.body_a, "ground");
+  EXPECT_EQ(m.point_a.x, 0.3);   // ground point D
+  EXPECT_EQ(m.point_b.x, 0.08);  // crank point B
+  ASSERT_TRUE(m.active_when && m.profile);
+  EXPECT_EQ(m.active_when->sign, -1);
+  EXPECT_NEAR(calc_point_force_tension(m, 0.4), 40 * (1 + 0.5 * std::sin(0.4)), 1e-12);
+  EXPECT_EQ(calc_point_force_tension(s.point_forces[1], 0.4), -3.0);  // a push: negative tension
+  EXPECT_EQ(s.point_forces[1].point_a.y, 0.02);
+}
+
+TEST(SceneYaml, PointForceHashHoldsGeometryAndShapeNotTheTension) {
+  auto scene = [](const std::string& load) { return parse_scene(std::string(kFourbar) + load, "p.yaml"); };
+  const std::string base = "  - {type: point_force, name: m, body_a: ground, point_a: D, body_b: crank, point_b: B, ";
+  const auto a = scene(base + "force_N: 10}\n");
+  const auto b = scene(base + "force_N: 25}\n");
+  const auto c = scene("  - {type: point_force, name: m, body_a: ground, point_a: A, body_b: crank, point_b: B, "
+                       "force_N: 10}\n");
+  const auto d = scene(base + "profile: {of: crank, fourier: {a0: 2}}}\n");
+  const auto e = scene(base + "profile: {of: crank, fourier: {a0: 3}}}\n");
+  const auto g = scene(base + "force_N: 10, active_when: {joint: crank, rate: positive}}\n");
+  EXPECT_EQ(scene_hash(a), scene_hash(b));  // the tension is calibrated without re-extraction
+  EXPECT_NE(scene_hash(a), scene_hash(c));
+  EXPECT_NE(scene_hash(d), scene_hash(e));
+  EXPECT_NE(scene_hash(a), scene_hash(g));
+  EXPECT_NE(scene_hash(a), scene_hash(scene("")));
+}
+
+TEST(SceneYaml, BadPointForcesAreRefusedNamingLineAndField) {
+  struct Bad {
+    std::string load, field, message;
+  };
+  const std::string ok = "body_a: ground, point_a: D, body_b: crank, point_b: B";
+  const std::vector<Bad> bad{
+      {"body_a: nosuch, point_a: [0, 0], body_b: crank, point_b: B, force_N: 1", "loads[1].body_a", "unknown body"},
+      {"body_a: ground, point_a: Z, body_b: crank, point_b: B, force_N: 1", "loads[1].point_a", "no point named 'Z'"},
+      {"body_a: ground, point_a: D, body_b: crank, point_b: C, force_N: 1", "loads[1].point_b", "no point named 'C'"},
+      {ok + ", force_N: .nan", "loads[1].force_N", "finite"},
+      {ok + ", force_N: 2.0e6", "loads.p.force_N", "1e+06"},
+      {ok + ", force_N: 4.0e5, profile: {of: crank, fourier: {a0: 2, a: [1]}}", "loads.p.force_N", "can reach 1.2e+06"},
+      {ok + ", profile: {of: nosuch, fourier: {a0: 1}}", "loads.p.profile.of", "unknown joint"},
+      {ok + ", force_N: 1, active_when: {joint: nosuch, rate: positive}", "loads.p.active_when.joint", "unknown joint"},
+      {ok + ", force_N: 1, active_when: {joint: crank, rate: up}", "loads[1].active_when.rate", "positive or negative"},
+      {ok, "loads[1].force_N", "give force_N"},
+      {ok + ", force_N: 1, torque_Nm: 2", "loads[1].torque_Nm", "unknown key"},
+      {"body_a: crank, point_a: [0, 0], body_b: crank, point_b: B, force_N: 1", "loads.p.body_b", "one body"},
+      {"body_a: ground, point_a: [0, 2000], body_b: crank, point_b: B, force_N: 1", "loads.p.point_a[1]", "1000"},
+  };
+  for (const auto& b : bad) {
+    const std::string line = "  - {type: point_force, name: p, " + b.load + "}\n";
+    const std::string yaml = std::string(kFourbar) + line;
+    const SceneError e = refusal(yaml);
+    EXPECT_EQ(e.file(), "test.yaml") << b.load;
+    EXPECT_EQ(e.field(), b.field) << b.load << "\n" << e.what();
+    EXPECT_EQ(e.line(), line_in(yaml, line)) << b.load << "\n" << e.what();
+    EXPECT_NE(e.message().find(b.message), std::string::npos) << b.load << "\n" << e.what();
+  }
 }
 
 }  // namespace

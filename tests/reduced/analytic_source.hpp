@@ -56,7 +56,7 @@ class AnalyticSource : public reduced::KinetostaticSource {
   }
   reduced::RatioPoint ratios(double q) override {
     ++calls;
-    return {{1.0, std::cos(q)}, {{0.0, 0.5}}, {}, {}};
+    return {{1.0, std::cos(q)}, {{0.0, 0.5}}, {}, {}, {}, {}};
   }
   // Coordinates consistent with the ratios: crank q, lever sin q (d/dq sin q = cos q).
   std::optional<double> joint_coordinate(double q, int joint) override {

@@ -131,6 +131,29 @@ TEST(Extract, ProfiledTorqueIsTabulatedAtTheAngleOfItsJoint) {
   EXPECT_THROW(extract_samples(blind, scene, opt), TableError);
 }
 
+// A point force needs its line's length rates from the source (dL/dq, dL/dx_k): a source that
+// does not give them is refused, not guessed (the engine's source gives them:
+// tests/engine/reduced_source_test.cpp checks them against the closed form).
+TEST(Extract, PointForceNeedsLengthRatesFromTheSource) {
+  auto scene = test::analytic_scene();
+  models::PointForce pf;
+  pf.name = "m";
+  pf.body_a = models::kGround;
+  pf.point_a = {1.0, 1.0};
+  pf.body_b = scene.bodies[0].name;
+  pf.value = 2.0;
+  scene.point_forces.push_back(pf);
+  test::AnalyticSource src;
+  ExtractOptions opt;
+  opt.step_rad = 15 * M_PI / 180;
+  try {
+    extract_samples(src, scene, opt);
+    FAIL() << "extracted without length rates";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("length rates of point forces"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Extract, GridMustDivideATurn) {
   test::AnalyticSource src;
   ExtractOptions opt;

@@ -49,6 +49,30 @@ TEST(JointOutputNames, ColumnsInOrderAndReactionLinesForLoops) {
   }
 }
 
+// A point force on a body whose Newton–Euler balance gives a reaction would enter that balance:
+// refused like a spring (the full model gives those reactions).
+TEST(JointOutputNames, PointForceOnABalancedBodyIsRefusedLikeASpring) {
+  auto r = models::load_scene("slider-crank", {{"outputs.reactions", "all"}});
+  models::PointForce pf;
+  pf.name = "pull";
+  pf.body_a = "ground";
+  pf.point_a = {0.3, 0.1};
+  pf.body_b = "slider";
+  pf.value = 10;
+  r.point_forces.push_back(pf);
+  try {
+    with_reaction_requests(r);
+    ADD_FAILURE() << "accepted";
+  } catch (const TableError& e) {
+    EXPECT_NE(std::string(e.what()).find("its child 'slider' carries point force 'pull'"), std::string::npos)
+        << e.what();
+  }
+  // On the crank (a revolute joint's child: its reaction comes from its own lines) it is accepted.
+  r.point_forces[0].body_b = "crank";
+  r.outputs.reactions = {"crank"};
+  EXPECT_NO_THROW(with_reaction_requests(r));
+}
+
 struct Csv {
   std::map<std::string, std::vector<double>> col;
 };

@@ -72,6 +72,29 @@ TEST(Calibrate, WrittenSceneScalesProfiledLoadsWhereTheSceneListsThem) {
   }
 }
 
+TEST(Calibrate, WrittenSceneScalesPointForcesNamedTogether) {
+  // bicycle-muscle: two profiled point forces under `loads`, calibrated together by name; both
+  // tensions are rewritten (the profile's amplitude), nothing of the generator.
+  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle-muscle.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto scene = models::parse_scene(text.str(), "bicycle-muscle.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+  EXPECT_EQ(opt.load, "gluteus_r+gluteus_l");  // from its validation.calibrate block
+  CalibrationResult r;
+  r.load_value = 512.5;  // names joined by '+': the magnitude each gets
+  r.steady_qdot = 6.0;
+  const auto again =
+      models::parse_scene(calibrated_scene_yaml("bicycle-muscle.yaml", text.str(), {}, scene, opt, r), "w.yaml");
+  ASSERT_EQ(again.point_forces.size(), 2u);
+  for (const auto& f : again.point_forces) {
+    EXPECT_TRUE(f.profile && f.active_when) << f.name;
+    EXPECT_EQ(f.value, 512.5) << f.name;
+  }
+  EXPECT_TRUE(again.joint_torques.empty());
+  EXPECT_EQ(again.initial.qdot, 6.0);
+}
+
 TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {
   // Viscous resistance at a fixed cadence: dissipation ∝ P, and the gated hip work per
   // revolution is T·Δθ, so T ∝ P (up to the tiny speed fluctuation).
@@ -191,6 +214,89 @@ TEST(Calibrate, CylinderForceDoesForceTimesStrokePerRevolution) {
 
 // Refusals are bad input (SceneError) naming the field: an unknown load, a load that is not a
 // drive, a load that does no net work per revolution, no joint torque and no load named.
+// A flywheel pulled by a profiled point force from a ground point G = (0.5, 0) to its rim point
+// B = (0.1, 0): L(q)² = 0.26 − 0.1 cos q, dL/dq = 0.05 sin q / L. With τ(q) = 1 − 0.8 sin q the
+// constant part is conservative and the sine does net work per revolution per newton:
+// W = −∫ τ dL = 0.04 ∫ sin² q / L dq (midpoint sum here, spectrally accurate for a periodic
+// integrand). Calibration by name finds the tension that holds the cadence against the drag.
+std::string pulled_flywheel_yaml(const std::string& loads) {
+  return "name: pulled_flywheel\n"
+         "ground_points: {G: [0.5, 0]}\n"
+         "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05, points: {B: [0.1, 0]}}]\n"
+         "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
+         "independent: wheel\n"
+         "loads:\n"
+         "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n" +
+         loads +
+         "initial: {q_deg: 0, qdot: 5.0}\n"
+         "simulation: {duration_s: 2, output_interval_s: 0.01, tolerance: 1.0e-9}\n";
+}
+
+TEST(Calibrate, PointForceDoesItsClosedFormWorkPerRevolution) {
+  const std::string pf = "  - {type: point_force, name: m, body_a: ground, point_a: G, body_b: wheel, point_b: B, "
+                         "force_N: 3, profile: {of: wheel, fourier: {a0: 1, b: [-0.8]}}}\n";
+  const auto scene = models::parse_scene(pulled_flywheel_yaml(pf), "pulled.yaml");
+  double W = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double q = (i + 0.5) * 2 * M_PI / n, L = std::sqrt(0.26 - 0.1 * std::cos(q));
+    W += 0.04 * std::sin(q) * std::sin(q) / L * (2 * M_PI / n);
+  }
+  CalibrationOptions opt = calibration_options_of(scene, 1.0, 0.0, "m");
+  opt.full_check_s = 2.0;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_EQ(r.load, "m");
+  EXPECT_EQ(r.load_kind, "point_force");
+  EXPECT_EQ(r.load_unit, "N");
+  EXPECT_TRUE(std::isnan(r.torque_Nm));
+  EXPECT_NEAR(r.work_per_rev_per_unit, W, 1e-6 * W);
+  EXPECT_NEAR(r.mean_cadence_hz_reduced, 1.0, 1e-6);
+  EXPECT_NEAR(r.mean_cadence_hz_full, 1.0, 1e-2);
+  // Energy per revolution: the tension's work balances the drag's, c ∫ ω dq ≈ c·2π·ω̄ (the speed
+  // fluctuates by a few per cent, so only roughly): T·W ≈ 0.02·2π·2π.
+  EXPECT_NEAR(r.load_value * W, 0.02 * 4 * M_PI * M_PI, 0.05 * 0.02 * 4 * M_PI * M_PI);
+
+  // Two point forces named together get the same tension: each half of the work.
+  const std::string two = "  - {type: point_force, name: a, body_a: ground, point_a: G, body_b: wheel, point_b: B, "
+                          "force_N: 3, profile: {of: wheel, fourier: {a0: 1, b: [-0.8]}}}\n"
+                          "  - {type: point_force, name: b, body_a: ground, point_a: G, body_b: wheel, point_b: B, "
+                          "force_N: 3, profile: {of: wheel, fourier: {a0: 1, b: [-0.8]}}}\n";
+  const auto scene2 = models::parse_scene(pulled_flywheel_yaml(two), "pulled2.yaml");
+  CalibrationOptions o2 = calibration_options_of(scene2, 1.0, 0.0, "a+b");
+  o2.full_check_s = 0;
+  const auto r2 = calibrate(scene2, o2, quiet);
+  EXPECT_EQ(r2.load, "a+b");
+  EXPECT_EQ(r2.load_kind, "point_forces");
+  EXPECT_NEAR(r2.load_value, r.load_value / 2, 1e-6 * r.load_value);
+  EXPECT_NEAR(r2.work_per_rev_per_unit, 2 * W, 2e-6 * W);
+  EXPECT_EQ(load_value_column(scene2, o2), "point_forces_N");
+  EXPECT_EQ(load_value_column(scene, opt), "point_force_N");
+  // Refusals: a name twice, an unknown part, a constant tension (conservative: no net work).
+  auto refusal = [&](const models::Scene& s, const std::string& load) {
+    CalibrationOptions o = calibration_options_of(s, 1.0, 0.0, load);
+    o.full_check_s = 0;
+    try {
+      calibrate(s, o, quiet);
+    } catch (const models::SceneError& e) {
+      return e.field() + ": " + e.message();
+    }
+    return std::string("accepted");
+  };
+  std::string f = refusal(scene2, "a+a");
+  EXPECT_EQ(f.rfind("--load: 'a' is named twice", 0), 0u) << f;
+  f = refusal(scene2, "a+nope");
+  EXPECT_EQ(f.rfind("--load: no joint_torque, point_force or motor named 'nope'", 0), 0u) << f;
+  f = refusal(scene2, "a+");
+  EXPECT_NE(f.find("empty name"), std::string::npos) << f;
+  const auto constant = models::parse_scene(
+      pulled_flywheel_yaml("  - {type: point_force, name: m, body_a: ground, point_a: G, body_b: wheel, point_b: B, "
+                           "force_N: 3}\n"),
+      "constant.yaml");
+  f = refusal(constant, "m");
+  EXPECT_EQ(f.rfind("--load: 'm' does no net work per revolution", 0), 0u) << f;
+}
+
 TEST(Calibrate, RefusalsNameTheField) {
   Progress quiet(false);
   auto field_of = [&](const models::Scene& scene, CalibrationOptions opt) {
@@ -205,7 +311,7 @@ TEST(Calibrate, RefusalsNameTheField) {
   const auto fw = models::parse_scene(
       flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
   std::string f = field_of(fw, calibration_options_of(fw, 1.0, 0.0, "nope"));
-  EXPECT_EQ(f.rfind("--load: no joint_torque or motor named 'nope' (the scene has drive)", 0), 0u) << f;
+  EXPECT_EQ(f.rfind("--load: no joint_torque, point_force or motor named 'nope' (the scene has drive)", 0), 0u) << f;
   f = field_of(fw, calibration_options_of(fw, 1.0, 0.0, "drag"));
   EXPECT_EQ(f.rfind("--load: 'drag' is a resistance", 0), 0u) << f;
   // From the scene's own block, the field is the scene's.

@@ -251,7 +251,7 @@ TEST_F(Cli, CalibrateNamedLoad) {
   EXPECT_NE(r.output.find("\"target_power_w\": null"), std::string::npos) << r.output;
   r = rdyn("calibrate " + scene + " --load nope");
   EXPECT_EQ(r.status, 2) << r.output;
-  EXPECT_NE(r.output.find("field '--load': no joint_torque or motor named 'nope'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("field '--load': no joint_torque, point_force or motor named 'nope'"), std::string::npos) << r.output;
   r = rdyn("calibrate " + scene + " --load motor --cadence-hz 5");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("field '--load': motor 'motor' cannot hold 5 Hz"), std::string::npos) << r.output;

@@ -563,7 +563,7 @@ void found_later(std::vector<Case>& cs) {
   // Named drive loads (issue #14): a bad --load or validation.calibrate.load is bad input naming
   // its field, and --write-scene leaves nothing behind.
   for (const auto& [tag, load, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"unknown", "nope", "field '--load': no joint_torque or motor named 'nope'"},
+           {"unknown", "nope", "field '--load': no joint_torque, point_force or motor named 'nope'"},
            {"resistance", "flywheel_resistance", "is a resistance"},
            {"bad_name", "a\nb", "field '--load'"},
            {"generated_write", "hip_torque_r", "field '--write-scene'"},
@@ -574,11 +574,42 @@ void found_later(std::vector<Case>& cs) {
                 {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=60:70:2", "--load", "nope", "--out", "w.csv"},
                 2, "field '--load'", {}, nullptr, "w.csv"});
   cs.push_back({"calibrate_load_in_scene_unknown", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
-                "field 'validation.calibrate.load': no joint_torque or motor named 'ghost'",
+                "field 'validation.calibrate.load': no joint_torque, point_force or motor named 'ghost'",
                 {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ghost}}\n"}}, nullptr, "cal.yaml"});
   cs.push_back({"calibrate_load_in_scene_empty", {"calibrate", "d.yaml", "--write-scene", "cal.yaml"}, 2,
                 "field 'validation.calibrate.load': an empty name names no load",
                 {{"d.yaml", driven + "validation: {calibrate: {cadence_Hz: 1, load: ''}}\n"}}, nullptr, "cal.yaml"});
+  // Point forces (issue #13): points that coincide where the mechanism assembles are bad input
+  // naming point_b's line (both models); points that meet during a run are a numerical failure;
+  // a '+' list with a repeated name, and a tension beyond 1e6 N through --set, are bad input.
+  const std::string pulled =
+      "name: pulled\nground_points: {O: [0, 0], G: [0.1, 0]}\n"
+      "bodies: [{name: crank, mass_kg: 1.0, com_m: [0.05, 0], inertia_kgm2: 2.0e-3, points: {B: [0.1, 0]}}]\n"
+      "joints: [{name: crank, type: revolute, parent: ground, parent_point: O, child: crank}]\n"
+      "independent: crank\nloads:\n"
+      "  - {type: point_force, name: m, body_a: ground, point_a: G, body_b: crank, point_b: B, force_N: 5}\n"
+      "initial: {q_deg: 0, qdot: 1}\n";
+  for (const std::string model : {"full", "reduced"})
+    cs.push_back({"point_force_coincident_" + model, {"simulate", "p.yaml", "--model", model, "--out", "o"}, 2,
+                  "p.yaml:7: field 'loads.m.point_b': point force 'm': point_b on 'crank' lies 0 m from point_a",
+                  {{"p.yaml", pulled}}, nullptr, "o"});
+  cs.push_back({"point_force_points_meet",
+                {"simulate", "s.yaml", "--model", "full", "--out", "o"}, 1, "point force 'm': its points met",
+                {{"s.yaml", "name: slide\nground_points: {O: [0, 0]}\n"
+                            "bodies: [{name: block, mass_kg: 1.0, inertia_kgm2: 1.0e-3}]\n"
+                            "joints: [{name: s, type: prismatic, parent: ground, parent_point: O, child: block, "
+                            "axis: [1, 0], guess_m: 0.3}]\n"
+                            "independent: s\nindependent_range: [-1, 1]\nloads:\n"
+                            "  - {type: point_force, name: m, body_a: ground, point_a: O, body_b: block, "
+                            "point_b: [0, 0], force_N: 10}\n"
+                            "initial: {q: 0.3, qdot: 0}\nsimulation: {duration_s: 1}\n"}},
+                nullptr, "o"});
+  cs.push_back({"point_force_set_huge",
+                {"simulate", "bicycle-muscle", "--set", "loads.gluteus_r.force_N=2e6", "--out", "o"}, 2,
+                "field '--set loads.gluteus_r.force_N'", {}, nullptr, "o"});
+  cs.push_back({"calibrate_load_list_repeated",
+                {"calibrate", "bicycle-muscle", "--load", "gluteus_r+gluteus_r", "--write-scene", "cal.yaml"}, 2,
+                "field '--load': 'gluteus_r' is named twice", {}, nullptr, "cal.yaml"});
   for (const std::string reserved : {"summary.json", "index.html"})
     cs.push_back({"suite_name_" + reserved.substr(0, reserved.find('.')), {"validate", "--suite", "s", "--out", "o"}, 2,
                   "suite's own output", {{"s/" + reserved + ".yaml", scene_text("fourbar")}}, nullptr, "o"});
