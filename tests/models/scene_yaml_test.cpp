@@ -762,6 +762,7 @@ TEST(SceneYaml, UnitVectorsAreKeptAsWritten) {
   EXPECT_EQ(s.outputs.constraint_forces[0].direction.y, y);
   EXPECT_NEAR(s.outputs.constraint_forces[1].direction.x, 0.6, 1e-16);
   EXPECT_NEAR(s.outputs.constraint_forces[1].direction.y, 0.8, 1e-16);
+}
 
 // Point forces (muscle-like tensions between two points): the fields, ground as a body, named
 // points, the profile and gate, the hash (geometry and shape in, tension out), and refusals.
