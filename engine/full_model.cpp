@@ -239,9 +239,9 @@ void check_branches(const FullModel::Impl& m, const State& s) {
     if (l.branch->sign * v > 0) continue;
     const double shown = rev ? v * 180 / Pi : v;
     throw EngineError(fmt::format(
-        "{}: field 'loops.{}.branch': loop '{}' assembled on the other branch: joint '{}' is at {:.6g}{} but the "
+        "{}: loop '{}' assembled on the other branch: joint '{}' is at {:.6g}{} but the "
         "branch asks for a {} value{}; move the guesses toward that branch (e.g. {} of '{}')",
-        m.scene.source_file, l.name, l.name, jt.name, shown, rev ? "° (wrapped to (−180°, 180°])" : " m",
+        models::where(m.scene, "loops." + l.name + ".branch"), l.name, jt.name, shown, rev ? "° (wrapped to (−180°, 180°])" : " m",
         l.branch->sign > 0 ? "positive" : "negative", v == 0 ? " (0 is the boundary between the branches)" : "",
         rev ? "guess_deg" : "guess_m", jt.name));
   }

@@ -59,8 +59,9 @@ Walk walk(const FullModel& model, double dir, double h0, double limit, bool revo
   Walk out;
   while (std::abs(q - q0) < limit) {
     if (++moves > kMaxMoves)
-      throw EngineError(fmt::format("{}: the search for the dead points of '{}' took more than {} moves",
-                                    model.scene().source_file, model.scene().independent, kMaxMoves));
+      // A numerical failure (exit 1), not bad input: the scene was valid, the walk did not end.
+      throw models::NumericalError(fmt::format("{}: the search for the dead points of '{}' took more than {} moves",
+                                               model.scene().source_file, model.scene().independent, kMaxMoves));
     const double q_try = q + dir * std::min(h, limit - std::abs(q - q0) + 1e-12);
     if (try_reach(model, ws, q_try)) {
       q = q_try;
@@ -135,10 +136,11 @@ IndependentDomain calc_independent_domain(const FullModel& model) {
       if (!(span > 0)) continue;
       const Walk w = walk(model, dir, std::min(h0, span), span, false, moves);
       if (w.dead)
-        throw EngineError(fmt::format("{}: independent_range [{:.9g}, {:.9g}]{} of '{}' crosses a dead point at "
-                                      "{:.9g}{} (the loops cannot close beyond it): declare a range inside the dead "
-                                      "points, or leave it out and rdyn finds them",
-                                      sc.source_file, d.min * k, d.max * k, unit, sc.independent, *w.dead * k, unit));
+        throw EngineError(fmt::format(
+            "{}: independent_range [{:.9g}, {:.9g}]{} of '{}' crosses a dead point at {:.9g}{} (the loops cannot "
+            "close beyond it): declare a range inside the dead points, or leave it out and rdyn finds them",
+            models::where(sc, sc.line_of("independent_range_deg") > 0 ? "independent_range_deg" : "independent_range"),
+            d.min * k, d.max * k, unit, sc.independent, *w.dead * k, unit));
     }
     return d;
   }
@@ -171,7 +173,7 @@ IndependentDomain calc_independent_domain(const FullModel& model) {
         "{}: the initial {} lies within {:g} % of a dead point of '{}' (dead points at {:.9g}{} and {:.9g}{}; the "
         "range rdyn uses stops {:g} % of their distance short of each): start further inside, or declare "
         "independent_range",
-        sc.source_file, format_coordinate(sc.initial.q, d.revolute), 100 * kDeadPointMargin, sc.independent,
+        models::where(sc, "initial"), format_coordinate(sc.initial.q, d.revolute), 100 * kDeadPointMargin, sc.independent,
         *d.dead_min * k, unit, *d.dead_max * k, unit, 100 * kDeadPointMargin));
   return d;
 }

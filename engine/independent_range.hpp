@@ -37,7 +37,7 @@ struct IndependentDomain {
 // cannot close, then bisects to the dead point. A revolute that completes a turn is periodic.
 // A prismatic coordinate that meets no dead point within 40 mechanism sizes, or only one,
 // gets an unbounded domain (unbounded_reason). Throws EngineError when the initial q lies within
-// the margin of a dead point.
+// the margin of a dead point, models::NumericalError when the walk exceeds its budget of moves.
 IndependentDomain calc_independent_domain(const FullModel& model);
 
 // Size of the mechanism [m]: the largest distance of any point (ground points, body points,

@@ -25,6 +25,17 @@ SceneError::SceneError(std::string file, int line, std::string field, const std:
       field_(std::move(field)),
       message_(message) {}
 
+int Scene::line_of(const std::string& key) const {
+  const auto it = key_lines.find(key);
+  return it == key_lines.end() ? 0 : it->second;
+}
+
+std::string where(const Scene& scene, const std::string& key) {
+  std::string w = scene.source_file.empty() ? std::string("<scene>") : scene.source_file;
+  if (const int line = scene.line_of(key); line > 0) w += fmt::format(":{}", line);
+  return w + fmt::format(": field '{}'", key);
+}
+
 const Body* Scene::find_body(const std::string& n) const {
   for (const auto& b : bodies)
     if (b.name == n) return &b;

@@ -322,6 +322,13 @@ struct Scene {
   Validation validation;
   std::optional<OptimizeSpec> optimize;  // scene block `optimize` (rdyn optimize)
 
+  // Lines (1-based) of the keys whose checks need the assembled model or a table, so that their
+  // refusals name the line too: "independent_range" (or _deg), "initial", "loops.<name>.branch",
+  // "validation.calibrate.load", "outputs.reactions". Filled by the YAML reader; where the key
+  // came from, not part of the description (not hashed, not written back).
+  std::map<std::string, int> key_lines;
+
+  int line_of(const std::string& key) const;  // 0 when unknown
   const Body* find_body(const std::string& name) const;
   const Joint* find_joint(const std::string& name) const;
   int joint_index(const std::string& name) const;  // −1 when absent
@@ -332,6 +339,10 @@ struct Scene {
 // finite and within `limits`). Throws SceneError naming the scene file and the offending
 // field: "bodies.<name>.mass_kg" (by name) or "bodies[<i>].name" for a bad name.
 void check_scene(const Scene& scene);
+
+// "file:line: field 'key'" (the line when the reader recorded it): how refusals found after
+// loading (engine, calibration, reduced reactions) name where the scene says it.
+std::string where(const Scene& scene, const std::string& key);
 
 // Resistance torque at angular rate ω [rad/s]: −c0·sgn ω, −c1·ω or −c2·ω|ω| [N·m].
 double resistance_torque(ResistanceLaw law, double coefficient, double omega);

@@ -549,6 +549,7 @@ void read_mechanism(const Fields& top, Scene& s) {
     l.point_b = read_point(f, "point_b", l.body_b, s);
     if (f.has("branch")) {  // {joint, sign: positive|negative} (or +1 / -1)
       Fields b(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"});
+      s.key_lines["loops." + l.name + ".branch"] = b.line();
       BranchSign br{b.str("joint"), +1};
       if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
       if (br.joint == top.str_or("independent", ""))
@@ -837,6 +838,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   // Initial conditions first: the generator places the mechanism at q0.
   if (top.has("initial")) {
     Fields f(top.raw("initial"), "initial", ctx, {"q", "q_deg", "qdot", "cadence_Hz"});
+    s.key_lines["initial"] = f.line();
     if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
     if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
     // Ranges in SI are check_scene's; the converted units are checked here, where the
@@ -863,6 +865,8 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     read_mechanism(top, s);
   }
   read_independent_range(top, s);
+  for (const char* k : {"independent_range", "independent_range_deg"})
+    if (top.has(k)) s.key_lines[k] = line_of(top.raw(k));
   std::vector<PendingDissipation> pending;
   read_loads(top, s, pending);
   for (const auto& p : pending) {
@@ -943,7 +947,10 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       return out;
     };
     if (f.has("joints")) s.outputs.joints = names_or_all("joints", false);
-    if (f.has("reactions")) s.outputs.reactions = names_or_all("reactions", true);
+    if (f.has("reactions")) {
+      s.outputs.reactions = names_or_all("reactions", true);
+      s.key_lines["outputs.reactions"] = line_of(f.raw("reactions"));
+    }
     s.outputs.shaking = f.flag_or("shaking", false);
   }
   if (top.has("simulation")) {
@@ -977,6 +984,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       // power_W absent: mean-speed mode (the resistances stay as given).
       s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
       s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
+      if (c.has("load")) s.key_lines["validation.calibrate.load"] = line_of(c.raw("load"));
       if (c.has("load") && s.validation.calibrate_load.empty())
         c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
       // A present block with zeros would silently mean "off": refuse (ranges: check_scene).

@@ -48,9 +48,9 @@ std::pair<std::string, int> loop_balance_body(const models::Scene& s, const mode
     for (const auto& o : s.loops) ok &= &o == &l || (o.body_a != body && o.body_b != body);
     if (ok) return {body, sign};
   }
-  throw TableError(fmt::format("the reduced model cannot give the reaction of loop '{}': neither of its bodies hangs "
-                               "from revolute joints only, free of springs and other loops (use --model full)",
-                               l.name));
+  throw TableError(fmt::format("{}: the reduced model cannot give the reaction of loop '{}': neither of its bodies "
+                               "hangs from revolute joints only, free of springs and other loops (use --model full)",
+                               models::where(s, "outputs.reactions"), l.name));
 }
 
 // A prismatic joint's reaction by Newton–Euler of its child C: C's other joints are revolute
@@ -60,9 +60,9 @@ std::pair<std::string, int> loop_balance_body(const models::Scene& s, const mode
 void check_prismatic_balance(const models::Scene& s, const models::Joint& jt) {
   const std::string& c = jt.child;
   auto refuse = [&](const std::string& why) {
-    throw TableError(fmt::format("the reduced model cannot give the reaction of prismatic joint '{}': its child '{}' {} "
-                                 "(use --model full)",
-                                 jt.name, c, why));
+    throw TableError(fmt::format("{}: the reduced model cannot give the reaction of prismatic joint '{}': its child "
+                                 "'{}' {} (use --model full)",
+                                 models::where(s, "outputs.reactions"), jt.name, c, why));
   };
   for (const auto& j : s.joints) {
     if (j.parent != c) continue;

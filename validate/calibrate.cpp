@@ -49,7 +49,7 @@ const char* unit_of(const models::Scene& s, const std::string& joint) {
 // opt.load_field for an unknown load or one that is not a drive load.
 Selection select_load(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
   };
   auto candidates = [&] {
     std::string c;
@@ -229,7 +229,7 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
   };
   const Selection sel = select_load(scene, opt);
   const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;

@@ -98,7 +98,8 @@ double RunRecord::error_of(const std::string& q) const {
 std::string RunRecord::label() const {
   if (model == "full") return fmt::format("full {} tol {:.0e}", integrator, tolerance);
   if (model != "reduced") return fmt::format("{} {} h={:.3g} ms", model, integrator, fixed_step_s * 1e3);
-  std::string s = fmt::format("reduced {:g}° {}{}", grid_deg, interpolation, energy_consistent ? "+ec" : "");
+  std::string s = fmt::format("reduced {:g}° {}{}", grid_deg, fit.empty() ? interpolation : fit,
+                              energy_consistent ? "+ec" : "");
   if (integrator == "rk4-fixed") return s + fmt::format(" rk4 h={:g} ms", fixed_step_s * 1e3);
   return s + fmt::format(" {} tol {:.0e}", integrator, tolerance);
 }
@@ -213,6 +214,7 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
         r.model = "reduced";
         r.grid_deg = grid;
         r.interpolation = var.interpolation;
+        r.fit = model.table.fit;
         r.energy_consistent = var.energy_consistent;
         r.integrator = integrator;
         r.tolerance = tol;
@@ -289,6 +291,7 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
       r.model = "reduced";
       r.grid_deg = th.grid_deg;
       r.interpolation = interp;
+      r.fit = m.table.fit;
       r.integrator = "rk8pd";
       r.tolerance = v.tightest_tolerance;
       auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);

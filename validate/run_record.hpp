@@ -14,7 +14,8 @@ struct RunRecord {
   double tolerance = 0.0;
   std::string integrator;
   double grid_deg = 0.0;      // reduced
-  std::string interpolation;  // reduced
+  std::string interpolation;  // reduced: as requested
+  std::string fit;            // reduced: the interpolant built (a range table: "cubic (not-a-knot)" for fourier/cubic)
   bool energy_consistent = false;
   double fixed_step_s = 0.0;     // rk4-fixed, and a peer's fixed step
   double wall_s = 0.0;           // median over repeats, the run as simulated [s]

@@ -134,6 +134,7 @@ nlohmann::json run_json(const RunRecord& r) {
   if (r.model == "reduced") {
     j["grid_deg"] = r.grid_deg;
     j["interpolation"] = r.interpolation;
+    if (!r.fit.empty()) j["fit"] = r.fit;  // the interpolant built (differs from the request on range tables)
     j["energy_consistent_m2"] = r.energy_consistent;
     if (r.integrator == "rk4-fixed") j["fixed_step_s"] = r.fixed_step_s;
     nlohmann::json oi = nlohmann::json::object();

@@ -2,6 +2,7 @@
 // against their closed forms; periodic and declared cases.
 #include "engine/independent_range.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -103,6 +104,12 @@ TEST(IndependentRange, AnInitialPositionNextToADeadPointIsRefused) {
     FAIL() << "accepted";
   } catch (const EngineError& e) {
     EXPECT_NE(std::string(e.what()).find("dead point"), std::string::npos) << e.what();
+    // The refusal names where the scene gives the initial position.
+    EXPECT_NE(std::string(e.what()).find(fmt::format("slider-crank-slider.yaml:{}: field 'initial'",
+                                                     scene.line_of("initial"))),
+              std::string::npos)
+        << e.what();
+    EXPECT_GT(scene.line_of("initial"), 0);
   }
 }
 

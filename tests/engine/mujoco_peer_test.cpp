@@ -178,7 +178,9 @@ TEST(MujocoPeer, EveryShippedSceneLoadsAndMoves) {
     EXPECT_NEAR(ts.q.front(), s.initial.q, 1e-12) << e.path();
     EXPECT_NEAR(ts.qdot.front(), s.initial.qdot, 1e-12) << e.path();
     EXPECT_LT(ts.stats.max_constraint_error, 1e-3) << e.path();
-    if (s.initial.qdot != 0) EXPECT_NE(ts.q.back(), ts.q.front()) << e.path();
+    if (s.initial.qdot != 0) {
+      EXPECT_NE(ts.q.back(), ts.q.front()) << e.path();
+    }
   }
   EXPECT_GE(scenes, 11);
 }

@@ -514,6 +514,33 @@ TEST(SceneYaml, JointOutputsAllOrNames) {
             std::string::npos);
 }
 
+// Keys whose refusals come after loading (engine, calibration, reduced reactions) keep their
+// lines, so those refusals can name them.
+TEST(SceneYaml, KeysCheckedAfterLoadingKeepTheirLines) {
+  const Scene s = parse_scene(R"(name: lines
+bodies: [{name: crank, mass_kg: 1, inertia_kgm2: 0.01}]
+joints: [{name: crank, type: revolute, parent: ground, parent_point: [0, 0], child: crank}]
+independent: crank
+independent_range_deg: [-10, 10]
+outputs:
+  reactions: all
+initial:
+  q_deg: 0
+validation:
+  calibrate: {cadence_Hz: 1, load: drive}
+)",
+                              "lines.yaml");
+  EXPECT_EQ(s.line_of("independent_range_deg"), 5);
+  EXPECT_EQ(s.line_of("outputs.reactions"), 7);
+  EXPECT_EQ(s.line_of("initial"), 9);  // the block's first key
+  EXPECT_EQ(s.line_of("validation.calibrate.load"), 11);
+  EXPECT_EQ(s.line_of("loops.C.branch"), 0);
+  EXPECT_EQ(where(s, "initial"), "lines.yaml:9: field 'initial'");
+  EXPECT_EQ(where(s, "nothing"), "lines.yaml: field 'nothing'");
+  const Scene rocker = load_scene("fourbar-rocker");
+  EXPECT_EQ(rocker.line_of("loops.C.branch"), 25);
+}
+
 }  // namespace
 }  // namespace rdyn::models
 

@@ -63,5 +63,33 @@ TEST(Compare, RelativeErrorsAndGateExclusion) {
   EXPECT_THROW(compare_series(ref, run, 0), std::runtime_error);
 }
 
+
+// A rocking mechanism: q = A sin ωt, mean speed over the window near zero. Its mean-speed error
+// is measured against 1 % of the peak speed, not against the near-zero mean.
+TEST(Compare, MeanSpeedOfAnOscillationIsScaledByThePeakSpeed) {
+  models::TimeSeries ref;
+  const double A = 0.3, w = 2 * M_PI;
+  for (int i = 0; i <= 1000; ++i) {
+    const double t = i * 1e-3 * 1.01;  // 1.01 periods: mean speed ≈ A·sin(2π·1.01)/1.01 ≈ 0.019 rad/s
+    ref.t.push_back(t);
+    ref.q.push_back(A * std::sin(w * t));
+    ref.qdot.push_back(A * w * std::cos(w * t));
+  }
+  auto run = ref;
+  run.q.back() += 1e-4;  // displacement error 1e-4 rad over 1.01 s
+  const auto c = compare_series(ref, run, 0.0);
+  const double peak = A * w, mean_ref = (ref.q.back() - ref.q.front()) / ref.t.back();
+  ASSERT_LT(std::abs(mean_ref), 0.01 * peak);  // the case this guards
+  EXPECT_NEAR(c.find("mean_qdot")->max_rel, 1e-4 / ref.t.back() / (0.01 * peak), 1e-9);
+  // A turning run keeps the relative error of its mean speed.
+  auto turning = ref;
+  for (size_t i = 0; i < turning.t.size(); ++i) turning.q[i] += 2 * M_PI * turning.t[i];
+  auto turning_run = turning;
+  turning_run.q.back() += 1e-4;
+  const auto ct = compare_series(turning, turning_run, 0.0);
+  const double mean_turning = (turning.q.back() - turning.q.front()) / turning.t.back();
+  EXPECT_NEAR(ct.find("mean_qdot")->max_rel, 1e-4 / turning.t.back() / mean_turning, 1e-9);
+}
+
 }  // namespace
 }  // namespace rdyn::validate

@@ -26,11 +26,11 @@ struct Case {
   std::vector<std::string> args;  // after `rdyn`; run in a fresh folder
   int status = 2;                 // expected exit status
   std::string message;            // expected in standard error
-  std::map<std::string, std::string> files;       // written before the run; must be intact after
-  std::function<void(const fs::path&)> setup;     // more set-up (FIFOs, links, folders)
-  std::string out;                                // must not exist after a failure
-  RunLimits limits;
-  std::function<void(const fs::path&, const RdynRun&)> check;  // more assertions
+  std::map<std::string, std::string> files{};     // written before the run; must be intact after
+  std::function<void(const fs::path&)> setup{};   // more set-up (FIFOs, links, folders)
+  std::string out{};                              // must not exist after a failure
+  RunLimits limits{};
+  std::function<void(const fs::path&, const RdynRun&)> check{};  // more assertions
 };
 
 // Test names only, instead of gtest's byte dump of the parameter.
@@ -66,8 +66,9 @@ TEST_P(Hostile, ExitStatusMessageAndDisk) {
   EXPECT_NE(r.err.find(c.message), std::string::npos) << "expected «" << c.message << "» in: " << r.err;
   EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
   for (const auto& [name, text] : c.files) EXPECT_EQ(slurp(dir / name), text) << name << " was changed";
-  if (r.status != 0 && !c.out.empty())
+  if (r.status != 0 && !c.out.empty()) {
     EXPECT_FALSE(fs::exists(fs::symlink_status(dir / c.out))) << c.out << " left after a failure";
+  }
   const std::regex non_finite("(^|,)-?(nan|inf)(,|$)", std::regex::icase | std::regex::multiline);
   std::error_code ec;
   for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
@@ -77,8 +78,9 @@ TEST_P(Hostile, ExitStatusMessageAndDisk) {
     EXPECT_NE(name, "PWNED") << "a shell ran user text";
     std::error_code fe;
     const bool input = c.files.count(fs::relative(it->path(), dir, fe).string()) > 0;  // the case's own files
-    if (!input && it->is_regular_file(fe) && it->path().extension() == ".csv" && it->file_size(fe) < (1u << 24))
+    if (!input && it->is_regular_file(fe) && it->path().extension() == ".csv" && it->file_size(fe) < (1u << 24)) {
       EXPECT_FALSE(std::regex_search(slurp(it->path()), non_finite)) << "non-finite value in " << it->path();
+    }
   }
   EXPECT_FALSE(fs::exists("PWNED"));
   if (c.check) c.check(dir, r);

@@ -92,12 +92,22 @@ TEST(Sweep, UncalibratableSceneFailsBeforeWork) {
   EXPECT_THROW(run_sweep(o, false), models::SceneError);
 }
 
+// Removes a temporary scene file however the test ends (a throwing run_sweep included).
+struct RemoveOnExit {
+  std::filesystem::path path;
+  ~RemoveOnExit() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
 // A failing case is a row with status "error" and its message, and it is counted: the
 // four-bar driven by a crank torque, with the ground pivot D moved so far in the second case
 // that the loop cannot close.
 TEST(Sweep, FailingCasesAreCountedAndReported) {
   namespace fs = std::filesystem;
   const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
   std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
   std::stringstream text;
   text << in.rdbuf();
@@ -112,7 +122,6 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
   o.axes = {parse_sweep_axis("ground_points.D.0=0.30:3.0:2")};
   o.threads = 2;
   const SweepResult r = run_sweep(o, false);
-  fs::remove(scene);
   EXPECT_EQ(r.cases, 2);
   EXPECT_EQ(r.failed, 1) << r.csv;
   const auto lines = r.csv.substr(r.csv.find('\n') + 1);
@@ -125,6 +134,7 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
 TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
   namespace fs = std::filesystem;
   const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_motor_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
   std::ofstream(scene) << "name: flywheel\n"
                           "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05}]\n"
                           "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
@@ -140,7 +150,6 @@ TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
   o.axes = {parse_sweep_axis("loads.drag.coefficient=0.01:0.03:3")};
   o.threads = 1;
   const SweepResult r = run_sweep(o, false);
-  fs::remove(scene);
   ASSERT_EQ(r.failed, 0) << r.csv;
   std::istringstream lines(r.csv);
   std::string line;
