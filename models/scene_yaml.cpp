@@ -782,6 +782,10 @@ void read_optimize(const Fields& f, Scene& s) {
     same_nodes.push_back(n);
   });
   if (f.has("loads") && o.loads.empty()) f.fail("loads", "list at least one design load, or leave the key out");
+  // Where the design is written: the refusals that need the whole design (calibration scales
+  // every joint torque together) come after loading.
+  s.key_lines["optimize"] = f.line();
+  if (f.has("loads")) s.key_lines["optimize.loads"] = line_of(f.raw("loads"));
   for (size_t i = 0; i < o.loads.size(); ++i) {
     const auto& d = o.loads[i];
     if (d.same_as.empty()) continue;

@@ -105,7 +105,8 @@ models::Scene shaped_scene(models::Scene s, const Design& d, const double* x) {
 // The design: groups, loads, their starting point; SceneError naming the field.
 Design resolve_design(const models::Scene& s, const models::OptimizeSpec& spec, const OptimizeOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(s.source_file, 0, field, msg);
+    const int line = s.line_of("optimize.loads") ? s.line_of("optimize.loads") : s.line_of("optimize");
+    throw models::SceneError(s.source_file, line, field, msg);
   };
   Design d;
   d.H = opt.harmonics > 0 ? opt.harmonics : spec.harmonics;

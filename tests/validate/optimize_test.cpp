@@ -7,7 +7,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -129,6 +131,31 @@ TEST(Optimize, RefusalsNameTheField) {
   } catch (const models::SceneError& e) {
     EXPECT_EQ(e.field(), "optimize.loads");
     EXPECT_NE(std::string(e.what()).find("extra"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Optimize, AJointTorqueOutsideTheDesignNamesTheLine) {
+  // The bicycle's block without the left hip: it stays a joint torque but is not designed. The
+  // refusal names the line where the design list starts.
+  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string y = ss.str();
+  const std::string left = "    - {load: hip_torque_l, same_as: hip_torque_r, shift_deg: 180}\n";
+  ASSERT_NE(y.find(left), std::string::npos);
+  y.erase(y.find(left), left.size());
+  const auto scene = models::parse_scene(y, "bicycle.yaml");
+  const int line = 1 + static_cast<int>(std::count(y.begin(), y.begin() + static_cast<long>(y.find("    - {load: hip_torque_r}")), '\n'));
+  OptimizeOptions o;
+  o.power_w = 125;
+  Progress quiet(false);
+  try {
+    optimize(scene, o, quiet);
+    ADD_FAILURE() << "optimised with hip_torque_l outside the design";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "optimize.loads");
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find("hip_torque_l"), std::string::npos) << e.what();
   }
 }
 
