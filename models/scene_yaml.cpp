@@ -37,6 +37,14 @@ size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 std::vector<std::string> split_key_path(const std::string& path);
+
+// v / len, or v itself when it is already a unit vector to rounding (|len − 1| ≤ 4 ulp):
+// dividing a normalised vector by its rounded length can move it by an ulp, and a scene
+// written by scene_to_yaml must read back bit for bit.
+Vec2 unit_vector(const Vec2& v, double len) {
+  if (std::abs(len - 1.0) <= 4 * std::numeric_limits<double>::epsilon()) return v;
+  return {v.x / len, v.y / len};
+}
 bool parse_index(const std::string& text, size_t size, size_t& index);
 
 int line_of(const YAML::Node& n) {
@@ -505,7 +513,7 @@ void read_mechanism(const Fields& top, Scene& s) {
   for_each_item(top, "joints", [&](const YAML::Node& n, const std::string& path) {
     Fields f(n, path, top.ctx(),
              {"name", "type", "parent", "child", "parent_point", "child_point", "axis",
-              "offset_deg", "guess_deg", "guess_m"});
+              "offset_deg", "guess_deg", "guess_m", "offset_rad", "guess_rad"});
     Joint j;
     j.name = f.name("name");
     const std::string type = f.str("type");
@@ -526,16 +534,23 @@ void read_mechanism(const Fields& top, Scene& s) {
       j.axis = f.has("axis") ? f.vec2("axis") : Vec2{1, 0};
       const double len = std::hypot(j.axis.x, j.axis.y);
       if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
-      j.axis = {j.axis.x / len, j.axis.y / len};
-      if (f.has("offset_deg") || f.has("guess_deg"))
-        f.fail("type", "prismatic joints take guess_m, not degrees");
+      j.axis = unit_vector(j.axis, len);
+      if (f.has("offset_deg") || f.has("guess_deg") || f.has("offset_rad") || f.has("guess_rad"))
+        f.fail("type", "prismatic joints take guess_m, not angles");
       j.guess = f.num_or("guess_m", 0.0);
     } else {
       if (f.has("axis") || f.has("guess_m"))
         f.fail("type", "revolute joints take guess_deg and no axis");
+      // Degrees, or radians (what scene_to_yaml writes: x·π/180 need not round back to the same double).
       const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
-      j.offset_rad = f.num_abs_max("offset_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
-      j.guess = f.num_abs_max("guess_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
+      auto angle = [&](const std::string& name) {
+        if (f.has(name + "_deg") && f.has(name + "_rad"))
+          f.fail(name + "_rad", fmt::format("give {0}_deg or {0}_rad, not both", name));
+        if (f.has(name + "_rad")) return f.num_abs_max(name + "_rad", 0.0, limits::kMaxAngle_rad, "rad");
+        return f.num_abs_max(name + "_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
+      };
+      j.offset_rad = angle("offset");
+      j.guess = angle("guess");
     }
     s.joints.push_back(j);
   });
@@ -621,9 +636,10 @@ void read_independent_range(const Fields& top, Scene& s) {
 // the order of the table's angles are checked here, where the line of each row is known;
 // the joint and the load's range by check_scene.
 LoadProfile read_profile(const Fields& parent, const std::string& key) {
-  Fields p(parent.raw(key), parent.join(key), parent.ctx(), {"of", "fourier", "table_deg"});
-  if (p.has("fourier") == p.has("table_deg"))
-    p.fail("fourier", "give fourier: {a0, a, b} or table_deg: [[angle_deg, value], ...], one of them");
+  Fields p(parent.raw(key), parent.join(key), parent.ctx(), {"of", "fourier", "table_deg", "table_rad"});
+  if (int(p.has("fourier")) + int(p.has("table_deg")) + int(p.has("table_rad")) != 1)
+    p.fail("fourier",
+           "give fourier: {a0, a, b} or table_deg: [[angle_deg, value], ...] (or table_rad), one of them");
   const std::string of = p.str("of");
   auto list = [&](const Fields& f, const std::string& k, size_t max, const char* what) {
     std::vector<double> v;
@@ -643,16 +659,20 @@ LoadProfile read_profile(const Fields& parent, const std::string& key) {
     out.b = list(f, "b", limits::kMaxProfileHarmonics, "sine coefficients");
     return out;
   }
-  const YAML::Node rows = p.raw("table_deg");
-  const std::string field = p.join("table_deg");
-  if (!rows.IsSequence()) p.fail("table_deg", "expected a list of [angle_deg, value] rows");
+  // table_rad (what scene_to_yaml writes): the same rows in radians, checked in degrees.
+  const bool rad = p.has("table_rad");
+  const std::string table_key = rad ? "table_rad" : "table_deg";
+  const YAML::Node rows = p.raw(table_key);
+  const std::string field = p.join(table_key);
+  if (!rows.IsSequence()) p.fail(table_key, "expected a list of [angle, value] rows");
   if (rows.size() < limits::kMinProfileRows || rows.size() > limits::kMaxProfileRows)
-    p.fail("table_deg", fmt::format("{} rows; a periodic table takes {} to {}", rows.size(),
+    p.fail(table_key, fmt::format("{} rows; a periodic table takes {} to {}", rows.size(),
                                     limits::kMinProfileRows, limits::kMaxProfileRows));
   std::vector<double> theta, value;
   for (size_t i = 0; i < rows.size(); ++i) {
     const std::string fi = field + fmt::format("[{}]", i);
-    const Vec2 row = p.to_vec2(rows[i], fi);
+    const Vec2 typed = p.to_vec2(rows[i], fi);
+    const Vec2 row{rad ? typed.x * 180.0 / kPi : typed.x, typed.y};  // angle in degrees
     if (std::abs(row.x) > 360.0)
       p.fail_at(rows[i], fi + "[0]", fmt::format("angle {:g}° outside [−360°, 360°]", row.x));
     if (i > 0 && !(row.x - theta.back() * 180 / kPi >= limits::kMinProfileSpacing_deg))
@@ -664,7 +684,7 @@ LoadProfile read_profile(const Fields& parent, const std::string& key) {
                 fmt::format("the table covers one turn: angles must stay below the first + 360° (got {:g}° "
                             "after a first angle of {:g}°)",
                             row.x, theta.front() * 180 / kPi));
-    theta.push_back(row.x * kPi / 180.0);
+    theta.push_back(rad ? typed.x : row.x * kPi / 180.0);
     value.push_back(row.y);
   }
   return make_table_profile(of, std::move(theta), std::move(value));
@@ -907,7 +927,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       }
       const double len = std::hypot(r.direction.x, r.direction.y);
       if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
-      r.direction = {r.direction.x / len, r.direction.y / len};
+      r.direction = unit_vector(r.direction, len);
       for (const auto& other : s.outputs.constraint_forces)
         if (other.name == r.name) c.fail("name", "duplicate constraint force name");
       s.outputs.constraint_forces.push_back(r);

@@ -9,6 +9,7 @@
 #include "models/scene.hpp"
 #include "reduced/samples.hpp"
 #include "validate/commands.hpp"
+#include "validate/expand.hpp"
 #include "validate/inspect.hpp"
 #include "validate/optimize_command.hpp"
 #include "validate/output_dir.hpp"
@@ -227,6 +228,17 @@ int main(int argc, char** argv) {
   optimize->add_option("--set", opz.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   optimize->add_option("--out", opz.out, "Output folder (written atomically)")->required();
   optimize->add_flag("--force", opz.force, kForceHelpDir);
+  ExpandArgs exp;
+  auto* expand = app.add_subcommand(
+      "expand",
+      "Write the scene as rdyn reads it -- generators (bicycle_leg) expanded into bodies and joints, --set "
+      "overrides applied, named points as coordinates, every default explicit, angles in radians -- as YAML that "
+      "every command loads as the same scene (checked before writing: the text is read back and must give the "
+      "same scene). Comments of the original are not kept.");
+  expand->add_option("scene", exp.scene, "Scene name or YAML file")->required();
+  expand->add_option("--set", exp.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  expand->add_option("--out", exp.out, "Output YAML file (default: standard output)");
+  expand->add_flag("--force", exp.force, kForceHelpFile);
 
   try {
     app.parse(argc, argv);
@@ -256,6 +268,7 @@ int main(int argc, char** argv) {
     if (*inspect) return run_inspect(ins);
     if (*export_mjcf) return run_export_mjcf(mj);
     if (*optimize) return run_optimize(opz);
+    if (*expand) return run_expand(exp);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
@@ -592,6 +593,9 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   r.constant = c0;
   r.optimised = c1;
   scene1.optimize.reset();
+  scene1.description = fmt::format("{} Optimised by rdyn optimize: {} shaped over {} to minimise the peak {} force at {:g} Hz.",
+                                   scene.description.substr(0, 3000), fmt::join(r.design_loads, ", "), design.of,
+                                   r.force_name, opt.cadence_hz);
   r.optimised_scene = scene1;
   r.reduction_reduced = 1 - c1.peak_reduced_N / c0.peak_reduced_N;
   r.reduction_full = 1 - c1.peak_full_N / c0.peak_full_N;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "models/scene_write.hpp"
 #include "models/scene_yaml.hpp"
 #include "validate/calibrate.hpp"
 #include "validate/optimize.hpp"
@@ -63,6 +64,11 @@ int run_optimize(const OptimizeArgs& a) {
   if (!failure.empty()) throw models::NumericalError(failure);
   const auto summary = optimize_summary(r);
   render_optimize_report(summary, dir.file(""));
+  // The optimised scene, loadable by every command (read back and checked by the writer).
+  write_text_file(dir.file("optimised.yaml"),
+                  "# Written by `rdyn optimize` from " + scene.name + ": the design loads profiled at the optimum, the "
+                  "calibrated amplitude and resistance, steady initial conditions.\n" +
+                      models::scene_to_yaml_checked(r.optimised_scene));
   dir.commit();
   // The headline numbers on standard output (the whole record is DIR/summary.json).
   nlohmann::json head = {{"scene", r.scene},

@@ -753,5 +753,77 @@ TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
   EXPECT_EQ(p.optimize->p, 12.0);
 }
 
+// Radian keys (what scene_to_yaml writes, models/scene_write.hpp): read exactly as given, one
+// unit per angle, none on a prismatic joint.
+TEST(SceneYaml, JointAnglesInRadiansReadExactly) {
+  const std::string y = with(kFourbar, "guess_deg: 90}", "offset_rad: 0.1234567890123, guess_rad: 1.5707}");
+  const Scene s = parse_scene(y, "t.yaml");
+  EXPECT_EQ(s.joints[2].offset_rad, 0.1234567890123);
+  EXPECT_EQ(s.joints[2].guess, 1.5707);
+  const SceneError both = refusal(with(kFourbar, "guess_deg: 90}", "guess_deg: 90, guess_rad: 1.5}"));
+  EXPECT_EQ(both.field(), "joints[2].guess_rad") << both.what();
+  EXPECT_NE(both.message().find("not both"), std::string::npos) << both.what();
+  EXPECT_EQ(both.line(), line_in(kFourbar, "name: rocker, type"));
+  const SceneError big = refusal(with(kFourbar, "guess_deg: 90}", "guess_rad: 2.0e6}"));
+  EXPECT_EQ(big.field(), "joints[2].guess_rad") << big.what();
+}
+
+TEST(SceneYaml, PrismaticJointRefusesRadianKeys) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/slider-crank.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  const SceneError e = refusal(with(text.str(), "guess_m: 0.2417}", "guess_m: 0.2417, offset_rad: 0.1}"));
+  EXPECT_NE(e.field().find("type"), std::string::npos) << e.what();
+  EXPECT_NE(e.message().find("guess_m"), std::string::npos) << e.what();
+}
+
+// table_rad: the same rows in radians give the same spline (to the rounding of x·π/180),
+// checked in degrees like table_deg.
+TEST(SceneYaml, ProfileTableInRadiansMatchesDegrees) {
+  auto scene = [](const std::string& table) {
+    return parse_scene(std::string(kFourbar) + "  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, " +
+                           table + "}}\n",
+                       "t.yaml");
+  };
+  const Scene deg = scene("table_deg: [[-10, 1], [100, 4], [200, 2]]");
+  const Scene rad = scene(fmt::format("table_rad: [[{}, 1], [{}, 4], [{}, 2]]", -10 * kPi / 180, 100 * kPi / 180,
+                                      200 * kPi / 180));
+  const auto& pr = *rad.joint_torques[0].profile;
+  EXPECT_EQ(pr.table_theta_rad[1], 100 * kPi / 180);  // as written
+  for (double th = -4; th < 4; th += 0.37)
+    EXPECT_NEAR(calc_profile(pr, th), calc_profile(*deg.joint_torques[0].profile, th), 1e-12) << th;
+  const std::string close = "table_rad: [[0, 1], [0.0001, 4], [3, 2]]";  // 0.0057° apart
+  const SceneError e = refusal(std::string(kFourbar) +
+                               "  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, " + close + "}}\n");
+  EXPECT_EQ(e.field(), "loads[1].profile.table_rad[1][0]") << e.what();
+  const SceneError two = refusal(std::string(kFourbar) +
+                                 "  - {type: joint_torque, name: p, joint: crank, profile: {of: crank, table_deg: [[0, "
+                                 "1], [90, 1], [180, 1]], table_rad: [[0, 1], [1, 1], [2, 1]]}}\n");
+  EXPECT_NE(two.message().find("one of them"), std::string::npos) << two.what();
+}
+
+// A direction or axis already of unit length to rounding is kept as written (so a written
+// scene reads back bit for bit); any other is normalised.
+TEST(SceneYaml, UnitVectorsAreKeptAsWritten) {
+  // A normalised vector whose rounded length is not 1: dividing by it again would move it.
+  double x = 1, y = 0;
+  for (int a = 1; a < 1000 && std::hypot(x, y) == 1.0; ++a) {
+    const double len = std::hypot(a, 7.0);
+    x = a / len, y = 7.0 / len;
+  }
+  ASSERT_NE(std::hypot(x, y), 1.0);
+  ASSERT_NEAR(std::hypot(x, y), 1.0, 4e-16);
+  const Scene s = parse_scene(std::string(kFourbar) + fmt::format(
+                                                          "outputs:\n  constraint_forces:\n    - {{name: u, joint: rocker, "
+                                                          "direction: [{}, {}]}}\n    - {{name: v, joint: rocker, "
+                                                          "direction: [3, 4]}}\n",
+                                                          x, y),
+                              "t.yaml");
+  EXPECT_EQ(s.outputs.constraint_forces[0].direction.x, x);
+  EXPECT_EQ(s.outputs.constraint_forces[0].direction.y, y);
+  EXPECT_NEAR(s.outputs.constraint_forces[1].direction.x, 0.6, 1e-16);
+  EXPECT_NEAR(s.outputs.constraint_forces[1].direction.y, 0.8, 1e-16);
+}
+
 }  // namespace
 }  // namespace rdyn::models
