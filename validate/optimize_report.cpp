@@ -91,16 +91,22 @@ json optimize_summary(const OptimizeResult& r) {
     loads.push_back({{"load", r.design_loads[i]},
                      {"same_as", r.same_as[i].empty() ? json(nullptr) : json(r.same_as[i])},
                      {"shift_deg", r.shift_deg[i]}});
+  // A value that is missing or not finite is null (an empty CSV field), never NaN.
+  const size_t n = r.constant.curves.angle_deg.size();
+  auto nums = [n](const std::vector<double>& v) {
+    json a = json::array();
+    for (size_t i = 0; i < n; ++i) a.push_back(i < v.size() && std::isfinite(v[i]) ? json(v[i]) : json(nullptr));
+    return a;
+  };
   json curves = {{"angle_deg", r.constant.curves.angle_deg}};
   for (size_t l = 0; l < r.design_loads.size(); ++l) {
-    curves[r.design_loads[l] + "_constant"] = r.constant.curves.torque_Nm[l];
-    curves[r.design_loads[l] + "_optimised"] = r.optimised.curves.torque_Nm[l];
+    curves[r.design_loads[l] + "_constant"] = nums(r.constant.curves.torque_Nm[l]);
+    curves[r.design_loads[l] + "_optimised"] = nums(r.optimised.curves.torque_Nm[l]);
   }
-  auto full = [](const std::vector<double>& v) { return v.empty() ? json(std::vector<double>(360, NAN)) : json(v); };
-  curves["force_constant_reduced"] = r.constant.curves.force_reduced_N;
-  curves["force_optimised_reduced"] = r.optimised.curves.force_reduced_N;
-  curves["force_constant_full"] = full(r.constant.curves.force_full_N);
-  curves["force_optimised_full"] = full(r.optimised.curves.force_full_N);
+  curves["force_constant_reduced"] = nums(r.constant.curves.force_reduced_N);
+  curves["force_optimised_reduced"] = nums(r.optimised.curves.force_reduced_N);
+  curves["force_constant_full"] = nums(r.constant.curves.force_full_N);
+  curves["force_optimised_full"] = nums(r.optimised.curves.force_full_N);
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return {{"scene", r.scene},
           {"status", optimize_failure_message(r).empty() ? "pass" : "fail"},
@@ -148,8 +154,9 @@ std::string optimize_profile_csv(const json& s) {
   const auto& angle = c.at("angle_deg");
   for (size_t i = 0; i < angle.size(); ++i) {
     out += fmt::format("{:g}", angle[i].get<double>());
-    for (const auto& n : cols) out += fmt::format(",{:.10g}", c.at(n)[i].get<double>());
-    for (const auto& n : fcols) {
+    std::vector<std::string> all = cols;
+    all.insert(all.end(), fcols.begin(), fcols.end());
+    for (const auto& n : all) {
       const auto& v = c.at(n)[i];
       out += v.is_number() ? fmt::format(",{:.10g}", v.get<double>()) : std::string(",");
     }
