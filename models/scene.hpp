@@ -301,6 +301,27 @@ struct Validation {
   std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };
 
+// The pedalling-strategy search of `rdyn optimize` (scene block `optimize`, models/README.md):
+// which drive loads get a shape τ(θ) = a0 + Σ_k a_k cos kθ + b_k sin kθ of a revolute joint's
+// angle, the constraint force whose peak (or p-norm) over the steady cycle it minimises, and the
+// bounds. The loads' common amplitude is not designed: it is calibrated per shape.
+inline constexpr int kMaxOptimizeHarmonics = 12;
+struct OptimizeLoad {
+  std::string load;         // a joint torque of the scene
+  std::string same_as;      // empty: a shape of its own; else the design load whose shape it takes
+  double shift_rad = 0.0;   // with same_as: τ(θ) = τ_same_as(θ − shift) [rad]
+};
+struct OptimizeSpec {
+  std::vector<OptimizeLoad> loads;  // empty: every joint torque, each its own shape
+  std::string of;                   // joint whose angle the shapes read; empty: the independent coordinate
+  std::string force;                // constraint force to minimise; empty: the first requested
+  int harmonics = 3;                // H, [1, kMaxOptimizeHarmonics]
+  double max_load = 0.0;            // bound on |value·τ(θ)| [N·m or N]; 0: 5× the calibrated constant value
+  bool nonnegative = true;          // τ(θ) ≥ 0 at the sampled angles (the load keeps its sign)
+  std::string objective = "peak";   // peak | pnorm
+  double p = 8.0;                   // pnorm exponent, [2, 64]
+};
+
 struct Scene {
   std::string name;
   std::string source_file;  // where it was read from (for messages)
@@ -322,6 +343,7 @@ struct Scene {
   Initial initial;
   Simulation simulation;
   Validation validation;
+  std::optional<OptimizeSpec> optimize;  // scene block `optimize` (rdyn optimize)
 
   // Lines (1-based) of the keys whose checks need the assembled model or a table, so that their
   // refusals name the line too: "independent_range" (or _deg), "initial", "loops.<name>.branch",

@@ -797,13 +797,85 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
   });
 }
 
+// The `optimize` block (rdyn optimize): every name known, every number in range, here where
+// the line is known.
+void read_optimize(const Fields& f, Scene& s) {
+  OptimizeSpec o;
+  auto is_torque = [&](const std::string& n) {
+    return std::any_of(s.joint_torques.begin(), s.joint_torques.end(), [&](const JointTorque& t) { return t.name == n; });
+  };
+  std::vector<YAML::Node> same_nodes;
+  for_each_item(f, "loads", [&](const YAML::Node& n, const std::string& path) {
+    Fields l(n, path, f.ctx(), {"load", "same_as", "shift_deg"});
+    OptimizeLoad d;
+    d.load = l.name("load");
+    if (!is_torque(d.load)) l.fail("load", "no joint_torque named '" + d.load + "' (design loads are joint torques)");
+    for (const auto& e : o.loads)
+      if (e.load == d.load) l.fail("load", "'" + d.load + "' is listed twice");
+    if (l.has("same_as")) {
+      d.same_as = l.name("same_as");
+      if (d.same_as == d.load) l.fail("same_as", "a load cannot take its own shape");
+    }
+    if (l.has("shift_deg") && !l.has("same_as")) l.fail("shift_deg", "a shift needs same_as");
+    d.shift_rad = l.num_abs_max("shift_deg", 0.0, 360.0, "degrees") * kPi / 180.0;
+    o.loads.push_back(d);
+    same_nodes.push_back(n);
+  });
+  if (f.has("loads") && o.loads.empty()) f.fail("loads", "list at least one design load, or leave the key out");
+  // Where the design is written: the refusals that need the whole design (calibration scales
+  // every joint torque together) come after loading.
+  s.key_lines["optimize"] = f.line();
+  if (f.has("loads")) s.key_lines["optimize.loads"] = line_of(f.raw("loads"));
+  for (size_t i = 0; i < o.loads.size(); ++i) {
+    const auto& d = o.loads[i];
+    if (d.same_as.empty()) continue;
+    const auto it = std::find_if(o.loads.begin(), o.loads.end(), [&](const OptimizeLoad& e) { return e.load == d.same_as; });
+    const std::string path = f.join("loads") + fmt::format("[{}].same_as", i);
+    if (it == o.loads.end())
+      f.fail_at(same_nodes[i]["same_as"], path, "'" + d.same_as + "' is not a design load listed in optimize.loads");
+    if (!it->same_as.empty())
+      f.fail_at(same_nodes[i]["same_as"], path,
+                "'" + d.same_as + "' takes its shape from '" + it->same_as + "': name that load instead");
+  }
+  if (f.has("of")) {
+    o.of = f.name("of");
+    const Joint* j = s.find_joint(o.of);
+    if (!j) f.fail("of", "unknown joint '" + o.of + "'");
+    if (j->type != JointType::Revolute) f.fail("of", "a profile reads a revolute joint's angle");
+  }
+  if (f.has("force")) {
+    o.force = f.name("force");
+    const auto& cf = s.outputs.constraint_forces;
+    if (std::none_of(cf.begin(), cf.end(), [&](const ConstraintForceRequest& c) { return c.name == o.force; }))
+      f.fail("force", "no requested constraint force named '" + o.force + "' (outputs.constraint_forces)");
+  }
+  if (f.has("harmonics")) {
+    const double h = f.num_in("harmonics", 1, kMaxOptimizeHarmonics, "");
+    if (h != std::floor(h)) f.fail("harmonics", fmt::format("must be a whole number (got {:g})", h));
+    o.harmonics = static_cast<int>(h);
+  }
+  if (f.has("max_load")) {
+    o.max_load = f.num("max_load");
+    if (!(o.max_load > 0 && o.max_load <= limits::kMaxForce))
+      f.fail("max_load", fmt::format("must be in (0, {:g}] N·m or N (got {:g})", limits::kMaxForce, o.max_load));
+  }
+  o.nonnegative = f.flag_or("nonnegative", true);
+  o.objective = f.str_or("objective", "peak");
+  if (o.objective != "peak" && o.objective != "pnorm") f.fail("objective", "expected peak or pnorm");
+  if (f.has("p")) {
+    o.p = f.num_in("p", 2, 64, "");
+    if (o.objective != "pnorm") f.fail("p", "an exponent needs objective: pnorm");
+  }
+  s.optimize = o;
+}
+
 // Reads the YAML tree into `s` (names and shapes checked here, values by check_scene).
 void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   Fields top(
       root, "", ctx,
       {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
        "independent", "independent_range", "independent_range_deg", "loads", "gravity", "outputs", "initial",
-       "simulation", "validation"});
+       "simulation", "validation", "optimize"});
   s.name = top.name("name");
   s.description = top.str_or("description", "");
 
@@ -978,6 +1050,10 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       s.validation.compare.push_back(cv);
     });
   }
+  if (top.has("optimize")) read_optimize(Fields(top.raw("optimize"), "optimize", ctx,
+                                                {"loads", "of", "force", "harmonics", "max_load", "nonnegative",
+                                                 "objective", "p"}),
+                                         s);
 }
 
 }  // namespace

@@ -268,30 +268,30 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
                                     scene.independent));
 }
 
-CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
-  const auto start = std::chrono::steady_clock::now();
+double calc_resistance_coefficient(const models::Scene& scene, const CalibrationOptions& opt) {
+  if (!(opt.power_w > 0)) return NAN;  // mean-speed mode: the resistances stay as given
+  const auto& res = scene.resistances[0];
+  const double omega_b = std::abs(*models::fixed_speed_ratio(scene, res.body)) * 2 * M_PI * opt.cadence_hz;
+  return opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
+}
+
+models::Scene with_unit_load(const models::Scene& scene, const CalibrationOptions& opt) {
+  return with_load(scene, select_load(scene, opt), 1.0, calc_resistance_coefficient(scene, opt));
+}
+
+CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
+                                    const CalibrationOptions& opt, Progress& progress) {
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
   };
-  check_calibratable(scene, opt);
   const Selection sel = select_load(scene, opt);
   const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
   CalibrationResult r;
   r.load = sel.name;
   r.load_kind = sel.kind;
   r.load_unit = sel.unit;
-  r.resistance_coefficient = NAN;  // mean-speed mode: the resistances stay as given
-  if (opt.power_w > 0) {
-    const auto& res = scene.resistances[0];
-    const double omega_b = std::abs(*models::fixed_speed_ratio(scene, res.body)) * 2 * M_PI * opt.cadence_hz;
-    r.resistance_coefficient = opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
-  }
-
-  // The table does not depend on load values: extract once.
-  progress.note("calibrate: extracting the reduced table");
-  const auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
-  auto m = reduced::make_reduced_model(e.samples, with_load(scene, sel, 1.0, r.resistance_coefficient),
-                                       reduced::parse_interpolation(opt.interpolation));
+  r.resistance_coefficient = calc_resistance_coefficient(scene, opt);
+  set_load(m, sel, 1.0);  // the energy balance below reads the selected loads at unit value
 
   // First guess from the energy balance per revolution at the constant target rate: the
   // load's work T·W_unit balances the work of every other non-conservative load, W_other
@@ -421,16 +421,12 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
         100 * kReducedCadenceTolerance));
 
   // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
-  auto fluct = [](const std::vector<double>& v, size_t from) {
-    double lo = INFINITY, hi = -INFINITY, sum = 0;
-    for (size_t i = from; i < v.size(); ++i) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]), sum += v[i];
-    return (hi - lo) / (sum / (v.size() - from));
-  };
   r.speed_fluctuation = cy.detail.speed_fluctuation;
   if (!scene.outputs.constraint_forces.empty()) {
     r.force_name = scene.outputs.constraint_forces[0].name;
     r.peak_force_N = cy.detail.peak_force_N[0];
   }
+  r.peak_forces_N = cy.detail.peak_force_N;
   if (sel.entries[0].motor) {
     // A motor's power depends on the speed: trapezoid rule over the periodic cycle samples
     // (spectrally accurate for a smooth periodic integrand).
@@ -452,6 +448,28 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions
   } else {
     r.mean_power_w = T * W_unit / cy.period;  // a position-dependent load: its work per revolution is exact
   }
+
+  r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
+  return r;
+}
+
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  check_calibratable(scene, opt);
+  const Selection sel = select_load(scene, opt);
+
+  // The table does not depend on load values: extract once.
+  progress.note("calibrate: extracting the reduced table");
+  const auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
+  auto m = reduced::make_reduced_model(e.samples, with_unit_load(scene, opt),
+                                       reduced::parse_interpolation(opt.interpolation));
+  CalibrationResult r = calibrate_reduced(m, scene, opt, progress);
+  const double T = std::abs(r.load_value);
+  auto fluct = [](const std::vector<double>& v, size_t from) {
+    double lo = INFINITY, hi = -INFINITY, sum = 0;
+    for (size_t i = from; i < v.size(); ++i) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]), sum += v[i];
+    return (hi - lo) / (sum / (v.size() - from));
+  };
 
   // Confirmation with the full model from the same point of the steady cycle.
   r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;

@@ -12,6 +12,7 @@
 
 #include "models/scene.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/reduced_model.hpp"
 #include "validate/progress.hpp"
 
 namespace rdyn::validate {
@@ -42,6 +43,7 @@ struct CalibrationResult {
   std::string force_name;               // first requested constraint force (empty if none)
   double peak_force_N = 0.0;            // max |F| over the steady cycle (reduced)
   double peak_force_full_N = 0.0;
+  std::vector<double> peak_forces_N;   // max |F| of every requested constraint force, in order (reduced)
   double speed_fluctuation = 0.0;       // (max − min)/mean of q̇ over the steady cycle (reduced)
   double speed_fluctuation_full = 0.0;
   // Work of the load per revolution per unit of its value at the constant target rate [J per
@@ -73,6 +75,23 @@ std::string load_value_column(const models::Scene& scene, const CalibrationOptio
 // no net work per revolution, a motor whose joint would turn beyond its no-load speed) come
 // from calibrate().
 void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt);
+
+// The coefficient of the scene's one resistance that dissipates opt.power_w at opt.cadence_hz
+// (P = c·ωⁿ, ω the resistance body's rate); NaN in mean-speed mode (no power).
+double calc_resistance_coefficient(const models::Scene& scene, const CalibrationOptions& opt);
+
+// `scene` with the load(s) opt.load selects at unit value (signs kept) and, with a power, the
+// resistance coefficient set: the scene whose reduced model calibrate_reduced takes.
+models::Scene with_unit_load(const models::Scene& scene, const CalibrationOptions& opt);
+
+// calibrate()'s reduced part on a model already built from the scene's table and
+// with_unit_load(scene, opt): the first guess from the energy balance per revolution, the
+// refusals that need the table (SceneError), Brent on the load value, the steady cycle there
+// (extremes and peak forces). Leaves `m` at the calibrated value; the full-model fields are NaN.
+// Does not call check_calibratable (the caller has). Throws NumericalError when no value
+// reaches F to 1e-6. A search over load shapes calls it once per shape on the same table.
+CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
+                                    const CalibrationOptions& opt, Progress& progress);
 
 // Throws as check_calibratable, and models::NumericalError when no value reaches F or the
 // result misses its target (reduced 1e-6, full 1 % of F).

@@ -11,6 +11,7 @@
 #include "validate/commands.hpp"
 #include "validate/expand.hpp"
 #include "validate/inspect.hpp"
+#include "validate/optimize_command.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/peers.hpp"
 
@@ -192,6 +193,41 @@ int main(int argc, char** argv) {
   export_mjcf->add_option("--integrator", mj.integrator, "<option integrator>: Euler or RK4")
       ->check(CLI::IsMember({"Euler", "RK4"}));
 
+  OptimizeArgs opz;
+  auto* optimize = app.add_subcommand(
+      "optimize",
+      "Find the shape of drive loads (truncated Fourier series of a joint angle, the scene's `optimize` block) that "
+      "minimises the peak (or p-norm) of a constraint force over the reduced steady cycle, the amplitude calibrated "
+      "per shape to hold the mean cadence (with --power-w: the resistance dissipating P at F); NLopt COBYLA; both the "
+      "constant strategy and the optimum confirmed with the full model. Writes DIR/summary.json, profile.csv, "
+      "report.html.");
+  optimize->add_option("scene", opz.scene, "Scene name or YAML file")->required();
+  auto* opz_cadence = optimize->add_option("--cadence-hz", opz.cadence_hz,
+                                           "Mean cadence [rev/s] (default: the scene's validation.calibrate, else 1)");
+  auto* opz_power = optimize->add_option("--power-w", opz.power_w,
+                                         "Power the resistance dissipates at that cadence [W] (default: the scene's "
+                                         "validation.calibrate; none: resistances as given)");
+  optimize->add_option("--harmonics", opz.harmonics, "Harmonics H of each shape, 1..12 (default: the scene's, else 3)");
+  optimize->add_option("--objective", opz.objective, "peak (default) or pnorm: (mean |F|^p)^(1/p) over the cycle")
+      ->check(CLI::IsMember({"peak", "pnorm"}));
+  optimize->add_option("--p", opz.p, "Exponent of pnorm, 2..64 (default 8)");
+  optimize->add_option("--max-load", opz.max_load,
+                       "Bound on |value·τ(θ)| of the design loads [N·m or N] (default: the scene's optimize.max_load, "
+                       "else 5× the constant strategy's value)");
+  optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
+  optimize->add_option("--add-torque", opz.add_torques,
+                       "Add a profiled torque torque_<JOINT> on a revolute joint as a further design load (signed "
+                       "shape; repeatable)");
+  optimize->add_option("--add-torque-max", opz.add_torque_max, "Bound on |torque_<JOINT>| [N·m] (default 50)");
+  optimize->add_option("--max-evaluations", opz.max_evaluations, "Optimiser evaluations, 1..100000 (default 400)");
+  optimize->add_option("--rel-tolerance", opz.rel_tolerance, "Optimiser relative tolerance (default 1e-4)");
+  optimize->add_option("--grid-deg", opz.grid_deg, "Reduced table grid [deg] (default 10)");
+  optimize->add_option("--interp", opz.interpolation, "Reduced table interpolation (default fourier)")
+      ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
+  optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
+  optimize->add_option("--set", opz.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  optimize->add_option("--out", opz.out, "Output folder (written atomically)")->required();
+  optimize->add_flag("--force", opz.force, kForceHelpDir);
   ExpandArgs exp;
   auto* expand = app.add_subcommand(
       "expand",
@@ -219,6 +255,8 @@ int main(int argc, char** argv) {
   cal.cadence_given = cal_cadence_opt->count() > 0;
   cal.power_given = cal_power_opt->count() > 0;
   if (dt_out_opt->count()) sim.dt_out = dt_out;
+  opz.cadence_given = opz_cadence->count() > 0;
+  opz.power_given = opz_power->count() > 0;
   if (tolerance_opt->count()) sim.tolerance = tolerance;
   try {
     if (*simulate) return run_simulate(sim);
@@ -229,6 +267,7 @@ int main(int argc, char** argv) {
     if (*report) return run_report(rep);
     if (*inspect) return run_inspect(ins);
     if (*export_mjcf) return run_export_mjcf(mj);
+    if (*optimize) return run_optimize(opz);
     if (*expand) return run_expand(exp);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());

@@ -692,6 +692,67 @@ TEST(SceneYaml, ProfileOfAPrismaticJointIsRefused) {
 }
 
 
+// The optimize block (rdyn optimize): read as written, and every bad field refused with its
+// line and dotted path.
+TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string y = ss.str();
+  const Scene s = parse_scene(y, "bicycle.yaml");
+  ASSERT_TRUE(s.optimize);
+  ASSERT_EQ(s.optimize->loads.size(), 2u);
+  EXPECT_EQ(s.optimize->loads[1].load, "hip_torque_l");
+  EXPECT_EQ(s.optimize->loads[1].same_as, "hip_torque_r");
+  EXPECT_NEAR(s.optimize->loads[1].shift_rad, kPi, 1e-15);
+  EXPECT_EQ(s.optimize->force, "knee");
+  EXPECT_EQ(s.optimize->harmonics, 3);
+  EXPECT_EQ(s.optimize->max_load, 250.0);
+  EXPECT_TRUE(s.optimize->nonnegative);
+  EXPECT_EQ(s.optimize->objective, "peak");
+  // The block is not part of the mechanism: the scene hash ignores it.
+  const std::string without = y.substr(0, y.find("optimize:"));
+  EXPECT_EQ(scene_hash(parse_scene(without, "b.yaml")), scene_hash(s));
+  EXPECT_FALSE(parse_scene(without, "b.yaml").optimize);
+
+  struct Case {
+    std::string from, to, field, says;
+  };
+  const std::vector<Case> cases{
+      {"{load: hip_torque_r}", "{load: hip_torque_x}", "optimize.loads[0].load", "no joint_torque named"},
+      {"same_as: hip_torque_r,", "same_as: hip_torque_l,", "optimize.loads[1].same_as", "its own shape"},
+      {"{load: hip_torque_r}", "{load: hip_torque_r, same_as: hip_torque_l}", "optimize.loads[0].same_as",
+       "takes its shape from"},
+      {"- {load: hip_torque_r}\n", "", "optimize.loads[0].same_as", "not a design load listed"},
+      {"shift_deg: 180", "shift_deg: .nan", "optimize.loads[1].shift_deg", "finite"},
+      {"shift_deg: 180", "shift_deg: 400", "optimize.loads[1].shift_deg", "360"},
+      {"{load: hip_torque_r}", "{load: hip_torque_r, shift_deg: 10}", "optimize.loads[0].shift_deg", "needs same_as"},
+      {"harmonics: 3", "harmonics: 13", "optimize.harmonics", "[1, 12]"},
+      {"harmonics: 3", "harmonics: 0", "optimize.harmonics", "[1, 12]"},
+      {"harmonics: 3", "harmonics: 2.5", "optimize.harmonics", "whole number"},
+      {"max_load: 250", "max_load: -1", "optimize.max_load", "must be in"},
+      {"max_load: 250", "max_load: 1e9", "optimize.max_load", "must be in"},
+      {"force: knee", "force: ankle", "optimize.force", "no requested constraint force"},
+      {"objective: peak", "objective: mean", "optimize.objective", "peak or pnorm"},
+      {"objective: peak", "objective: peak\n  p: 4", "optimize.p", "pnorm"},
+      {"objective: peak", "objective: pnorm\n  p: 1", "optimize.p", "[2, 64]"},
+      {"nonnegative: true", "nonnegative: maybe", "optimize.nonnegative", "true or false"},
+      {"objective: peak", "objective: peak\n  of: pedal_r", "optimize.of", "unknown joint"},
+      {"objective: peak", "objective: peak\n  sharpness: 3", "optimize.sharpness", "unknown key"},
+  };
+  for (const auto& c : cases) {
+    const std::string bad = with(y, c.from, c.to);
+    const SceneError e = refusal(bad);
+    EXPECT_EQ(e.field(), c.field) << c.to << ": " << e.what();
+    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
+    EXPECT_GT(e.line(), line_in(bad, "optimize:") - 1) << e.what();
+  }
+  // pnorm with its exponent parses.
+  const Scene p = parse_scene(with(y, "objective: peak", "objective: pnorm\n  p: 12"), "b.yaml");
+  EXPECT_EQ(p.optimize->objective, "pnorm");
+  EXPECT_EQ(p.optimize->p, 12.0);
+}
+
 // Radian keys (what scene_to_yaml writes, models/scene_write.hpp): read exactly as given, one
 // unit per angle, none on a prismatic joint.
 TEST(SceneYaml, JointAnglesInRadiansReadExactly) {
