@@ -248,8 +248,8 @@ void write_profile(Writer& w, const LoadProfile& p, const std::string& f) {
 // Loads by kind (torques, resistances, springs, motors), each kind in scene order: the reader keeps
 // one list per kind, so this order reads back to the same lists.
 void write_loads(Writer& w, const Scene& s) {
-  const bool none =
-      s.joint_torques.empty() && s.resistances.empty() && s.springs.empty() && s.motors.empty();
+  const bool none = s.joint_torques.empty() && s.resistances.empty() && s.springs.empty() &&
+                    s.point_forces.empty() && s.motors.empty();
   w.line(none ? "loads: []" : "loads:");
   for (const auto& t : s.joint_torques) {
     const std::string f = "loads." + t.name;
@@ -283,6 +283,20 @@ void write_loads(Writer& w, const Scene& s) {
     w.line("    point_b: " + w.vec(sp.point_b, f + ".point_b"));
     w.line("    stiffness_N_per_m: " + w.num(sp.stiffness_N_per_m, f + ".stiffness_N_per_m"));
     w.line("    rest_length_m: " + w.num(sp.rest_length_m, f + ".rest_length_m"));
+  }
+  for (const auto& pf : s.point_forces) {
+    const std::string f = "loads." + pf.name;
+    w.line("  - type: point_force");
+    w.line("    name: " + w.text(pf.name));
+    w.line("    body_a: " + w.text(pf.body_a));
+    w.line("    point_a: " + w.vec(pf.point_a, f + ".point_a"));
+    w.line("    body_b: " + w.text(pf.body_b));
+    w.line("    point_b: " + w.vec(pf.point_b, f + ".point_b"));
+    w.line("    force_N: " + w.num(pf.value, f + ".force_N") + (pf.profile ? "  # amplitude of the profile" : ""));
+    if (pf.active_when)
+      w.line("    active_when: {joint: " + w.text(pf.active_when->joint) +
+             ", rate: " + (pf.active_when->sign > 0 ? "positive" : "negative") + "}");
+    if (pf.profile) write_profile(w, *pf.profile, f + ".profile");
   }
   for (const auto& m : s.motors) {
     const std::string f = "loads." + m.name;
@@ -354,6 +368,29 @@ void write_validation(Writer& w, const Scene& s) {
   }
 }
 
+// The `optimize` block (rdyn optimize's design), shifts in radians so they read back exactly.
+void write_optimize(Writer& w, const OptimizeSpec& o) {
+  w.line("optimize:");
+  if (!o.loads.empty()) {
+    w.line("  loads:");
+    for (size_t i = 0; i < o.loads.size(); ++i) {
+      const auto& d = o.loads[i];
+      std::string item = "    - {load: " + w.text(d.load);
+      if (!d.same_as.empty())
+        item += ", same_as: " + w.text(d.same_as) + ", shift_rad: " +
+                w.num(d.shift_rad, fmt::format("optimize.loads[{}].shift_rad", i));
+      w.line(item + "}");
+    }
+  }
+  if (!o.of.empty()) w.line("  of: " + w.text(o.of));
+  if (!o.force.empty()) w.line("  force: " + w.text(o.force));
+  w.line(fmt::format("  harmonics: {}", o.harmonics));
+  if (o.max_load > 0) w.line("  max_load: " + w.num(o.max_load, "optimize.max_load"));
+  w.line(std::string("  nonnegative: ") + (o.nonnegative ? "true" : "false"));
+  w.line("  objective: " + w.text(o.objective));
+  if (o.objective == "pnorm") w.line("  p: " + w.num(o.p, "optimize.p"));
+}
+
 }  // namespace
 
 std::string scene_to_yaml(const Scene& s) {
@@ -381,6 +418,7 @@ std::string scene_to_yaml(const Scene& s) {
          w.num(s.simulation.output_interval_s, "simulation.output_interval_s") +
          ", tolerance: " + w.num(s.simulation.tolerance, "simulation.tolerance") + "}");
   write_validation(w, s);
+  if (s.optimize) write_optimize(w, *s.optimize);
   return w.take();
 }
 

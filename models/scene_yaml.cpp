@@ -806,7 +806,7 @@ void read_optimize(const Fields& f, Scene& s) {
   };
   std::vector<YAML::Node> same_nodes;
   for_each_item(f, "loads", [&](const YAML::Node& n, const std::string& path) {
-    Fields l(n, path, f.ctx(), {"load", "same_as", "shift_deg"});
+    Fields l(n, path, f.ctx(), {"load", "same_as", "shift_deg", "shift_rad"});
     OptimizeLoad d;
     d.load = l.name("load");
     if (!is_torque(d.load)) l.fail("load", "no joint_torque named '" + d.load + "' (design loads are joint torques)");
@@ -816,8 +816,12 @@ void read_optimize(const Fields& f, Scene& s) {
       d.same_as = l.name("same_as");
       if (d.same_as == d.load) l.fail("same_as", "a load cannot take its own shape");
     }
-    if (l.has("shift_deg") && !l.has("same_as")) l.fail("shift_deg", "a shift needs same_as");
-    d.shift_rad = l.num_abs_max("shift_deg", 0.0, 360.0, "degrees") * kPi / 180.0;
+    for (const char* k : {"shift_deg", "shift_rad"})
+      if (l.has(k) && !l.has("same_as")) l.fail(k, "a shift needs same_as");
+    if (l.has("shift_deg") && l.has("shift_rad")) l.fail("shift_rad", "give shift_deg or shift_rad, not both");
+    // shift_rad: how rdyn writes it back (degrees do not reach every radian value exactly).
+    d.shift_rad = l.has("shift_rad") ? l.num_abs_max("shift_rad", 0.0, 2 * kPi, "rad")
+                                     : l.num_abs_max("shift_deg", 0.0, 360.0, "degrees") * kPi / 180.0;
     o.loads.push_back(d);
     same_nodes.push_back(n);
   });

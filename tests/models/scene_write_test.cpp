@@ -125,6 +125,37 @@ std::string dump(const Scene& s) {
         .vec("pb", sp.point_b)
         .num("k", sp.stiffness_N_per_m)
         .num("L0", sp.rest_length_m);
+  d.integer("point_forces", static_cast<long>(s.point_forces.size()));
+  for (const auto& pf : s.point_forces) {
+    d.str("point_force", pf.name)
+        .str("a", pf.body_a)
+        .vec("pa", pf.point_a)
+        .str("b", pf.body_b)
+        .vec("pb", pf.point_b)
+        .num("value", pf.value)
+        .integer("gate", pf.active_when ? 1 : 0);
+    if (pf.active_when) d.str("gate_joint", pf.active_when->joint).integer("gate_sign", pf.active_when->sign);
+    d.integer("profile", pf.profile ? 1 : 0);
+    if (pf.profile)
+      d.str("of", pf.profile->of)
+          .num("a0", pf.profile->a0)
+          .nums("a", pf.profile->a)
+          .nums("b", pf.profile->b)
+          .nums("theta", pf.profile->table_theta_rad)
+          .nums("tau", pf.profile->table_value);
+  }
+  d.integer("optimize", s.optimize ? 1 : 0);
+  if (s.optimize) {
+    const auto& o = *s.optimize;
+    for (const auto& l : o.loads) d.str("design", l.load).str("same_as", l.same_as).num("shift", l.shift_rad);
+    d.str("of", o.of)
+        .str("force", o.force)
+        .integer("harmonics", o.harmonics)
+        .num("max_load", o.max_load)
+        .integer("nonnegative", o.nonnegative ? 1 : 0)
+        .str("objective", o.objective)
+        .num("p", o.p);
+  }
   d.integer("motors", static_cast<long>(s.motors.size()));
   for (const auto& m : s.motors)
     d.str("motor", m.name)
