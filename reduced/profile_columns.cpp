@@ -55,6 +55,9 @@ void refit_profile_columns(ReducedModel& m, const Samples& s, Interpolation inte
       for (int k = 0; k < 4; ++k)
         m.table.coef[(static_cast<size_t>(iv) * m.table.cols + dest[c]) * 4 + k] =
             t.coef[(static_cast<size_t>(iv) * t.cols + c) * 4 + k];
+  // The fused evaluations read packed copies of the columns: repack them from the new table.
+  m.rhs_block = make_column_block(m.table, m.rhs_cols);
+  m.record_block = make_column_block(m.table, m.record_cols);
 }
 
 }  // namespace rdyn::reduced

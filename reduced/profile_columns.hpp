@@ -27,8 +27,9 @@ std::vector<double> calc_profile_angles(const Samples& s, const models::Scene& s
 Samples with_profile_columns(Samples s, const models::Scene& scene);
 
 // Refits the tau columns of `s` (from with_profile_columns) into m's table with the
-// interpolation m was built with; every other column is left as it is. Throws TableError when
-// the grids differ.
+// interpolation m was built with; every other column is left as it is, and the packed column
+// blocks (rhs_block, record_block) are rebuilt from the new table. Throws TableError when the
+// grids differ.
 void refit_profile_columns(ReducedModel& m, const Samples& s, Interpolation interp);
 
 }  // namespace rdyn::reduced

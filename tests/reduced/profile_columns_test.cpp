@@ -64,6 +64,22 @@ TEST(ProfileColumns, NewShapeOnTheSameTableEqualsAFreshExtraction) {
                            0.2 * std::sin(q) - 0.07 * std::sin(3 * q);
         EXPECT_NEAR(m.table.eval(m.torques[0].c_tau, q), tau, 1e-10) << q;
       }
+    // The equation of motion and the output rows see the new shape too (they read packed copies
+    // of the columns, which must follow the refit).
+    ReducedWorkspace ws(m), ws_ref(ref);
+    init_gates(m, ws);
+    init_gates(ref, ws_ref);
+    for (double q : {0.05, 1.234, 3.3, 5.9}) {
+      double a = 0, p = 0, a_ref = 0, p_ref = 0;
+      calc_acceleration(m, ws, q, 2.0, a, p);
+      calc_acceleration(ref, ws_ref, q, 2.0, a_ref, p_ref);
+      EXPECT_NEAR(a, a_ref, 1e-11 * (1 + std::abs(a_ref))) << q;
+      EXPECT_NEAR(p, p_ref, 1e-11 * (1 + std::abs(p_ref))) << q;
+      std::vector<double> f(m.force_names.size() + 1), f_ref(f.size());
+      EXPECT_NEAR(calc_sample(m, ws, q, 2.0, a, p, f.data()), calc_sample(ref, ws_ref, q, 2.0, a_ref, p_ref, f_ref.data()),
+                  1e-11);
+      EXPECT_NEAR(p, p_ref, 1e-11 * (1 + std::abs(p_ref))) << q;
+    }
   }
 }
 
