@@ -245,6 +245,15 @@ void write_profile(Writer& w, const LoadProfile& p, const std::string& f) {
   }
 }
 
+// The optional rate gate and profile of a drive load (joint torque or point force).
+void write_gate_and_profile(Writer& w, const std::optional<RateGate>& gate, const std::optional<LoadProfile>& profile,
+                            const std::string& f) {
+  if (gate)
+    w.line("    active_when: {joint: " + w.text(gate->joint) + ", rate: " + (gate->sign > 0 ? "positive" : "negative") +
+           "}");
+  if (profile) write_profile(w, *profile, f + ".profile");
+}
+
 // Loads by kind (torques, resistances, springs, motors), each kind in scene order: the reader keeps
 // one list per kind, so this order reads back to the same lists.
 void write_loads(Writer& w, const Scene& s) {
@@ -260,10 +269,7 @@ void write_loads(Writer& w, const Scene& s) {
     const std::string key = prismatic ? "force_N" : "torque_Nm";
     w.line("    " + key + ": " + w.num(t.value, f + "." + key) +
            (t.profile ? "  # amplitude of the profile" : ""));
-    if (t.active_when)
-      w.line("    active_when: {joint: " + w.text(t.active_when->joint) +
-             ", rate: " + (t.active_when->sign > 0 ? "positive" : "negative") + "}");
-    if (t.profile) write_profile(w, *t.profile, f + ".profile");
+    write_gate_and_profile(w, t.active_when, t.profile, f);
   }
   for (const auto& r : s.resistances) {
     const std::string f = "loads." + r.name;
@@ -293,10 +299,7 @@ void write_loads(Writer& w, const Scene& s) {
     w.line("    body_b: " + w.text(pf.body_b));
     w.line("    point_b: " + w.vec(pf.point_b, f + ".point_b"));
     w.line("    force_N: " + w.num(pf.value, f + ".force_N") + (pf.profile ? "  # amplitude of the profile" : ""));
-    if (pf.active_when)
-      w.line("    active_when: {joint: " + w.text(pf.active_when->joint) +
-             ", rate: " + (pf.active_when->sign > 0 ? "positive" : "negative") + "}");
-    if (pf.profile) write_profile(w, *pf.profile, f + ".profile");
+    write_gate_and_profile(w, pf.active_when, pf.profile, f);
   }
   for (const auto& m : s.motors) {
     const std::string f = "loads." + m.name;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <tuple>
+#include <utility>
 
 #include "../reduced/analytic_source.hpp"
 #include "engine/kinetostatic.hpp"
@@ -198,6 +200,32 @@ TEST(ReducedSource, SwitchAnglesAreZerosOfTheThighRate) {
   }
 }
 
+// The scene over 3 s in both models (5° fourier table at 1e-10; Simbody at 1e-10), 10 ms rows.
+std::pair<models::TimeSeries, models::TimeSeries> reduced_and_full_3s(const models::Scene& scene) {
+  const auto samples = extract(scene, 5, reduced::Method::Kinetostatic);
+  const auto m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Fourier);
+  reduced::ReducedOptions ro;
+  ro.duration_s = 3.0;
+  ro.output_interval_s = 0.01;
+  ro.tolerance = 1e-10;
+  ForwardOptions fo;
+  fo.duration_s = 3.0;
+  fo.output_interval_s = 0.01;
+  fo.tolerance = 1e-10;
+  return {reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro), simulate_full(FullModel(scene), fo)};
+}
+
+// Largest |Δq|, |Δq̇| and |ΔF| of the first constraint force between two runs on the same rows.
+std::tuple<double, double, double> max_differences(const models::TimeSeries& a, const models::TimeSeries& b) {
+  double dq = 0, dqdot = 0, dF = 0;
+  for (size_t i = 0; i < a.t.size(); ++i) {
+    dq = std::max(dq, std::abs(a.q[i] - b.q[i]));
+    dqdot = std::max(dqdot, std::abs(a.qdot[i] - b.qdot[i]));
+    dF = std::max(dF, std::abs(a.forces[0][i] - b.forces[0][i]));
+  }
+  return {dq, dqdot, dF};
+}
+
 TEST(ReducedSource, ProfiledTorquesAgreeBetweenReducedAndFullModels) {
   // The four-bar driven by a table profile of the rocker's angle (gated by the rocker's rate)
   // and a Fourier profile of the crank's angle: the reduced model's tau_<load> columns against
@@ -209,25 +237,9 @@ TEST(ReducedSource, ProfiledTorquesAgreeBetweenReducedAndFullModels) {
       "  - {type: joint_torque, name: wave, joint: crank, profile: {of: crank, fourier: {a0: 1.5, a: [0.5], b: [0, "
       "0.3]}}}\n";
   const auto scene = models::parse_scene(test::fourbar_with_loads(loads, "0.05"), "profiled.yaml");
-  const auto samples = extract(scene, 5, reduced::Method::Kinetostatic);
-  const auto m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Fourier);
-  reduced::ReducedOptions ro;
-  ro.duration_s = 3.0;
-  ro.output_interval_s = 0.01;
-  ro.tolerance = 1e-10;
-  const auto red = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
-  ForwardOptions fo;
-  fo.duration_s = 3.0;
-  fo.output_interval_s = 0.01;
-  fo.tolerance = 1e-10;
-  const auto full = simulate_full(FullModel(scene), fo);
+  const auto [red, full] = reduced_and_full_3s(scene);
   ASSERT_EQ(red.t.size(), full.t.size());
-  double dq = 0, dqdot = 0, dF = 0;
-  for (size_t i = 0; i < red.t.size(); ++i) {
-    dq = std::max(dq, std::abs(red.q[i] - full.q[i]));
-    dqdot = std::max(dqdot, std::abs(red.qdot[i] - full.qdot[i]));
-    dF = std::max(dF, std::abs(red.forces[0][i] - full.forces[0][i]));
-  }
+  const auto [dq, dqdot, dF] = max_differences(red, full);
   const double peak_F = max_abs(full.forces[0]);
   std::printf("profiled four-bar, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| %.3g N (of %.3g)\n",
               dq, dqdot, max_abs(full.qdot), dF, peak_F);
@@ -272,25 +284,9 @@ TEST(ReducedSource, ProfiledGatedPointForceAgreesBetweenReducedAndFullModels) {
       "     force_N: 6, active_when: {joint: rocker, rate: negative},\n"
       "     profile: {of: rocker, fourier: {a0: 1, a: [0.4], b: [0.2]}}}\n";
   const auto scene = models::parse_scene(test::fourbar_with_loads(loads, "0.05"), "muscle.yaml");
-  const auto samples = extract(scene, 5, reduced::Method::Kinetostatic);
-  const auto m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Fourier);
-  reduced::ReducedOptions ro;
-  ro.duration_s = 3.0;
-  ro.output_interval_s = 0.01;
-  ro.tolerance = 1e-10;
-  const auto red = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
-  ForwardOptions fo;
-  fo.duration_s = 3.0;
-  fo.output_interval_s = 0.01;
-  fo.tolerance = 1e-10;
-  const auto full = simulate_full(FullModel(scene), fo);
+  const auto [red, full] = reduced_and_full_3s(scene);
   ASSERT_EQ(red.t.size(), full.t.size());
-  double dq = 0, dqdot = 0, dF = 0;
-  for (size_t i = 0; i < red.t.size(); ++i) {
-    dq = std::max(dq, std::abs(red.q[i] - full.q[i]));
-    dqdot = std::max(dqdot, std::abs(red.qdot[i] - full.qdot[i]));
-    dF = std::max(dF, std::abs(red.forces[0][i] - full.forces[0][i]));
-  }
+  const auto [dq, dqdot, dF] = max_differences(red, full);
   const double peak_F = max_abs(full.forces[0]);
   std::printf("four-bar with a point force, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| "
               "%.3g N (of %.3g)\n",

@@ -54,6 +54,16 @@ class Dump {
   }
 };
 
+void dump_profile(Dump& d, const LoadProfile& p) {
+  d.str("of", p.of)
+      .num("a0", p.a0)
+      .nums("a", p.a)
+      .nums("b", p.b)
+      .nums("theta", p.table_theta_rad)
+      .nums("tau", p.table_value)
+      .nums("d2", p.table_d2);
+}
+
 std::string dump(const Scene& s) {
   Dump d;
   d.str("name", s.name).str("description", s.description);
@@ -101,14 +111,7 @@ std::string dump(const Scene& s) {
     if (t.active_when)
       d.str("gate_joint", t.active_when->joint).integer("gate_sign", t.active_when->sign);
     d.integer("profile", t.profile ? 1 : 0);
-    if (t.profile)
-      d.str("of", t.profile->of)
-          .num("a0", t.profile->a0)
-          .nums("a", t.profile->a)
-          .nums("b", t.profile->b)
-          .nums("theta", t.profile->table_theta_rad)
-          .nums("tau", t.profile->table_value)
-          .nums("d2", t.profile->table_d2);
+    if (t.profile) dump_profile(d, *t.profile);
   }
   d.integer("resistances", static_cast<long>(s.resistances.size()));
   for (const auto& r : s.resistances)
@@ -136,13 +139,7 @@ std::string dump(const Scene& s) {
         .integer("gate", pf.active_when ? 1 : 0);
     if (pf.active_when) d.str("gate_joint", pf.active_when->joint).integer("gate_sign", pf.active_when->sign);
     d.integer("profile", pf.profile ? 1 : 0);
-    if (pf.profile)
-      d.str("of", pf.profile->of)
-          .num("a0", pf.profile->a0)
-          .nums("a", pf.profile->a)
-          .nums("b", pf.profile->b)
-          .nums("theta", pf.profile->table_theta_rad)
-          .nums("tau", pf.profile->table_value);
+    if (pf.profile) dump_profile(d, *pf.profile);
   }
   d.integer("optimize", s.optimize ? 1 : 0);
   if (s.optimize) {
