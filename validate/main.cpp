@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
   optimize->add_option("--max-load", opz.max_load,
                        "Bound on |value·τ(θ)| of the design loads [N·m or N] (default: the scene's optimize.max_load, "
                        "else 5× the constant strategy's value)");
-  optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
+  auto* opz_force_name = optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
   optimize->add_option("--add-torque", opz.add_torques,
                        "Add a profiled torque torque_<JOINT> on a revolute joint as a further design load (signed "
                        "shape; repeatable)");
@@ -256,6 +256,7 @@ int main(int argc, char** argv) {
   cal.power_given = cal_power_opt->count() > 0;
   if (dt_out_opt->count()) sim.dt_out = dt_out;
   opz.cadence_given = opz_cadence->count() > 0;
+  opz.force_name_given = opz_force_name->count() > 0;
   opz.power_given = opz_power->count() > 0;
   if (tolerance_opt->count()) sim.tolerance = tolerance;
   try {

@@ -32,6 +32,7 @@ int run_optimize(const OptimizeArgs& a) {
   if (a.harmonics && !(*a.harmonics >= 1 && *a.harmonics <= models::kMaxOptimizeHarmonics))
     bad("--harmonics", fmt::format("must be a whole number in [1, {}] (got {})", models::kMaxOptimizeHarmonics,
                                    *a.harmonics));
+  if (a.force_name_given && a.force_name.empty()) bad("--force-name", "an empty name names no constraint force");
   if (a.p && !(*a.p >= 2 && *a.p <= 64)) bad("--p", fmt::format("must be in [2, 64] (got {:g})", *a.p));
   if (a.max_load && !(*a.max_load > 0 && *a.max_load <= models::limits::kMaxForce))
     bad("--max-load", fmt::format("must be in (0, {:g}] N·m or N (got {:g})", models::limits::kMaxForce, *a.max_load));

@@ -18,6 +18,7 @@ struct OptimizeArgs {
   std::string objective;
   std::optional<double> p, max_load;
   std::string force_name;
+  bool force_name_given = false;  // typed, even empty (refused)
   std::vector<std::string> add_torques;
   double add_torque_max = 50.0;
   int max_evaluations = 400;

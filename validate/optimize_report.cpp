@@ -56,7 +56,7 @@ std::string figure_gp(const json& s, bool torques) {
   const auto& loads = s.at("design_loads");
   const std::string force = s.at("force_name").get<std::string>();
   std::string gp =
-      "set terminal svg size 960,420 dynamic enhanced font 'sans,11' background rgb 'white'\n"
+      "set terminal svg size 960,420 dynamic noenhanced font 'sans,11' background rgb 'white'\n"
       "set datafile separator ','\nset grid\nset key outside right\nset xrange [0:360]\nset xtics 45\n";
   gp += fmt::format("set output '{}'\nset xlabel {}\n", torques ? "torques.svg" : "force.svg",
                     gnuplot_quoted(s.at("independent").get<std::string>() + " angle [deg]"));

@@ -180,6 +180,8 @@ TEST(OptimizeCli, RefusalsExitTwoAndWriteNothing) {
       {{"--set", "optimize.harmonics=40"}, "optimize.harmonics"},
       {{"--set", "optimize.loads.0.load=nobody"}, "optimize.loads"},
       {{"--objective", "mean"}, "--objective"},
+      {{"--force-name", ""}, "an empty name"},
+      {{"--add-torque", "knee_r", "--add-torque", "knee_r"}, "joint 'knee_r' is given twice"},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args{"optimize", "bicycle", "--out", "out"};
@@ -190,6 +192,12 @@ TEST(OptimizeCli, RefusalsExitTwoAndWriteNothing) {
     EXPECT_EQ(run.err.find("internal error"), std::string::npos) << run.err;
     EXPECT_FALSE(fs::exists(dir / "out")) << c.says;
   }
+  // A scene whose drive is not a joint torque (bicycle-muscle: point forces) is told what
+  // optimize shapes, and how to add one.
+  const auto muscle = test::run_rdyn({"optimize", "bicycle-muscle", "--out", "out"}, dir);
+  EXPECT_EQ(muscle.status, 2) << muscle.err;
+  EXPECT_NE(muscle.err.find("optimize shapes joint torques and the scene has none"), std::string::npos) << muscle.err;
+  EXPECT_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
 
