@@ -212,8 +212,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"peak", "pnorm"}));
   optimize->add_option("--p", opz.p, "Exponent of pnorm, 2..64 (default 8)");
   optimize->add_option("--max-load", opz.max_load,
-                       "Bound on |value·τ(θ)| of the design loads [N·m or N] (default: the scene's optimize.max_load, "
-                       "else 5× the constant strategy's value)");
+                       "Bound on |value·τ(θ)| of the scene's design loads [N·m or N] (default: the scene's optimize.max_load, "
+                       "else 5× the constant strategy's value; loads added by --add-torque take --add-torque-max)");
   auto* opz_force_name = optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
   optimize->add_option("--add-torque", opz.add_torques,
                        "Add a profiled torque torque_<JOINT> on a revolute joint as a further design load (signed "
