@@ -124,6 +124,12 @@ void not_a_knot_coefficients(const std::vector<double>& y, double h, int col, in
 
 int Table::locate(double q, double& dx) const {
   const double u = (q - q0) / step;
+  // NaN, or beyond the exactly representable integers: no interval (the cast would be undefined);
+  // dx is NaN for NaN so callers see a non-finite value and report it.
+  if (!(std::abs(u) < 4.0e18)) {
+    dx = u - u;
+    return 0;
+  }
   // floor(u) by truncation and one correction (exact for |u| < 2^63, the same value as
   // std::floor, which without SSE4.1 is a library call on the hot path).
   long i = static_cast<long>(u);
