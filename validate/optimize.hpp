@@ -1,4 +1,4 @@
-// The pedalling strategy that minimises a constraint force (issue #13, `rdyn optimize`): the
+// The drive-load shape that minimises a constraint force (issue #13, `rdyn optimize`): the
 // shape of one or more drive loads as truncated Fourier series of a revolute joint's angle,
 //   τ(θ) = a0 + Σ_{k=1..H} a_k cos kθ + b_k sin kθ,
 // each load keeping its rate gate, searched by NLopt's COBYLA on the reduced model's steady
