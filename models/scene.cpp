@@ -30,10 +30,15 @@ int Scene::line_of(const std::string& key) const {
   return it == key_lines.end() ? 0 : it->second;
 }
 
+std::string Scene::field_of(const std::string& key) const {
+  const auto it = key_overrides.find(key);
+  return it == key_overrides.end() ? key : "--set " + it->second;
+}
+
 std::string where(const Scene& scene, const std::string& key) {
   std::string w = scene.source_file.empty() ? std::string("<scene>") : scene.source_file;
   if (const int line = scene.line_of(key); line > 0) w += fmt::format(":{}", line);
-  return w + fmt::format(": field '{}'", key);
+  return w + fmt::format(": field '{}'", scene.field_of(key));
 }
 
 const Body* Scene::find_body(const std::string& n) const {

@@ -347,11 +347,16 @@ struct Scene {
 
   // Lines (1-based) of the keys whose checks need the assembled model or a table, so that their
   // refusals name the line too: "independent_range" (or _deg), "initial", "loops.<name>.branch",
-  // "validation.calibrate.load", "outputs.reactions", "loads.<point force>.point_b". Filled by the YAML reader; where the key
+  // "validation.calibrate.load", "outputs.reactions", "loads.<point force>.point_b", "loads.<name>". Filled by the YAML reader; where the key
   // came from, not part of the description (not hashed, not written back).
   std::map<std::string, int> key_lines;
+  // The same keys when a `--set` override gave their value: key → the override's key path (its
+  // line is then 0): a refusal of such a value names the --set argument, not the file's line.
+  std::map<std::string, std::string> key_overrides;
 
   int line_of(const std::string& key) const;  // 0 when unknown
+  // The field a refusal of `key` names: "--set <path>" when an override gave it, else `key`.
+  std::string field_of(const std::string& key) const;
   const Body* find_body(const std::string& name) const;
   const Joint* find_joint(const std::string& name) const;
   int joint_index(const std::string& name) const;  // −1 when absent

@@ -216,6 +216,17 @@ struct Context {
   }
 };
 
+// Records where `key` of the scene was given: the node's line, or the --set override that
+// set it (Scene::key_overrides), so that refusals found after loading name the right one.
+void note_key(Scene& s, const Context& ctx, const std::string& key, const YAML::Node& n) {
+  if (const std::string* o = ctx.override_of(n)) {
+    s.key_lines.erase(key);
+    s.key_overrides[key] = *o;
+  } else {
+    s.key_lines[key] = line_of(n);
+  }
+}
+
 // A YAML mapping whose keys are checked against the allowed set; typed getters throw
 // SceneError with file, line and dotted field path.
 class Fields {
@@ -564,7 +575,7 @@ void read_mechanism(const Fields& top, Scene& s) {
     l.point_b = read_point(f, "point_b", l.body_b, s);
     if (f.has("branch")) {  // {joint, sign: positive|negative} (or +1 / -1)
       Fields b(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"});
-      s.key_lines["loops." + l.name + ".branch"] = b.line();
+      note_key(s, top.ctx(), "loops." + l.name + ".branch", f.raw("branch"));
       BranchSign br{b.str("joint"), +1};
       if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
       if (br.joint == top.str_or("independent", ""))
@@ -719,6 +730,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
     if (!names.insert(name).second)
       throw SceneError(top.file(), line_of(n), path + ".name",
                        "duplicate load name '" + name + "'");
+    s.key_lines["loads." + name] = line_of(n);  // refusals after loading (optimize's design) name the load's line
     if (type == "joint_torque") {
       Fields f(n, path, top.ctx(),
                {"type", "name", "joint", "torque_Nm", "force_N", "active_when", "profile"});
@@ -774,7 +786,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
         if (body != kGround && !s.find_body(body)) f.fail(key, "unknown body '" + body + "'");
       pf.point_a = read_point(f, "point_a", pf.body_a, s);
       pf.point_b = read_point(f, "point_b", pf.body_b, s);
-      s.key_lines["loads." + pf.name + ".point_b"] = line_of(f.raw("point_b"));  // checked at assembly
+      note_key(s, top.ctx(), "loads." + pf.name + ".point_b", f.raw("point_b"));  // checked at assembly
       if (f.has("profile")) pf.profile = read_profile(f, "profile");
       if (!f.has("profile") && !f.has("force_N")) f.fail("force_N", "give force_N (the tension, positive pulls the points together)");
       pf.value = f.num_or("force_N", 1.0);
@@ -829,7 +841,7 @@ void read_optimize(const Fields& f, Scene& s) {
   // Where the design is written: the refusals that need the whole design (calibration scales
   // every joint torque together) come after loading.
   s.key_lines["optimize"] = f.line();
-  if (f.has("loads")) s.key_lines["optimize.loads"] = line_of(f.raw("loads"));
+  if (f.has("loads")) note_key(s, f.ctx(), "optimize.loads", f.raw("loads"));
   for (size_t i = 0; i < o.loads.size(); ++i) {
     const auto& d = o.loads[i];
     if (d.same_as.empty()) continue;
@@ -914,7 +926,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   }
   read_independent_range(top, s);
   for (const char* k : {"independent_range", "independent_range_deg"})
-    if (top.has(k)) s.key_lines[k] = line_of(top.raw(k));
+    if (top.has(k)) note_key(s, ctx, k, top.raw(k));
   std::vector<PendingDissipation> pending;
   read_loads(top, s, pending);
   for (const auto& p : pending) {
@@ -997,7 +1009,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     if (f.has("joints")) s.outputs.joints = names_or_all("joints", false);
     if (f.has("reactions")) {
       s.outputs.reactions = names_or_all("reactions", true);
-      s.key_lines["outputs.reactions"] = line_of(f.raw("reactions"));
+      note_key(s, f.ctx(), "outputs.reactions", f.raw("reactions"));
     }
     s.outputs.shaking = f.flag_or("shaking", false);
   }
@@ -1032,7 +1044,7 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
       // power_W absent: mean-speed mode (the resistances stay as given).
       s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
       s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
-      if (c.has("load")) s.key_lines["validation.calibrate.load"] = line_of(c.raw("load"));
+      if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
       if (c.has("load") && s.validation.calibrate_load.empty())
         c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
       // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
@@ -1142,8 +1154,22 @@ Scene parse_scene(const std::string& text, const std::string& file,
   return s;
 }
 
+std::string non_regular_file_kind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return "";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO";
+  if (S_ISDIR(st.st_mode)) return "a folder";
+  if (S_ISCHR(st.st_mode)) return "a character device";
+  if (S_ISBLK(st.st_mode)) return "a block device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a file";
+}
+
 std::string read_scene_text(const std::string& name_or_path) {
   const std::string path = resolve_scene_path(name_or_path);
+  if (const std::string kind = non_regular_file_kind(path); !kind.empty())
+    throw SceneError(path, 0, "", "not a regular file (" + kind + "): give a scene file (a FIFO would block, a "
+                                  "device never ends)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, 0, "", "cannot open for reading");
   // Read at most one byte more than a scene may have: /dev/zero or a huge file cannot

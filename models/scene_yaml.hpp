@@ -32,8 +32,15 @@ Scene load_scene(const std::string& name_or_path, const std::vector<Override>& o
 Scene parse_scene(const std::string& yaml_text, const std::string& file,
                   const std::vector<Override>& overrides = {});
 
-// The text of a scene file (resolved like load_scene). Throws SceneError.
+// The text of a scene file (resolved like load_scene). Throws SceneError; "not a regular file"
+// for a FIFO, folder, device or socket (checked before opening: a FIFO without a writer would
+// block, a device never ends).
 std::string read_scene_text(const std::string& name_or_path);
+
+// What `path` is when it is not a regular file (links followed): "a FIFO", "a folder", "a
+// character device", "a block device", "a socket"; empty for a regular file or a path that
+// cannot be looked at (opening it reports that). Input files are refused on a non-empty answer.
+std::string non_regular_file_kind(const std::string& path);
 
 // Whether a dotted key path (as in overrides) exists in the scene's YAML.
 bool scene_yaml_has(const std::string& yaml_text, const std::string& path);

@@ -27,6 +27,11 @@ namespace {
 // target (issue #13: "holds 1 Hz within 1 %").
 constexpr double kReducedCadenceTolerance = 1e-6;
 constexpr double kFullCadenceTolerance = 1e-2;
+// Power mode: the steady cycle's mean dissipated power within 1e-8 of P (relative; the cycle is
+// solved to 1e-12 and the load to 1e-10, so a converged secant reaches it), in at most 30 load
+// searches (the secant converges in 3–6).
+constexpr double kPowerTolerance = 1e-8;
+constexpr int kMaxPowerPasses = 30;
 
 // The load being calibrated: one joint torque, one motor's stall torque, or every joint
 // torque together. Each entry is applied as sign·T with T ≥ 0 the calibrated magnitude.
@@ -64,7 +69,7 @@ const char* unit_of(const models::Scene& s, const std::string& joint) {
 // opt.load_field for an unknown load or one that is not a drive load.
 Selection select_load(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
   };
   auto candidates = [&] {
     std::string c;
@@ -282,7 +287,7 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, scene.line_of(field), field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
   };
   const Selection sel = select_load(scene, opt);
   const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
@@ -291,134 +296,201 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
   r.load_kind = sel.kind;
   r.load_unit = sel.unit;
   r.resistance_coefficient = calc_resistance_coefficient(scene, opt);
-  set_load(m, sel, 1.0);  // the energy balance below reads the selected loads at unit value
+  // Power mode: c = P/ω_Fⁿ dissipates P only at constant speed; on a fluctuating steady cycle the
+  // resistance dissipates c·⟨ωⁿ⟩ ≠ P (a motor-driven crank at 2.3× fluctuation: 25 W for 20 W).
+  // So the coefficient is adjusted too, around the load search, until the steady cycle both
+  // holds F (the load) and dissipates P (the coefficient): a secant on ln c ↦ ln(P_diss/P),
+  // whose slope is near 1 (P_diss = c·⟨ωⁿ⟩, ⟨ωⁿ⟩ nearly independent of c), at most
+  // kMaxPowerPasses load searches.
+  const bool power_mode = std::isfinite(r.resistance_coefficient);
+  if (power_mode && m.brakes.size() != 1)
+    throw models::NumericalError(fmt::format("calibration: the reduced model has {} resistances, the power mode one",
+                                             m.brakes.size()));
+  double T = 0.0, W_unit = 0.0, ln_c_prev = NAN, f_prev = NAN;
+  int evals = 0;
+  Cycle cy;
+  for (int pass = 0;; ++pass) {
+    if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
+    set_load(m, sel, 1.0);  // the energy balance below reads the selected loads at unit value
 
-  // First guess from the energy balance per revolution at the constant target rate: the
-  // load's work T·W_unit balances the work of every other non-conservative load, W_other
-  // (springs and gravity do none over a revolution). Both are linear in the load values:
-  // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
-  const int n = 3600;
-  const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
-  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
-      selected_force(m.point_forces.size(), 0);
-  for (const auto& en : sel.entries)
-    (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
-  double W_unit = 0.0, W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double q = scene.initial.q + (i + 0.5) * dq;
-    for (size_t k = 0; k < m.torques.size(); ++k) {
-      const auto& t = m.torques[k];
-      const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-      // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
-      const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
-      const double r_j = tau * m.table.eval(t.c_r, q);
-      if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
-      if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
-      if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq;
-    }
-    // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
-    for (size_t k = 0; k < m.point_forces.size(); ++k) {
-      const auto& f = m.point_forces[k];
-      const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
-      const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
-      if (selected_force[k]) W_scale += std::abs(Q) * dq;
-      if (on) (selected_force[k] ? W_unit : W_other) += f.value * Q * dq;
-      if (on && !selected_force[k]) W_other_scale += std::abs(f.value * Q) * dq;
-    }
-    for (size_t k = 0; k < m.motors.size(); ++k) {
-      const auto& mo = m.motors[k];
-      const double r_j = m.table.eval(mo.c_r, q);
-      const double w = mo.stall * (1.0 - r_j * qd / mo.no_load_speed) * r_j * dq;
-      if (selected_motor[k]) {
-        W_unit += w;
-        W_scale += std::abs(r_j) * dq;
-        max_motor_rate = std::max(max_motor_rate, r_j * qd / mo.no_load_speed);
-      } else {
-        W_other += w;
-        W_other_scale += std::abs(w);
+    // First guess from the energy balance per revolution at the constant target rate: the
+    // load's work T·W_unit balances the work of every other non-conservative load, W_other
+    // (springs and gravity do none over a revolution). Both are linear in the load values:
+    // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
+    const int n = 3600;
+    const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
+    std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
+        selected_force(m.point_forces.size(), 0);
+    for (const auto& en : sel.entries)
+      (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
+    W_unit = 0.0;
+    double W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
+    // The other loads' work per revolution one by one (named when they already balance the
+    // resistances: the real cause when the selected load has nothing left to do).
+    std::vector<double> W_torque(m.torques.size(), 0.0), W_force(m.point_forces.size(), 0.0),
+        W_motor(m.motors.size(), 0.0);
+    double W_brakes = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double q = scene.initial.q + (i + 0.5) * dq;
+      for (size_t k = 0; k < m.torques.size(); ++k) {
+        const auto& t = m.torques[k];
+        const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
+        // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
+        const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
+        const double r_j = tau * m.table.eval(t.c_r, q);
+        if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
+        if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
+        if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq, W_torque[k] += t.value * r_j * dq;
+      }
+      // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
+      for (size_t k = 0; k < m.point_forces.size(); ++k) {
+        const auto& f = m.point_forces[k];
+        const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
+        const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
+        if (selected_force[k]) W_scale += std::abs(Q) * dq;
+        if (on) (selected_force[k] ? W_unit : W_other) += f.value * Q * dq;
+        if (on && !selected_force[k]) W_other_scale += std::abs(f.value * Q) * dq, W_force[k] += f.value * Q * dq;
+      }
+      for (size_t k = 0; k < m.motors.size(); ++k) {
+        const auto& mo = m.motors[k];
+        const double r_j = m.table.eval(mo.c_r, q);
+        const double w = mo.stall * (1.0 - r_j * qd / mo.no_load_speed) * r_j * dq;
+        if (selected_motor[k]) {
+          W_unit += w;
+          W_scale += std::abs(r_j) * dq;
+          max_motor_rate = std::max(max_motor_rate, r_j * qd / mo.no_load_speed);
+        } else {
+          W_other += w;
+          W_other_scale += std::abs(w);
+          W_motor[k] += w;
+        }
+      }
+      for (const auto& b : m.brakes) {
+        const double w = m.table.eval(b.c_w, q);
+        const double wb = models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
+        W_other += wb;
+        W_other_scale += std::abs(wb);
+        W_brakes += wb;
       }
     }
-    for (const auto& b : m.brakes) {
-      const double w = m.table.eval(b.c_w, q);
-      const double wb = models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
-      W_other += wb;
-      W_other_scale += std::abs(wb);
+    r.work_per_rev_per_unit = W_unit;
+    if (!(std::abs(W_unit) > 1e-9 * W_scale) && sel.kind.rfind("motor", 0) != 0)
+      fail(load_field, fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
+                                   "mean speed: calibrate a load that drives the mechanism",
+                                   sel.name, W_unit, sel.unit));
+    if (!(W_unit > 0)) {
+      if (sel.kind.rfind("motor", 0) == 0)
+        fail(load_field,
+             fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load speed "
+                         "{:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall torque of "
+                         "the no-load speed's sign holds the target (lower the target or raise the no-load speed)",
+                         sel.name, opt.cadence_hz, max_motor_rate, scene.motors[sel.entries[0].index].no_load_speed,
+                         W_unit, sel.unit));
+      fail(load_field, fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
+                                   "per {}): give it the opposite sign",
+                                   sel.name, W_unit, sel.unit));
     }
-  }
-  r.work_per_rev_per_unit = W_unit;
-  if (!(std::abs(W_unit) > 1e-9 * W_scale) && sel.kind.rfind("motor", 0) != 0)
-    fail(load_field, fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
-                                 "mean speed: calibrate a load that drives the mechanism",
-                                 sel.name, W_unit, sel.unit));
-  if (!(W_unit > 0)) {
-    if (sel.kind.rfind("motor", 0) == 0)
-      fail(load_field,
-           fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load speed "
-                       "{:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall torque of "
-                       "the no-load speed's sign holds the target (lower the target or raise the no-load speed)",
-                       sel.name, opt.cadence_hz, max_motor_rate, scene.motors[sel.entries[0].index].no_load_speed,
-                       W_unit, sel.unit));
-    fail(load_field, fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
-                                 "per {}): give it the opposite sign",
-                                 sel.name, W_unit, sel.unit));
-  }
-  // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
-  // returns its work over a revolution).
-  if (!(W_other < -1e-9 * W_other_scale) || W_other == 0.0)
-    fail(load_field, fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
-                                 "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
-                                 "validation.calibrate.power_W) or a resistance",
-                                 opt.cadence_hz, W_other, sel.name));
-  r.initial_guess = -W_other / W_unit;
+    // The resistances dissipate but other drive loads already supply it (e.g. a scene's muscles
+    // calibrated for this operating point, and a torque added beside them): the selected load
+    // has no work left to do. Name those loads: "nothing dissipates" would be untrue.
+    std::string drivers;
+    auto add_driver = [&](const std::string& name, double W) {
+      if (W > 1e-9 * W_other_scale) drivers += fmt::format("{}'{}' {:+.4g} J", drivers.empty() ? "" : ", ", name, W);
+    };
+    for (size_t k = 0; k < W_torque.size(); ++k) add_driver(scene.joint_torques[k].name, W_torque[k]);
+    for (size_t k = 0; k < W_force.size(); ++k) add_driver(scene.point_forces[k].name, W_force[k]);
+    for (size_t k = 0; k < W_motor.size(); ++k) add_driver(scene.motors[k].name, W_motor[k]);
+    if (!(W_other < -1e-9 * W_other_scale) && W_brakes < -1e-9 * W_other_scale && !drivers.empty())
+      fail(load_field, fmt::format("at {:g} Hz the other drive loads already supply what the resistances dissipate "
+                                   "({:.4g} J per revolution): {} ({:+.3g} J net), so '{}' has no work left to do "
+                                   "and cannot set the mean speed; calibrate those loads instead, or remove them",
+                                   opt.cadence_hz, W_brakes, drivers, W_other, sel.name));
+    // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
+    // returns its work over a revolution).
+    if (!(W_other < -1e-9 * W_other_scale) || W_other == 0.0)
+      fail(load_field, fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
+                                   "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
+                                   "validation.calibrate.power_W) or a resistance",
+                                   opt.cadence_hz, W_other, sel.name));
+    r.initial_guess = -W_other / W_unit;
 
-  // Brent (GSL) on the load's magnitude: mean steady cadence = F.
-  int evals = 0;
-  RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
-  gsl_function fn{cadence_error, &ctx};
-  double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
-  double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
-  for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
-  for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
-    hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
-  if (!(flo <= 0 && fhi >= 0))
-    throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
-                                             sel.name, lo, hi, sel.unit, opt.cadence_hz));
-  gsl_set_error_handler_off();
-  std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
-      gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
-  gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
-  double T = r.initial_guess;
-  for (int it = 0; it < 100; ++it) {
-    gsl_root_fsolver_iterate(solver.get());
-    T = gsl_root_fsolver_root(solver.get());
-    progress.count("calibrate: load search", it + 1, it + 1);
-    if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
-                               1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
-      break;
+    // Brent (GSL) on the load's magnitude: mean steady cadence = F.
+    RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
+    gsl_function fn{cadence_error, &ctx};
+    double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
+    double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
+    for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
+    for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
+      hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
+    if (!(flo <= 0 && fhi >= 0))
+      throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
+                                               sel.name, lo, hi, sel.unit, opt.cadence_hz));
+    gsl_set_error_handler_off();
+    std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
+        gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
+    gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
+    T = r.initial_guess;
+    for (int it = 0; it < 100; ++it) {
+      gsl_root_fsolver_iterate(solver.get());
+      T = gsl_root_fsolver_root(solver.get());
+      progress.count("calibrate: load search", it + 1, it + 1);
+      if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
+                                 1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
+        break;
+    }
+    progress.note("");
+    // A value the scene format refuses (|load| or |amplitude|·max|τ| above limits::kMaxForce, a
+    // resistance coefficient beyond its body's bound) is no result: a written scene would not load.
+    try {
+      models::check_scene(with_load(scene, sel, T, r.resistance_coefficient));
+    } catch (const models::SceneError& e) {
+      throw models::NumericalError(fmt::format(
+          "calibration: holding {:g} Hz needs {} = {:.6g} {}, beyond what a scene allows (the limit is {:g} {} per "
+          "load): {}: {}; choose a lower power or another operating point",
+          opt.cadence_hz, sel.name, T, sel.unit, models::limits::kMaxForce, sel.unit, e.field(), e.message()));
+    }
+    const double sign = sel.entries[0].sign;
+    r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
+    r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
+    set_load(m, sel, T);
+    cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
+    if (!cy.ok)
+      throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
+                                               "({:.6g} {})", r.load_value, sel.unit));
+    r.steady_q = scene.initial.q;
+    r.steady_qdot = cy.speed;
+    r.mean_cadence_hz_reduced = 1.0 / cy.period;
+    // The result must meet its own target (issue #9): the root finder converges to 1e-10
+    // relative, so the reduced cadence is off by far less than kReducedCadenceTolerance unless
+    // the bracket held a discontinuity (a stall) instead of a root.
+    const double miss_reduced = std::abs(r.mean_cadence_hz_reduced - opt.cadence_hz) / opt.cadence_hz;
+    if (!(miss_reduced <= kReducedCadenceTolerance))
+      throw models::NumericalError(fmt::format(
+          "calibration missed its target: the reduced model's steady cadence is {:.6g} Hz at {} = {:.6g} {}, target "
+          "{:g} Hz (off by {:.3g} %, allowed {:g} %)",
+          r.mean_cadence_hz_reduced, sel.name, r.load_value, sel.unit, opt.cadence_hz, 100 * miss_reduced,
+          100 * kReducedCadenceTolerance));
+    if (!power_mode) break;
+    const double P_diss = cy.detail.dissipated_power_W;
+    const double f = std::log(P_diss / opt.power_w);  // 0 at the target
+    if (!std::isfinite(f))
+      throw models::NumericalError(fmt::format("calibration: the resistance dissipates {:.6g} W on the steady cycle "
+                                               "at {:g} Hz; no coefficient reaches {:g} W",
+                                               P_diss, opt.cadence_hz, opt.power_w));
+    if (std::abs(f) <= kPowerTolerance) break;
+    if (pass + 1 >= kMaxPowerPasses)
+      throw models::NumericalError(fmt::format(
+          "calibration did not converge: after {} load searches the steady cycle at {:g} Hz dissipates {:.8g} W "
+          "(resistance coefficient {:.6g}), target {:g} W (allowed {:g} %)",
+          pass + 1, opt.cadence_hz, P_diss, r.resistance_coefficient, opt.power_w, 100 * kPowerTolerance));
+    const double ln_c = std::log(r.resistance_coefficient);
+    double slope = std::isfinite(ln_c_prev) && ln_c != ln_c_prev ? (f - f_prev) / (ln_c - ln_c_prev) : 1.0;
+    if (!(slope > 0.1 && slope < 10)) slope = 1.0;  // a wild secant: the fixed-point step
+    ln_c_prev = ln_c, f_prev = f;
+    r.resistance_coefficient = std::exp(ln_c - f / slope);
   }
-  progress.note("");
-  const double sign = sel.entries[0].sign;
-  r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
-  r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
-  set_load(m, sel, T);
-  const Cycle cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
-  if (!cy.ok)
-    throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
-                                             "({:.6g} {})", r.load_value, sel.unit));
+  r.mean_dissipated_power_w = cy.detail.dissipated_power_W;
   r.evaluations = evals;
-  r.steady_q = scene.initial.q;
-  r.steady_qdot = cy.speed;
-  r.mean_cadence_hz_reduced = 1.0 / cy.period;
-  // The result must meet its own target (issue #9): the root finder converges to 1e-10
-  // relative, so the reduced cadence is off by far less than kReducedCadenceTolerance unless
-  // the bracket held a discontinuity (a stall) instead of a root.
-  const double miss_reduced = std::abs(r.mean_cadence_hz_reduced - opt.cadence_hz) / opt.cadence_hz;
-  if (!(miss_reduced <= kReducedCadenceTolerance))
-    throw models::NumericalError(fmt::format(
-        "calibration missed its target: the reduced model's steady cadence is {:.6g} Hz at {} = {:.6g} {}, target "
-        "{:g} Hz (off by {:.3g} %, allowed {:g} %)",
-        r.mean_cadence_hz_reduced, sel.name, r.load_value, sel.unit, opt.cadence_hz, 100 * miss_reduced,
-        100 * kReducedCadenceTolerance));
 
   // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
   r.speed_fluctuation = cy.detail.speed_fluctuation;
@@ -558,14 +630,20 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   } else {
     for (const auto& e : sel.entries) o.push_back({value_key(text, scene, e), num(e.sign * T)});
   }
+  // power_W at cadence_Hz means c = power_W/ω_Fⁿ (constant speed): the nominal power that gives
+  // the calibrated coefficient, which dissipates P on the fluctuating steady cycle.
+  const std::string nominal_w =
+      opt.power_w > 0 ? fmt::format("{:.17g}", opt.power_w * r.resistance_coefficient /
+                                                   calc_resistance_coefficient(scene, opt))
+                      : std::string();
   if (opt.power_w > 0) {
     if (models::scene_yaml_has(text, "bicycle_leg")) {
-      o.push_back({"bicycle_leg.resistance.power_W", num(opt.power_w)});
+      o.push_back({"bicycle_leg.resistance.power_W", nominal_w});
       o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
     } else {
       const auto& res = scene.resistances[0];
       if (models::scene_yaml_has(text, "loads." + res.name + ".dissipates")) {
-        o.push_back({"loads." + res.name + ".dissipates.power_W", num(opt.power_w)});
+        o.push_back({"loads." + res.name + ".dissipates.power_W", nominal_w});
         o.push_back({"loads." + res.name + ".dissipates.cadence_Hz", num(opt.cadence_hz)});
       } else {
         o.push_back({"loads." + res.name + ".coefficient", num(r.resistance_coefficient)});
@@ -581,7 +659,9 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   std::string from;
   for (char c : source) from += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
   const std::string point =
-      opt.power_w > 0 ? fmt::format("with the resistance dissipating {:.6g} W at {:.6g} Hz", opt.power_w, opt.cadence_hz)
+      opt.power_w > 0 ? fmt::format("with the resistance dissipating {:.6g} W on the steady cycle at {:.6g} Hz (its\n"
+                                    "# power_W is nominal: the power of its coefficient at a constant {:.6g} Hz)",
+                                    opt.power_w, opt.cadence_hz, opt.cadence_hz)
                       : std::string("with the resistances as given");
   return fmt::format(
       "# Calibrated by `rdyn calibrate` from {}: {} ({}) = {:.6g} {} holds a mean cadence of {:.6g} Hz\n"

@@ -2,8 +2,9 @@
 // torque, a prismatic joint's force, or a motor's stall torque with its no-load speed kept) —
 // or of every joint torque together, signs kept — that holds the mean steady rate of the
 // independent coordinate at F revolutions per second. Two operating points: with a power P the
-// scene's one resistance is first set to dissipate P at F (c = P/ωⁿ); without, the resistances
-// stay as given. Solved on the reduced model (GSL Brent on the load value), confirmed with the
+// scene's one resistance's coefficient is set too, so that it dissipates P on average over the
+// steady cycle at F (starting from c = P/ω_Fⁿ, exact only at constant speed; a secant around the
+// load search); without, the resistances stay as given. Solved on the reduced model (GSL Brent on the load value), confirmed with the
 // full model.
 #pragma once
 
@@ -36,10 +37,15 @@ struct CalibrationResult {
   double load_value = 0.0;  // calibrated value, signed (joint_torques: the magnitude each gets, signs kept)
   double torque_Nm = 0.0;   // = |load_value| for joint torques on revolute joints, NaN for other kinds
   double initial_guess = 0.0;           // from the energy balance per revolution [load unit]
-  double resistance_coefficient = 0.0;  // c0, c1 or c2 of the scene's resistance (NaN: mean-speed mode, unchanged)
+  // c0, c1 or c2 of the scene's resistance (NaN: mean-speed mode, unchanged): the one whose
+  // steady cycle at F dissipates P on average (not P/ω_Fⁿ, which holds only at constant speed).
+  double resistance_coefficient = 0.0;
   double mean_cadence_hz_reduced = 0.0;
   double mean_cadence_hz_full = 0.0;     // NaN when the full-model check was skipped
   double mean_power_w = 0.0;            // mean power of the calibrated load over the steady cycle (reduced)
+  // Mean power the resistances dissipate over the steady cycle (reduced) [W]: = P in power mode
+  // (to 1e-8; the coefficient is adjusted until it is), whatever the speed fluctuation.
+  double mean_dissipated_power_w = 0.0;
   std::string force_name;               // first requested constraint force (empty if none)
   double peak_force_N = 0.0;            // max |F| over the steady cycle (reduced)
   double peak_force_full_N = 0.0;

@@ -140,6 +140,9 @@ int run_simulate(const SimulateArgs& a) {
     reduced::Samples samples;
     double extraction_ms = 0.0;
     if (!a.table.empty()) {
+      // Checked before opening: a FIFO without a writer would block (models::non_regular_file_kind).
+      if (const std::string kind = models::non_regular_file_kind(a.table); !kind.empty())
+        throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
       samples = reduced::read_samples_csv(a.table);
       run["table"] = a.table;
     } else {
@@ -247,6 +250,7 @@ int run_calibrate(const CalibrateArgs& a) {
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
       {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
       {"mean_power_w", r.mean_power_w},
+      {"mean_dissipated_power_w", r.mean_dissipated_power_w},
       {"peak_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
       {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : number_or_null(r.peak_force_full_N)},
       {"force_name", r.force_name},

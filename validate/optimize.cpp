@@ -70,6 +70,9 @@ double eval_series(const Series& s, double th) {
   return v;
 }
 
+// min_θ τ(θ) of a nonnegative group's series: the true minimum, not a sample (below).
+double series_minimum(const Series& s) { return calc_fourier_minimum(s.a0, s.a, s.b); }
+
 Series group_series(const Design& d, int g, const double* x) {
   const Group& gr = d.groups[g];
   Series s;
@@ -250,6 +253,27 @@ const Evaluation& evaluate(Workspace& w, const double* x) {
   return w.last;
 }
 
+// Lifts every nonnegative group's series whose true minimum m is below 0 to τ ≥ 0 at every
+// angle: a free a0 rises by δ = −m; with a0 ≡ 1 (the first group) the series becomes
+// (τ + δ)/(1 + δ), its harmonics divided by 1 + δ. Returns the largest δ (0: none needed).
+double repair_nonnegative(const Design& d, std::vector<double>& x) {
+  double largest = 0.0;
+  for (int g = 0; g < static_cast<int>(d.groups.size()); ++g) {
+    if (!d.groups[g].nonnegative) continue;
+    const double m = series_minimum(group_series(d, g, x.data()));
+    if (!(m < 0)) continue;
+    const double delta = -m * (1 + 1e-12) + 1e-15;  // strictly lifted past rounding
+    largest = std::max(largest, delta);
+    const int first = d.groups[g].offset;
+    if (d.groups[g].fixed_a0) {
+      for (int k = 0; k < 2 * d.H; ++k) x[first + k] /= 1 + delta;
+    } else {
+      x[first] += delta;
+    }
+  }
+  return largest;
+}
+
 double objective_fn(unsigned n, const double* x, double* grad, void* data) {
   (void)n;
   (void)grad;  // derivative-free (COBYLA)
@@ -270,6 +294,7 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
     if (!d.groups[g].nonnegative) continue;
     const Series s = group_series(d, g, x);
     for (int k = 0; k < kNonnegativeSamples; ++k) result[i++] = -eval_series(s, kTwoPi * k / kNonnegativeSamples);
+    result[i++] = -series_minimum(s);  // between the samples too (the samples steer COBYLA's linear model)
   }
   const auto& e = evaluate(w, x);
   for (int g = 0; g < static_cast<int>(d.groups.size()); ++g)
@@ -335,6 +360,47 @@ FullWindow analyse_full(const models::TimeSeries& ts, double skip, int k) {
 
 }  // namespace
 
+double calc_fourier_minimum(double a0, const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t H = std::max(a.size(), b.size());
+  auto coef = [&](const std::vector<double>& c, size_t k) { return k < c.size() ? c[k] : 0.0; };
+  // τ, τ′, τ″ at θ.
+  auto eval = [&](double th, double& d1, double& d2) {
+    double v = a0;
+    d1 = d2 = 0.0;
+    for (size_t k = 0; k < H; ++k) {
+      const double n = static_cast<double>(k + 1), c = std::cos(n * th), s = std::sin(n * th);
+      const double ak = coef(a, k), bk = coef(b, k);
+      v += ak * c + bk * s;
+      d1 += n * (bk * c - ak * s);
+      d2 -= n * n * (ak * c + bk * s);
+    }
+    return v;
+  };
+  // A grid of N = 16(H + 1) angles (≥ 8 points per period of the highest harmonic): each local
+  // minimum of the samples brackets one of τ's (τ′ has at most 2H zeros), refined by Newton on
+  // τ′ within ± one spacing (quadratic convergence; 30 steps bound it).
+  const size_t N = 16 * (H + 1);
+  const double h = kTwoPi / static_cast<double>(N);
+  std::vector<double> v(N);
+  double d1 = 0.0, d2 = 0.0, lowest = HUGE_VAL;
+  for (size_t i = 0; i < N; ++i) v[i] = eval(h * static_cast<double>(i), d1, d2), lowest = std::min(lowest, v[i]);
+  for (size_t i = 0; i < N && H > 0; ++i) {
+    if (!(v[i] <= v[(i + N - 1) % N] && v[i] <= v[(i + 1) % N])) continue;
+    const double th0 = h * static_cast<double>(i);
+    double th = th0;
+    for (int it = 0; it < 30; ++it) {
+      eval(th, d1, d2);
+      if (!(d2 > 0)) break;  // not convex here: the samples already hold the minimum's value
+      const double step = d1 / d2;
+      th -= step;
+      if (std::abs(th - th0) > h) break;  // left its cell: another cell's minimum
+      lowest = std::min(lowest, eval(th, d1, d2));
+      if (std::abs(step) < 1e-14) break;
+    }
+  }
+  return lowest;
+}
+
 models::Scene scene_with_added_torques(const models::Scene& scene, const OptimizeOptions& opt) {
   models::Scene s = scene;
   for (const auto& j : opt.add_torques) {
@@ -383,7 +449,24 @@ void check_optimize_options(const models::Scene& scene, const OptimizeOptions& o
   if (cf.empty()) fail("outputs.constraint_forces", "optimize minimises a constraint force: request one");
   if (scene.joint_torques.empty())
     fail("loads", "optimize shapes joint torques and the scene has none: add a joint_torque, or one with --add-torque "
-                  "JOINT (point forces and motors are not design loads)");
+                  "JOINT, and remove the scene's drive loads of other kinds (point forces and motors are not design loads)");
+  // One amplitude scales the design loads (every joint torque) to hold the cadence, every other
+  // load as given. A motor or a point force would drive beside them, neither shaped nor scaled:
+  // with a motor as the real drive (slider-crank) the design load is the piston's load, which
+  // does no net work per revolution; with muscles calibrated for the operating point
+  // (bicycle-muscle) an added torque has nothing left to do. Refused before any work.
+  std::string designed;
+  for (const auto& t : scene.joint_torques) designed += (designed.empty() ? "'" : ", '") + t.name + "'";
+  auto refuse_drive = [&](const std::string& kind, const std::string& name, const std::string& joint) {
+    throw models::SceneError(
+        scene.source_file, scene.line_of("loads." + name), "loads." + name,
+        fmt::format("{} '{}' drives the mechanism but is not a design load: optimize shapes the joint torques ({}) "
+                    "and calibrates one amplitude for them to hold the cadence, every other load as given, so the "
+                    "drive must be joint torques alone; give the drive as a joint_torque{} and remove the {}",
+                    kind, name, designed, joint.empty() ? "" : " on joint '" + joint + "'", kind));
+  };
+  for (const auto& mo : scene.motors) refuse_drive("motor", mo.name, mo.joint);
+  for (const auto& pf : scene.point_forces) refuse_drive("point force", pf.name, "");
   if (!force.empty() &&
       std::none_of(cf.begin(), cf.end(), [&](const models::ConstraintForceRequest& c) { return c.name == force; }))
     fail(opt.force_name.empty() ? "optimize.force" : "--force-name",
@@ -494,7 +577,7 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   nlopt_set_upper_bounds(o, ub.data());
   nlopt_set_min_objective(o, objective_fn, &w);
   unsigned m = 0;
-  for (const auto& g : bounded.groups) m += (g.nonnegative ? kNonnegativeSamples : 0) + 1;
+  for (const auto& g : bounded.groups) m += (g.nonnegative ? kNonnegativeSamples + 1 : 0) + 1;
   std::vector<double> ctol(m, 1e-9);
   nlopt_add_inequality_mconstraint(o, m, constraints_fn, &w, ctol.data());
   nlopt_set_xtol_rel(o, opt.rel_tolerance);
@@ -515,11 +598,17 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   r.evaluations = w.evaluations;
   r.failed_evaluations = w.failures;
   r.optimise_wall_s = std::chrono::duration<double>(Clock::now() - t_search).count();
+  // COBYLA meets its constraints only to its own tolerance (the bicycle's optimum dipped to
+  // −1.3e-4 of the mean): lift each nonnegative shape to τ ≥ 0 at every angle, then recalibrate.
+  r.nonnegative_repair = repair_nonnegative(bounded, x);
   // NLopt returns the best feasible point it saw; a search that found nothing better keeps x0.
   Evaluation best = evaluate(w, x.data());
   bool feasible = best.ok;
-  for (size_t g = 0; g < bounded.groups.size() && feasible; ++g)
+  for (size_t g = 0; g < bounded.groups.size() && feasible; ++g) {
     feasible = std::abs(best.cal.load_value) * best.max_tau[g] <= bounded.groups[g].bound * (1 + 1e-6);
+    // τ ≥ 0 at every angle (after the repair: to rounding).
+    if (bounded.groups[g].nonnegative) feasible = feasible && series_minimum(group_series(bounded, g, x.data())) >= -1e-12;
+  }
   if (!feasible || !(best.objective < e0.objective)) {
     x = x0;
     best = e0;
@@ -547,7 +636,8 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
         mx = std::max(mx, std::abs(models::calc_joint_torque(t, kTwoPi * i / kBoundSamples)));
       sr.max_torque_Nm = std::max(sr.max_torque_Nm, mx);
     }
-    if (std::isfinite(r.resistance_coefficient)) sx.resistances[0].coefficient = r.resistance_coefficient;
+    // Each strategy's own coefficient: the one its steady cycle dissipates P with (calibrate_reduced).
+    if (std::isfinite(e.cal.resistance_coefficient)) sx.resistances[0].coefficient = e.cal.resistance_coefficient;
     sx.initial.q = sr.steady_q;
     sx.initial.qdot = sr.steady_qdot;
     // Reduced curves: the shape's model at the calibrated value over one cycle.
@@ -596,6 +686,8 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   (void)scene0;
   r.constant = c0;
   r.optimised = c1;
+  // The optimised scene's coefficient (each strategy dissipates P on its own steady cycle).
+  if (std::isfinite(r.resistance_coefficient)) r.resistance_coefficient = best.cal.resistance_coefficient;
   scene1.optimize.reset();
   scene1.description = fmt::format("{} Optimised by rdyn optimize: {} shaped over {} to minimise the peak {} force at {:g} Hz.",
                                    scene.description.substr(0, 3000), fmt::join(r.design_loads, ", "), design.of,

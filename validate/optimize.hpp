@@ -22,6 +22,11 @@ namespace rdyn::validate {
 inline constexpr int kMaxOptimizeEvaluations = 100000;
 inline constexpr double kMinOptimizeFullDuration_s = 4.0, kMaxOptimizeFullDuration_s = 600.0;
 
+// min_θ of τ(θ) = a0 + Σ a_k cos kθ + b_k sin kθ (degree H = max(|a|, |b|)): the least of
+// 16(H + 1) equally spaced samples, each local minimum among them refined by Newton on τ′ —
+// the exact minimum to rounding, not a sample of it (`nonnegative` constrains this value).
+double calc_fourier_minimum(double a0, const std::vector<double>& a, const std::vector<double>& b);
+
 struct OptimizeOptions {
   double cadence_hz = 1.0;  // mean cadence the amplitude holds [rev/s]
   double power_w = 0.0;     // > 0: the one resistance dissipates it at F (calibrate's power mode)
@@ -78,6 +83,9 @@ struct OptimizeResult {
   std::vector<std::string> same_as;       // per design load: the load it is tied to ("" none)
   std::vector<double> shift_deg;
   std::vector<std::string> added_loads;   // added by --add-torque
+  // The largest lift δ of a nonnegative shape after the search (COBYLA meets constraints to its
+  // tolerance): τ → τ + δ, or (τ + δ)/(1 + δ) for the first shape (a0 ≡ 1); 0 when none was needed.
+  double nonnegative_repair = 0.0;
   StrategyResult constant, optimised;
   double reduction_reduced = 0.0, reduction_full = 0.0;  // 1 − after/before of the peak
   double agreement = 0.0;  // |peak_full − peak_reduced| / peak_full at the optimum

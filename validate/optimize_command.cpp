@@ -63,7 +63,8 @@ int run_optimize(const OptimizeArgs& a) {
   const auto r = optimize(scene, opt, progress);
   const std::string failure = optimize_failure_message(r);
   if (!failure.empty()) throw models::NumericalError(failure);
-  const auto summary = optimize_summary(r);
+  auto summary = optimize_summary(r);
+  summary["nonnegative_repair"] = r.nonnegative_repair;  // the lift of a nonnegative shape after the search
   render_optimize_report(summary, dir.file(""));
   // The optimised scene, loadable by every command (read back and checked by the writer).
   write_text_file(dir.file("optimised.yaml"),
@@ -80,6 +81,7 @@ int run_optimize(const OptimizeArgs& a) {
                          {"peak_reduction_full", r.reduction_full},
                          {"mean_cadence_hz_full", {{"constant", r.constant.cadence_full_hz}, {"optimised", r.optimised.cadence_full_hz}}},
                          {"evaluations", r.evaluations},
+                         {"nonnegative_repair", r.nonnegative_repair},
                          {"wall_time_s", r.wall_time_s},
                          {"out", a.out}};
   std::printf("%s\n", head.dump(2).c_str());

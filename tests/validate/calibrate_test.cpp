@@ -17,8 +17,9 @@ namespace rdyn::validate {
 namespace {
 
 // The bicycle's whole-drive calibration (every joint torque, no load named) is unchanged by
-// named loads: 64.6859 N·m, as `rdyn calibrate bicycle --cadence-hz 1 --power-w 125` printed
-// before (64.68592225570332).
+// named loads: 64.6857 N·m, as `rdyn calibrate bicycle --cadence-hz 1 --power-w 125` prints
+// (64.68568861256895; 64.68592225570332 before the resistance coefficient was adjusted to
+// dissipate 125 W on the steady cycle, not at a constant 1 Hz).
 TEST(Calibrate, BicycleKeepsItsTorqueWithoutANamedLoad) {
   const auto scene = models::load_scene("bicycle");
   CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
@@ -27,7 +28,7 @@ TEST(Calibrate, BicycleKeepsItsTorqueWithoutANamedLoad) {
   opt.full_check_s = 0;
   Progress quiet(false);
   const auto r = calibrate(scene, opt, quiet);
-  EXPECT_NEAR(r.torque_Nm, 64.68592225570332, 1e-6);
+  EXPECT_NEAR(r.torque_Nm, 64.68568861256895, 1e-6);
   EXPECT_EQ(r.load_value, r.torque_Nm);
   EXPECT_EQ(r.load, "hip_torque_r+hip_torque_l");
   EXPECT_EQ(r.load_kind, "joint_torques");
@@ -295,6 +296,78 @@ TEST(Calibrate, PointForceDoesItsClosedFormWorkPerRevolution) {
       "constant.yaml");
   f = refusal(constant, "m");
   EXPECT_EQ(f.rfind("--load: 'm' does no net work per revolution", 0), 0u) << f;
+}
+
+// Power mode on a fluctuating cycle: a motor-driven slider-crank with a viscous resistance on
+// the crank turns at 5 Hz with its speed varying by 2.4× over a revolution. c = P/ω² would
+// dissipate P only at constant speed (⟨ω²⟩ > ω̄²: 20 W became 25 W); the calibrated coefficient
+// makes the steady cycle dissipate P, seen two ways: the motor's mean power by the trapezoid
+// rule over the cycle and the resistance's dissipated power from the first integral.
+TEST(Calibrate, PowerModeDissipatesThePowerOnTheFluctuatingCycle) {
+  auto scene = models::load_scene("slider-crank");
+  models::Resistance drag;
+  drag.name = "drag", drag.body = "crank", drag.law = models::ResistanceLaw::Viscous, drag.coefficient = 1e-3;
+  scene.resistances.push_back(drag);
+  CalibrationOptions opt = calibration_options_of(scene, 5.0, 20.0, "motor");
+  opt.full_check_s = 3.0;
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_GT(r.speed_fluctuation, 2.0);  // the case that broke the constant-speed rule
+  EXPECT_NEAR(r.mean_dissipated_power_w, 20.0, 20.0 * 1e-8);
+  EXPECT_NEAR(r.mean_power_w, 20.0, 20.0 * 1e-6);  // the motor supplies it (no other load does net work)
+  EXPECT_NEAR(r.mean_cadence_hz_reduced, 5.0, 5e-6);
+  EXPECT_NEAR(r.mean_cadence_hz_full, 5.0, 0.01 * 5.0);
+  // Jensen: ⟨ω²⟩ > ω̄², so the coefficient is below the constant-speed one.
+  const double omega = 2 * M_PI * 5.0;
+  EXPECT_LT(r.resistance_coefficient, 0.9 * 20.0 / (omega * omega));
+}
+
+// A calibrated value the scene format would refuse (|torque| above 1e6 N·m) is a numerical
+// failure naming the value and the limit, not a result.
+TEST(Calibrate, AValueBeyondTheSceneLimitIsAFailure) {
+  // A heavy wheel (50 kg·m²) and viscous brake (1e4 N·m·s; time constant 5 ms) at 20 Hz need
+  // c·ω ≈ 1.26e6 N·m.
+  const auto scene = models::parse_scene(
+      flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
+  auto heavy = scene;
+  heavy.bodies[0].inertia_kgm2 = 50.0;
+  heavy.resistances[0].coefficient = 1e4;
+  CalibrationOptions opt = calibration_options_of(heavy, 20.0, 0.0, "drive");
+  opt.full_check_s = 0;
+  Progress quiet(false);
+  try {
+    calibrate(heavy, opt, quiet);
+    ADD_FAILURE() << "a torque above the scene limit was returned";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("needs drive = 1.25664e+06 N·m"), std::string::npos) << m;
+    EXPECT_NE(m.find("limit is 1e+06 N·m"), std::string::npos) << m;
+  }
+  // Within the limit the same brake at 2 Hz is calibrated: T = c·ω.
+  opt.cadence_hz = 2.0;
+  EXPECT_NEAR(calibrate(heavy, opt, quiet).load_value, 1e4 * 2 * M_PI * 2.0, 1e-6 * 1e4 * 2 * M_PI * 2.0);
+}
+
+// A load added beside drive loads that already supply what the resistance dissipates has no
+// work left to do: the refusal names those loads, not "nothing dissipates" (bicycle-muscle's
+// muscles calibrated for 125 W at 1 Hz, and a hip torque beside them).
+TEST(Calibrate, ALoadWithNothingLeftToDoNamesTheOtherDrives) {
+  auto scene = models::load_scene("bicycle-muscle");
+  scene.joint_torques.push_back({"extra", "hip_r", 1.0, std::nullopt, std::nullopt});
+  CalibrationOptions opt = calibration_options_of(scene, 1.0, 125.0, "extra");
+  opt.full_check_s = 0;
+  Progress quiet(false);
+  try {
+    calibrate(scene, opt, quiet);
+    ADD_FAILURE() << "calibrated a load with nothing to do";
+  } catch (const models::SceneError& e) {
+    const std::string m = e.message();
+    EXPECT_EQ(e.field(), "--load");
+    EXPECT_NE(m.find("the other drive loads already supply what the resistances dissipate"), std::string::npos) << m;
+    EXPECT_NE(m.find("'gluteus_r' +"), std::string::npos) << m;
+    EXPECT_NE(m.find("'gluteus_l' +"), std::string::npos) << m;
+    EXPECT_EQ(m.find("nothing dissipates"), std::string::npos) << m;
+  }
 }
 
 TEST(Calibrate, RefusalsNameTheField) {
