@@ -470,6 +470,7 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
           "{:g} Hz (off by {:.3g} %, allowed {:g} %)",
           r.mean_cadence_hz_reduced, sel.name, r.load_value, sel.unit, opt.cadence_hz, 100 * miss_reduced,
           100 * kReducedCadenceTolerance));
+    r.load_searches = pass + 1;
     if (!power_mode) break;
     const double P_diss = cy.detail.dissipated_power_W;
     const double f = std::log(P_diss / opt.power_w);  // 0 at the target

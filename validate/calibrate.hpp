@@ -58,6 +58,7 @@ struct CalibrationResult {
   double work_per_rev_per_unit = 0.0;
   double steady_q = 0.0, steady_qdot = 0.0;  // a point of the steady cycle (initial conditions)
   int evaluations = 0;                  // steady cycles computed
+  int load_searches = 0;                // Brent searches of the load value (power mode: one per coefficient tried)
   double wall_time_s = 0.0;
 };
 

@@ -251,6 +251,7 @@ int run_calibrate(const CalibrateArgs& a) {
       {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
       {"mean_power_w", r.mean_power_w},
       {"mean_dissipated_power_w", r.mean_dissipated_power_w},
+      {"load_searches", r.load_searches},
       {"peak_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
       {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : number_or_null(r.peak_force_full_N)},
       {"force_name", r.force_name},

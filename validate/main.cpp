@@ -90,9 +90,11 @@ int main(int argc, char** argv) {
       "Find (GSL Brent) the value of a drive load -- a joint torque or force, or a motor's stall torque with its "
       "no-load speed kept (--load), or every joint torque together -- that holds the mean steady rate of the "
       "independent coordinate at F rev/s with the reduced model, confirmed with the full model. With --power-w "
-      "the scene's one resistance is first set to dissipate P watts at F; without, the resistances stay as given. "
+      "the scene's one resistance is set too, so that the steady cycle dissipates P watts on average at F; "
+      "without, the resistances stay as given. "
       "Prints JSON on standard output (load, load_kind, load_value, load_unit, drive_torque_Nm for joint torques, "
-      "mean_cadence_hz_reduced, mean_cadence_hz_full, mean_power_w, force_name and its peak_force_N, "
+      "mean_cadence_hz_reduced, mean_cadence_hz_full, mean_power_w, mean_dissipated_power_w, load_searches, "
+      "force_name and its peak_force_N, "
       "speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
   auto* cal_cadence_opt = calibrate->add_option(

@@ -154,6 +154,48 @@ TEST(Extract, PointForceNeedsLengthRatesFromTheSource) {
   }
 }
 
+// A line whose points meet between grid points: a point at radius R on the turning body pulled
+// toward a ground point at radius ρR and angle 3° (the 15° grid's points at 0° and 15°).
+// L(q) = R·√(1 + ρ² − 2ρ cos(q − φ)), dL/dq = R²ρ sin(q − φ)/L: at ρ = 1 the points meet at φ
+// (dL/dq jumps from −R to +R), the extraction stops naming the load (exit 1, as the full model);
+// at ρ = 0.99 (closest 1 % of R apart) dL/dq is smooth and the table is made.
+TEST(Extract, PointForceWhosePointsMeetBetweenGridPointsStops) {
+  struct Line : test::AnalyticSource {
+    double rho = 1.0, R = 0.1, phi = 3 * M_PI / 180;
+    reduced::RatioPoint ratios(double q) override {
+      auto r = test::AnalyticSource::ratios(q);
+      const double L = R * std::sqrt(1 + rho * rho - 2 * rho * std::cos(q - phi));
+      if (!(L >= models::limits::kMinPointForceLength_m))
+        throw models::NumericalError("analytic: point force 'm' has its points closer than the limit");
+      r.length_wrt_q = {R * R * rho * std::sin(q - phi) / L};
+      r.length_wrt_x.assign(num_constraint_forces(), std::vector<double>{0.0});
+      return r;
+    }
+  };
+  auto scene = test::analytic_scene();
+  models::PointForce pf;
+  pf.name = "m";
+  pf.body_a = models::kGround;
+  pf.body_b = scene.bodies[0].name;
+  pf.value = 2.0;
+  scene.point_forces.push_back(pf);
+  ExtractOptions opt;
+  opt.step_rad = 15 * M_PI / 180;
+  Line meets;
+  try {
+    extract_samples(meets, scene, opt);
+    FAIL() << "extracted through the meeting";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("point force 'm': its points meet near q = 0.0523"), std::string::npos) << m;
+  }
+  Line apart;
+  apart.rho = 0.99;
+  const Samples s = extract_samples(apart, scene, opt);
+  const int c = s.require("Qpf_m");
+  for (size_t i = 0; i < s.q.size(); ++i) EXPECT_EQ(s.columns[c][i], -apart.ratios(s.q[i]).length_wrt_q[0]);
+}
+
 TEST(Extract, GridMustDivideATurn) {
   test::AnalyticSource src;
   ExtractOptions opt;
