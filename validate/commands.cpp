@@ -467,6 +467,8 @@ constexpr std::uintmax_t kMaxSummaryBytes = 64u << 20;
 int run_report(const ReportArgs& a) {
   namespace fs = std::filesystem;
   std::error_code ec;
+  if (const std::string kind = models::non_regular_file_kind(a.summary); !kind.empty())  // before opening
+    throw ArgumentError(a.summary + ": not a regular file (" + kind + "): give the summary.json of `rdyn validate`");
   if (!fs::is_regular_file(a.summary, ec))
     throw ArgumentError(a.summary + ": not a readable file (give the summary.json of `rdyn validate`)");
   const auto size = fs::file_size(a.summary, ec);

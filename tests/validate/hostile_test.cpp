@@ -660,6 +660,8 @@ void found_later(std::vector<Case>& cs) {
            {"optimize", "p.yaml", "--out", "o"},
            {"validate", "p.yaml", "--quick", "--out", "o"}})
     cs.push_back({"scene_fifo_" + args[0], args, 2, "p.yaml: not a regular file (a FIFO)", {}, fifo("p.yaml"), "o", quick});
+  cs.push_back({"report_summary_fifo", {"report", "s.json", "--out", "o"}, 2, "s.json: not a regular file (a FIFO)", {},
+                fifo("s.json"), "o", quick});
   cs.push_back({"scene_folder", {"simulate", "p.yaml", "--out", "o"}, 2, "p.yaml: is a folder, not a scene file", {},
                 [](const fs::path& d) { fs::create_directory(d / "p.yaml"); }, "o"});
   cs.push_back({"table_fifo", {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--out", "o"}, 2,
