@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <gsl/gsl_errno.h>
@@ -55,6 +56,14 @@ const std::string& name_of(const models::Scene& s, const Entry& e) {
 const char* unit_of(const models::Scene& s, const std::string& joint) {
   const auto* j = s.find_joint(joint);
   return j && j->type == models::JointType::Prismatic ? "N" : "N·m";
+}
+
+// The index of the first element of `v` (loads of one kind) named `name`; none: empty.
+template <class Load>
+std::optional<size_t> index_named(const std::vector<Load>& v, const std::string& name) {
+  for (size_t i = 0; i < v.size(); ++i)
+    if (v[i].name == name) return i;
+  return std::nullopt;
 }
 
 // Which load `opt.load` names (empty: every joint torque). Throws SceneError naming
@@ -121,40 +130,33 @@ Selection select_load(const models::Scene& scene, const CalibrationOptions& opt)
   }
   if (!models::is_valid_name(opt.load)) fail(opt.load_field, models::invalid_name_message(opt.load));
   sel.name = opt.load;
-  for (size_t i = 0; i < scene.joint_torques.size(); ++i)
-    if (scene.joint_torques[i].name == opt.load) {
-      const auto& t = scene.joint_torques[i];
-      sel.entries.push_back({false, i, t.value < 0 ? -1.0 : 1.0});
-      sel.unit = unit_of(scene, t.joint);
-      sel.kind = sel.unit == "N" ? "joint_force" : "joint_torque";
-      return sel;
-    }
-  for (size_t i = 0; i < scene.motors.size(); ++i)
-    if (scene.motors[i].name == opt.load) {
-      const auto& m = scene.motors[i];
-      // The stall torque keeps the no-load speed's sign (check_scene: same signs).
-      sel.entries.push_back({true, i, m.no_load_speed < 0 ? -1.0 : 1.0});
-      sel.unit = unit_of(scene, m.joint);
-      sel.kind = sel.unit == "N" ? "motor_stall_force" : "motor_stall_torque";
-      return sel;
-    }
-  for (size_t i = 0; i < scene.point_forces.size(); ++i)
-    if (scene.point_forces[i].name == opt.load) {
-      // Its tension [N] (the amplitude with a profile): work per revolution per newton, like a torque.
-      Entry e{false, i, scene.point_forces[i].value < 0 ? -1.0 : 1.0, true};
-      sel.entries.push_back(e);
-      sel.unit = "N";
-      sel.kind = "point_force";
-      return sel;
-    }
-  for (const auto& r : scene.resistances)
-    if (r.name == opt.load)
-      fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque, "
-                           "point_force or motor (" + candidates() + "); the resistance follows from --power-w");
-  for (const auto& sp : scene.springs)
-    if (sp.name == opt.load)
-      fail(opt.load_field, "'" + opt.load + "' is a spring, which does no net work per revolution: calibrate adjusts "
-                           "a joint_torque or a motor (" + candidates() + ")");
+  auto selected = [&](Entry e, const std::string& unit, const std::string& kind) {
+    sel.entries.push_back(e);
+    sel.unit = unit;
+    sel.kind = kind;
+    return sel;
+  };
+  if (const auto i = index_named(scene.joint_torques, opt.load)) {
+    const auto& t = scene.joint_torques[*i];
+    const std::string unit = unit_of(scene, t.joint);
+    return selected({false, *i, t.value < 0 ? -1.0 : 1.0}, unit, unit == "N" ? "joint_force" : "joint_torque");
+  }
+  if (const auto i = index_named(scene.motors, opt.load)) {
+    // The stall torque keeps the no-load speed's sign (check_scene: same signs).
+    const auto& m = scene.motors[*i];
+    const std::string unit = unit_of(scene, m.joint);
+    return selected({true, *i, m.no_load_speed < 0 ? -1.0 : 1.0}, unit,
+                    unit == "N" ? "motor_stall_force" : "motor_stall_torque");
+  }
+  // A point force's tension [N] (the amplitude with a profile): work per revolution per newton, like a torque.
+  if (const auto i = index_named(scene.point_forces, opt.load))
+    return selected({false, *i, scene.point_forces[*i].value < 0 ? -1.0 : 1.0, true}, "N", "point_force");
+  if (index_named(scene.resistances, opt.load))
+    fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque, "
+                         "point_force or motor (" + candidates() + "); the resistance follows from --power-w");
+  if (index_named(scene.springs, opt.load))
+    fail(opt.load_field, "'" + opt.load + "' is a spring, which does no net work per revolution: calibrate adjusts "
+                         "a joint_torque or a motor (" + candidates() + ")");
   fail(opt.load_field, "no joint_torque, point_force or motor named '" + opt.load + "' (" + candidates() + ")");
   return sel;
 }
