@@ -172,15 +172,24 @@ ForwardOptions scene_options(const models::Scene& scene) {
   return opt;
 }
 
+// models/scenes/hard/parallelogram.yaml (conservative: gravity only, W = 0; it turns through its
+// aligned, singular positions) and its run options with `integrator` at `tolerance`.
+const models::Scene& hard_parallelogram() {
+  static const models::Scene scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  return scene;
+}
+ForwardOptions hard_parallelogram_options(const std::string& integrator, double tolerance) {
+  auto opt = scene_options(hard_parallelogram());
+  opt.integrator = integrator;
+  opt.tolerance = tolerance;
+  return opt;
+}
+
 TEST(ForwardDynamicsChecks, EnergyLostThroughSingularPositionsIsANumericalError) {
-  // models/scenes/hard/parallelogram.yaml is conservative (gravity only, W = 0). Merson at
-  // 1e-6 steps through the aligned positions onto a wrong motion and loses nearly all its
-  // energy (measured: residual 5.88 J of 5.88 J at t ≈ 2.7 s).
-  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
-  FullModel model(scene);
-  auto opt = scene_options(scene);
-  opt.integrator = "rkmerson";
-  opt.tolerance = 1e-6;
+  // Merson at 1e-6 steps through the aligned positions onto a wrong motion and loses nearly
+  // all its energy (measured: residual 5.88 J of 5.88 J at t ≈ 2.7 s).
+  FullModel model(hard_parallelogram());
+  auto opt = hard_parallelogram_options("rkmerson", 1e-6);
   const std::string m = message_of<models::NumericalError>([&] { simulate_full(model, opt); });
   EXPECT_TRUE(has(m, "energy balance does not close")) << m;
   EXPECT_TRUE(has(m, "'rkmerson' at tolerance 1e-06")) << m;
@@ -194,12 +203,7 @@ TEST(ForwardDynamicsChecks, EnergyLostThroughSingularPositionsIsANumericalError)
 TEST(ForwardDynamicsChecks, CPodesThroughTheSameSingularPositionsPasses) {
   // The scene's own reference setting (CPodes at 1e-7) keeps the energy (measured 1e-5
   // relative), well inside the 1 % acceptance.
-  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
-  FullModel model(scene);
-  auto opt = scene_options(scene);
-  opt.integrator = "cpodes";
-  opt.tolerance = 1e-7;
-  const auto ts = simulate_full(model, opt);
+  const auto ts = simulate_full(FullModel(hard_parallelogram()), hard_parallelogram_options("cpodes", 1e-7));
   const auto eb = models::energy_balance(ts);
   EXPECT_LT(eb.max_residual_J, 1e-3 * eb.energy_scale_J);
   EXPECT_GT(ts.q.back() - ts.q.front(), 2 * 3.14159265358979323846);  // it turned over the top
