@@ -295,39 +295,18 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
                                                                           : 0);
 
-  // 1. Which geared bodies can be folded onto their driver: a leaf turning about a fixed
-  //    axis through its centre of mass, touched by nothing else, whose motion is not
-  //    requested. Its kinetic energy ½ I (r u)² becomes ½ (r² I) u² on the driver.
+  // 1. Which geared bodies can be folded onto their driver (models/gear_fold.hpp): a leaf
+  //    turning about a fixed axis through its centre of mass, touched by nothing else, whose
+  //    motion is not requested. Its kinetic energy ½ I (r u)² becomes ½ (r² I) u² on the driver.
   std::vector<double> extra_inertia(nb, 0.0);
   std::vector<bool> gear_folded(scene.gears.size(), false);
-  for (size_t g = 0; g < scene.gears.size() && options.fold_geared_bodies; ++g) {
-    const auto& gear = scene.gears[g];
-    const int jd = scene.joint_index(gear.driven), jr = scene.joint_index(gear.driver);
-    const auto& driven = scene.joints[jd];
-    const auto& driver = scene.joints[jr];
-    const int b = scene.body_index(driven.child);
-    const auto& body = scene.bodies[b];
-    bool ok = driven.parent == models::kGround && driver.parent == models::kGround &&
-              std::hypot(body.com_m.x - driven.child_point.x, body.com_m.y - driven.child_point.y) < 1e-12;
-    for (const auto& name : scene.outputs.bodies) ok &= name != body.name;
-    for (const auto& j : scene.joints) ok &= j.parent != body.name;
-    for (const auto& l : scene.loops) ok &= l.body_a != body.name && l.body_b != body.name;
-    for (const auto& sp : scene.springs) ok &= sp.body_a != body.name && sp.body_b != body.name;
-    for (const auto& pf : scene.point_forces)
-      ok &= pf.body_a != body.name && pf.body_b != body.name &&
-            (!pf.active_when || pf.active_when->joint != driven.name);
-    for (const auto& t : scene.joint_torques) ok &= t.joint != driven.name && (!t.active_when || t.active_when->joint != driven.name);
-    for (const auto& m : scene.motors) ok &= m.joint != driven.name;
-    for (const auto& g2 : scene.gears) ok &= &g2 == &gear || (g2.driver != driven.name && g2.driven != driven.name);
-    for (const auto& c : scene.outputs.constraint_forces) ok &= c.joint != driven.name;
-    ok &= driven.name != scene.independent;
-    if (!ok) continue;
-    Fold f{b, jd, jr, gear.ratio, driven.guess - gear.ratio * driver.guess};
-    joint_fold[jd] = f;
-    body_fold[b] = f;
-    gear_folded[g] = true;
-    extra_inertia[scene.body_index(driver.child)] += gear.ratio * gear.ratio * body.inertia_kgm2;
-  }
+  if (options.fold_geared_bodies)
+    for (const auto& f : models::calc_gear_folds(scene)) {
+      joint_fold[f.driven_joint] = f;
+      body_fold[f.body] = f;
+      gear_folded[f.gear] = true;
+      extra_inertia[f.driver_body] += f.moved_inertia_kgm2;
+    }
 
   // 2. Mobilizers in tree order (parents first).
   std::vector<bool> built(nj, false);
@@ -407,7 +386,7 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     Vector coeff(3);
     coeff[0] = -gear.ratio;
     coeff[1] = 1.0;
-    coeff[2] = -(scene.joints[jd].guess - gear.ratio * scene.joints[jr].guess);
+    coeff[2] = -models::calc_gear_offset(scene, gear);
     std::vector<MobilizedBodyIndex> mbs{joint_mobod[jr].getMobilizedBodyIndex(),
                                         joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};

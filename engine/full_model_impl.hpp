@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/full_model.hpp"
+#include "models/gear_fold.hpp"
 
 namespace rdyn::engine {
 
@@ -27,14 +28,9 @@ enum LoadMode : int {
   kLoadsEvents = 3,        // everything; rate gates from flags switched by events
 };
 
-// A body reduced onto its driver joint through a gear of ratio r.
-struct Fold {
-  int body = -1;          // scene body index
-  int driven_joint = -1;  // scene joint index of the folded body's joint
-  int driver_joint = -1;
-  double ratio = 1.0;
-  double q_offset = 0.0;  // q_driven = r·q_driver + q_offset
-};
+// A body reduced onto its driver joint through a gear of ratio r (models/gear_fold.hpp: body,
+// driven_joint, driver_joint, ratio, q_offset with q_driven = r·q_driver + q_offset).
+using Fold = models::GearFold;
 
 struct FullModel::Impl {
   models::Scene scene;

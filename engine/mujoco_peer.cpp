@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 
+#include "models/gear_fold.hpp"
 #include "models/mjcf_export.hpp"
 
 #ifdef RDYN_HAVE_MUJOCO
@@ -65,13 +66,9 @@ std::string mujoco_version() { return mj_versionString(); }
 
 namespace {
 
-// A fold: joint `driven` turns at `ratio` times joint `driver` (+ offset), its body built into
-// the driver's (models::calc_foldable_gears).
-struct Fold {
-  int driver = -1;
-  double ratio = 1.0;
-  double offset = 0.0;
-};
+// A fold: joint driven_joint turns at `ratio` times joint driver_joint (+ q_offset), its body
+// built into the driver's (models/gear_fold.hpp).
+using Fold = models::GearFold;
 
 // MuJoCo reports fatal errors through mju_error, which by default prints and exits the process:
 // rdyn turns them into exceptions (MuJoCo is built with unwind tables on Debian's x86-64 and
@@ -107,7 +104,6 @@ struct MujocoModel::Impl {
   std::vector<std::optional<Fold>> joint_fold;
   std::vector<int> body_id;                     // per scene body; −1 when folded
   std::vector<std::optional<Fold>> body_fold;   // folded body: its rate = ratio · rate(driver)
-  std::vector<int> folded_body_joint;           // folded body: its own (driven) joint
   std::vector<int> request_body;                // per constraint force: the joint's child
   std::vector<models::Vec2> request_dir;        // unit, child frame
   int independent = -1;
@@ -153,22 +149,22 @@ struct Run {
   }
 
   double joint_q(int j) const {
-    if (const auto& f = model.joint_fold[j]) return f->ratio * joint_q(f->driver) + f->offset;
+    if (const auto& f = model.joint_fold[j]) return f->ratio * joint_q(f->driver_joint) + f->q_offset;
     return d->qpos[model.joint_qadr[j]];
   }
   double joint_u(int j) const {
-    if (const auto& f = model.joint_fold[j]) return f->ratio * joint_u(f->driver);
+    if (const auto& f = model.joint_fold[j]) return f->ratio * joint_u(f->driver_joint);
     return d->qvel[model.joint_dof[j]];
   }
   // Angular rate about z [rad/s]: MuJoCo's cvel holds the world angular velocity first.
   double body_rate(int b) const {
-    if (const auto& f = model.body_fold[b]) return f->ratio * joint_u(f->driver);
+    if (const auto& f = model.body_fold[b]) return f->ratio * joint_u(f->driver_joint);
     return d->cvel[6 * model.body_id[b] + 2];
   }
   // Generalized force on a joint's coordinate; a folded joint's goes to its driver by virtual
   // power (τ_driver = r·τ_driven), as engine/scene_loads.cpp add_joint_force.
   void add_joint_force(int j, double tau) {
-    if (const auto& f = model.joint_fold[j]) return add_joint_force(f->driver, f->ratio * tau);
+    if (const auto& f = model.joint_fold[j]) return add_joint_force(f->driver_joint, f->ratio * tau);
     d->qfrc_applied[model.joint_dof[j]] += tau;
   }
   models::Vec2 world_point(int body, models::Vec2 p) const {
@@ -223,7 +219,7 @@ struct Run {
       const int b = sc.body_index(r.body);
       const double w = body_rate(b), T = models::resistance_torque(r.law, r.coefficient, w);
       if (model.body_fold[b]) {
-        add_joint_force(model.folded_body_joint[b], T);
+        add_joint_force(model.body_fold[b]->driven_joint, T);
       } else {
         d->xfrc_applied[6 * model.body_id[b] + 5] += T;
       }
@@ -342,17 +338,9 @@ MujocoModel::MujocoModel(const models::Scene& scene, const std::vector<double>& 
   im.joint_fold.resize(nj);
   im.body_id.assign(nb, -1);
   im.body_fold.resize(nb);
-  im.folded_body_joint.assign(nb, -1);
-  const auto foldable = models::calc_foldable_gears(scene);
-  for (size_t g = 0; g < scene.gears.size(); ++g) {
-    if (!foldable[g]) continue;
-    const auto& gear = scene.gears[g];
-    const int jd = scene.joint_index(gear.driven), jr = scene.joint_index(gear.driver);
-    const Fold f{jr, gear.ratio, scene.joints[jd].guess - gear.ratio * scene.joints[jr].guess};
-    im.joint_fold[jd] = f;
-    const int b = scene.body_index(scene.joints[jd].child);
-    im.body_fold[b] = f;
-    im.folded_body_joint[b] = jd;
+  for (const auto& f : models::calc_gear_folds(scene)) {
+    im.joint_fold[f.driven_joint] = f;
+    im.body_fold[f.body] = f;
   }
   for (size_t j = 0; j < nj; ++j) {
     if (im.joint_fold[j]) continue;

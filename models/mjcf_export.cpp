@@ -58,17 +58,12 @@ class Writer {
     extra_Izz_.assign(s.bodies.size(), 0.0);
     folded_body_.assign(s.bodies.size(), false);
     folded_gear_.assign(s.gears.size(), false);
-    if (o.fold_geared_bodies) {
-      folded_gear_ = calc_foldable_gears(s);
-      for (size_t g = 0; g < s.gears.size(); ++g) {
-        if (!folded_gear_[g]) continue;
-        const auto& gear = s.gears[g];
-        const int b = s.body_index(s.find_joint(gear.driven)->child);
-        folded_body_[b] = true;
-        // ½ I (r u)² = ½ (r² I) u²: the driven body's kinetic energy on its driver.
-        extra_Izz_[s.body_index(s.find_joint(gear.driver)->child)] += gear.ratio * gear.ratio * s.bodies[b].inertia_kgm2;
+    if (o.fold_geared_bodies)
+      for (const auto& f : calc_gear_folds(s)) {
+        folded_gear_[f.gear] = true;
+        folded_body_[f.body] = true;
+        extra_Izz_[f.driver_body] += f.moved_inertia_kgm2;
       }
-    }
   }
 
   std::string document() {
@@ -207,9 +202,9 @@ class Writer {
       if (folded_gear_[g]) continue;
       const auto& gear = s_.gears[g];
       const int jr = s_.joint_index(gear.driver), jd = s_.joint_index(gear.driven);
-      // Scene: q_driven = r·q_driver + c, c = guess_driven − r·guess_driver (engine/full_model.cpp).
+      // Scene: q_driven = r·q_driver + c, c = guess_driven − r·guess_driver (models/gear_fold.hpp).
       // MJCF: y − y0 = a0 + a1 (x − x0), y = joint1 (driven), x = joint2 (driver), *0 their refs.
-      const double c = s_.joints[jd].guess - gear.ratio * s_.joints[jr].guess;
+      const double c = calc_gear_offset(s_, gear);
       const double a0 = gear.ratio * q_ref_[jr] + c - q_ref_[jd];
       out_ += fmt::format("    <joint name=\"gear_{}\" joint1=\"{}\" joint2=\"{}\" polycoef=\"{} {} 0 0 0\"/>\n",
                           xml_escape(gear.name), xml_escape(gear.driven), xml_escape(gear.driver), num(a0),
@@ -226,36 +221,6 @@ class Writer {
 };
 
 }  // namespace
-
-std::vector<bool> calc_foldable_gears(const Scene& s) {
-  std::vector<bool> fold(s.gears.size(), false);
-  for (size_t g = 0; g < s.gears.size(); ++g) {
-    const auto& gear = s.gears[g];
-    const Joint* driven = s.find_joint(gear.driven);
-    const Joint* driver = s.find_joint(gear.driver);
-    if (!driven || !driver) continue;
-    const Body* body = s.find_body(driven->child);
-    if (!body) continue;
-    bool ok = driven->parent == kGround && driver->parent == kGround && driven->name != s.independent &&
-              std::hypot(body->com_m.x - driven->child_point.x, body->com_m.y - driven->child_point.y) < 1e-12;
-    for (const auto& name : s.outputs.bodies) ok &= name != body->name;
-    for (const auto& j : s.joints) ok &= j.parent != body->name;
-    for (const auto& l : s.loops) ok &= l.body_a != body->name && l.body_b != body->name;
-    for (const auto& sp : s.springs) ok &= sp.body_a != body->name && sp.body_b != body->name;
-    for (const auto& pf : s.point_forces)
-      ok &= pf.body_a != body->name && pf.body_b != body->name &&
-            (!pf.active_when || pf.active_when->joint != driven->name);
-    for (const auto& t : s.joint_torques)
-      ok &= t.joint != driven->name && (!t.active_when || t.active_when->joint != driven->name);
-    for (const auto& m : s.motors) ok &= m.joint != driven->name;
-    for (const auto& g2 : s.gears) ok &= &g2 == &gear || (g2.driver != driven->name && g2.driven != driven->name);
-    for (const auto& c : s.outputs.constraint_forces) ok &= c.joint != driven->name;
-    // A driver that is itself folded would carry the inertia into a body that is not built.
-    for (size_t g2 = 0; g2 < g; ++g2) ok &= !(fold[g2] && s.gears[g2].driven == driver->name);
-    fold[g] = ok;
-  }
-  return fold;
-}
 
 std::string export_mjcf(const Scene& scene, const MjcfOptions& options) {
   check_options(scene, options);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "models/gear_fold.hpp"
 #include "models/scene.hpp"
 
 namespace rdyn::models {
@@ -31,12 +32,6 @@ struct MjcfOptions {
   double dampratio = 1.0;
   double impedance = 0.9999;  // dmin = dmax, in (0, 1)
 };
-
-// Whether gear `g` can be folded into its driver: the driven body is a leaf turning about its
-// centre of mass on a ground joint, touched by no loop, spring, load, request or other gear,
-// its motion not requested — the conditions of the full model's fold (engine/full_model.cpp),
-// so both engines simulate the same bodies.
-std::vector<bool> calc_foldable_gears(const Scene& scene);
 
 // The MJCF document. Throws SceneError for a body named "world" (MJCF's ground) and for options
 // out of range (reference_q of the wrong size or not finite, a time step ≤ 0, an unknown

@@ -8,6 +8,7 @@
 #include "engine/full_model.hpp"
 #include "models/scene.hpp"
 #include "reduced/samples.hpp"
+#include "validate/cli_options.hpp"
 #include "validate/commands.hpp"
 #include "validate/expand.hpp"
 #include "validate/inspect.hpp"
@@ -18,10 +19,6 @@
 namespace {
 constexpr int kExitBadInput = 2;
 constexpr int kExitNumerical = 1;
-constexpr const char* kForceHelpDir =
-    "Write into an existing folder that holds files rdyn did not write (same-named files are replaced, nothing else "
-    "is touched). Without it such a folder is refused; an earlier rdyn output is replaced atomically.";
-constexpr const char* kForceHelpFile = "Replace an existing file that rdyn did not write";
 }
 
 int main(int argc, char** argv) {
@@ -97,12 +94,7 @@ int main(int argc, char** argv) {
       "force_name and its peak_force_N, "
       "speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
-  auto* cal_cadence_opt = calibrate->add_option(
-      "--cadence-hz", cal.cadence_hz, "Target mean rate [rev/s] (default: the scene's validation.calibrate, else 1)");
-  auto* cal_power_opt = calibrate->add_option(
-      "--power-w", cal.power_w,
-      "Power the resistance dissipates at that cadence [W] (default: the scene's validation.calibrate; none: the "
-      "resistances stay as given)");
+  add_operating_point_options(*calibrate, cal.cadence_hz, cal.cadence_given, cal.power_w, cal.power_given);
   // An empty --load would silently mean "no load named" (every joint torque): refuse it.
   const CLI::Validator names_a_load(
       [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
@@ -112,10 +104,8 @@ int main(int argc, char** argv) {
       ->check(names_a_load);
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
   calibrate->add_flag("--force", cal.force, kForceHelpFile);
-  calibrate->add_option("--set", cal.sets, "Override a scalar of the scene: key.path=value (repeatable)");
-  calibrate->add_option("--grid-deg", cal.grid_deg, "Reduced table grid [deg] (default 10)");
-  calibrate->add_option("--interp", cal.interpolation, "Reduced table interpolation (default fourier)")
-      ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
+  add_scene_overrides(*calibrate, cal.sets);
+  add_reduced_table_options(*calibrate, cal.grid_deg, cal.interpolation);
 
   ValidateArgs val;
   auto* validate = app.add_subcommand(
@@ -204,11 +194,7 @@ int main(int argc, char** argv) {
       "constant strategy and the optimum confirmed with the full model. Writes DIR/summary.json, profile.csv, "
       "report.html.");
   optimize->add_option("scene", opz.scene, "Scene name or YAML file")->required();
-  auto* opz_cadence = optimize->add_option("--cadence-hz", opz.cadence_hz,
-                                           "Mean cadence [rev/s] (default: the scene's validation.calibrate, else 1)");
-  auto* opz_power = optimize->add_option("--power-w", opz.power_w,
-                                         "Power the resistance dissipates at that cadence [W] (default: the scene's "
-                                         "validation.calibrate; none: resistances as given)");
+  add_operating_point_options(*optimize, opz.cadence_hz, opz.cadence_given, opz.power_w, opz.power_given);
   optimize->add_option("--harmonics", opz.harmonics, "Harmonics H of each shape, 1..12 (default: the scene's, else 3)");
   optimize->add_option("--objective", opz.objective, "peak (default) or pnorm: (mean |F|^p)^(1/p) over the cycle")
       ->check(CLI::IsMember({"peak", "pnorm"}));
@@ -223,13 +209,10 @@ int main(int argc, char** argv) {
   optimize->add_option("--add-torque-max", opz.add_torque_max, "Bound on |torque_<JOINT>| [N·m] (default 50)");
   optimize->add_option("--max-evaluations", opz.max_evaluations, "Optimiser evaluations, 1..100000 (default 400)");
   optimize->add_option("--rel-tolerance", opz.rel_tolerance, "Optimiser relative tolerance (default 1e-4)");
-  optimize->add_option("--grid-deg", opz.grid_deg, "Reduced table grid [deg] (default 10)");
-  optimize->add_option("--interp", opz.interpolation, "Reduced table interpolation (default fourier)")
-      ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
+  add_reduced_table_options(*optimize, opz.grid_deg, opz.interpolation);
   optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
-  optimize->add_option("--set", opz.sets, "Override a scalar of the scene: key.path=value (repeatable)");
-  optimize->add_option("--out", opz.out, "Output folder (written atomically)")->required();
-  optimize->add_flag("--force", opz.force, kForceHelpDir);
+  add_scene_overrides(*optimize, opz.sets);
+  add_output_folder(*optimize, opz.out, opz.force);
   ExpandArgs exp;
   auto* expand = app.add_subcommand(
       "expand",
@@ -254,12 +237,8 @@ int main(int argc, char** argv) {
   }
 
   if (duration_opt->count()) sim.duration = duration;
-  cal.cadence_given = cal_cadence_opt->count() > 0;
-  cal.power_given = cal_power_opt->count() > 0;
   if (dt_out_opt->count()) sim.dt_out = dt_out;
-  opz.cadence_given = opz_cadence->count() > 0;
   opz.force_name_given = opz_force_name->count() > 0;
-  opz.power_given = opz_power->count() > 0;
   if (tolerance_opt->count()) sim.tolerance = tolerance;
   try {
     if (*simulate) return run_simulate(sim);

@@ -10,13 +10,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "engine/forward_dynamics.hpp"
-#include "engine/full_model.hpp"
 #include "reduced/profile_columns.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/confirm_full.hpp"
 
 namespace rdyn::validate {
 
@@ -24,8 +23,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kTwoPi = 2 * M_PI;
-// Acceptance of the full-model confirmation: the mean cadence within 1 % of F (issue #13).
-constexpr double kFullCadenceTolerance = 1e-2;
 // Sampled constraints: τ(θ_i) ≥ 0 at 5° spacing (a series of ≤ 12 harmonics has no dip
 // narrower than ~15° that falls between samples by more than a few percent of its depth), and
 // the bound on |value·τ| at 1° spacing.
@@ -300,62 +297,6 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
   for (int g = 0; g < static_cast<int>(d.groups.size()); ++g)
     result[i++] = e.ok ? (std::abs(e.cal.load_value) * e.max_tau[g] - d.groups[g].bound) / d.groups[g].bound : 1.0;
   (void)m;
-}
-
-// Samples (q, F) of one revolution resampled at 0°, 1°, … 359° of q (linear between the
-// samples, across the 360° wrap).
-std::vector<double> resample_by_angle(std::vector<std::pair<double, double>> pts) {
-  for (auto& p : pts) p.first = std::fmod(std::fmod(p.first, kTwoPi) + kTwoPi, kTwoPi);
-  std::sort(pts.begin(), pts.end());
-  std::vector<double> out(360, NAN);
-  if (pts.empty()) return out;
-  for (int a = 0; a < 360; ++a) {
-    const double th = a * M_PI / 180;
-    auto it = std::lower_bound(pts.begin(), pts.end(), std::make_pair(th, -HUGE_VAL));
-    const auto& hi = it == pts.end() ? pts.front() : *it;
-    const auto& lo = it == pts.begin() ? pts.back() : *(it - 1);
-    double span = hi.first - lo.first, off = th - lo.first;
-    if (span <= 0) span += kTwoPi;
-    if (off < 0) off += kTwoPi;
-    out[a] = lo.second + (hi.second - lo.second) * std::min(1.0, off / span);
-  }
-  return out;
-}
-
-// Mean cadence over the whole revolutions after `skip` and the peak |F_k| over that window.
-struct FullWindow {
-  double cadence_hz = NAN, peak_N = NAN;
-  std::vector<double> force_1deg;  // F over the last whole revolution at 0°, 1°, … 359° of q
-};
-
-FullWindow analyse_full(const models::TimeSeries& ts, double skip, int k) {
-  FullWindow w;
-  size_t i1 = 0;
-  while (i1 < ts.t.size() && ts.t[i1] < skip) ++i1;
-  if (i1 + 2 >= ts.t.size()) return w;
-  const double q0 = ts.q[i1];
-  const long revs = static_cast<long>(std::floor((ts.q.back() - q0) / kTwoPi));
-  if (revs < 1) return w;
-  // Time where q reaches q0 + 2π·n (linear between output rows, 2 ms apart).
-  auto crossing = [&](long n, size_t& at) {
-    const double target = q0 + kTwoPi * n;
-    size_t i = i1;
-    while (i + 1 < ts.q.size() && ts.q[i + 1] < target) ++i;
-    at = i;
-    const double f = (target - ts.q[i]) / (ts.q[i + 1] - ts.q[i]);
-    return ts.t[i] + f * (ts.t[i + 1] - ts.t[i]);
-  };
-  size_t i_end = 0, i_prev = 0;
-  const double t_end = crossing(revs, i_end);
-  crossing(revs - 1, i_prev);
-  w.cadence_hz = revs / (t_end - ts.t[i1]);
-  w.peak_N = 0.0;
-  for (size_t i = i1; i < ts.t.size(); ++i) w.peak_N = std::max(w.peak_N, std::abs(ts.forces[k][i]));
-  // The last whole revolution, by angle.
-  std::vector<std::pair<double, double>> pts;
-  for (size_t i = i_prev; i <= i_end + 1 && i < ts.t.size(); ++i) pts.push_back({ts.q[i], ts.forces[k][i]});
-  w.force_1deg = resample_by_angle(std::move(pts));
-  return w;
 }
 
 }  // namespace
@@ -667,17 +608,16 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
     // Force over the angle: the cycle's rows by angle.
     std::vector<std::pair<double, double>> pts;
     for (size_t i = 0; i < cyc.t.size(); ++i) pts.push_back({cyc.q[i], cyc.forces[force][i]});
-    c.force_reduced_N = resample_by_angle(std::move(pts));
+    c.force_reduced_N = calc_by_angle(std::move(pts));
     progress.note("optimize: full model, " + label + " strategy");
-    engine::FullModel full(sx);
-    engine::ForwardOptions fo;
-    fo.duration_s = opt.full_duration_s;
-    fo.output_interval_s = 0.002;
-    fo.tolerance = 1e-9;
-    const auto ts = engine::simulate_full(full, fo);
-    const auto fw = analyse_full(ts, opt.full_skip_s, force);
+    // Mean cadence over whole revolutions after full_skip_s, the force's peak and last revolution.
+    FullConfirmOptions fc;
+    fc.duration_s = opt.full_duration_s;
+    fc.skip_s = opt.full_skip_s;
+    fc.force = force;
+    const FullConfirmation fw = confirm_full(sx, fc);
     sr.cadence_full_hz = fw.cadence_hz;
-    sr.peak_full_N = fw.peak_N;
+    sr.peak_full_N = fw.peak_force_N;
     c.force_full_N = fw.force_1deg;
     return std::make_pair(sr, sx);
   };

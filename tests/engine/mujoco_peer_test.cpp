@@ -49,16 +49,33 @@ struct Case {
   Start start;
   models::Scene scene;
 };
-Case reference(const std::string& name, double duration) {
-  Case c{{}, {}, models::load_scene(name)};
-  c.start = assembled(c.scene);
-  FullModel full(c.scene);
+// The full model's run of `scene` from its assembled start, rows every 10 ms.
+Case reference(const models::Scene& scene, double duration, double tolerance) {
+  Case c{{}, assembled(scene), scene};
   ForwardOptions fo;
   fo.duration_s = duration;
   fo.output_interval_s = 0.01;
-  fo.tolerance = 1e-10;
-  c.ref = simulate_full(full, fo);
+  fo.tolerance = tolerance;
+  c.ref = simulate_full(FullModel(c.scene), fo);
   return c;
+}
+Case reference(const std::string& name, double duration) { return reference(models::load_scene(name), duration, 1e-10); }
+
+// An arm swinging about O under gravity, with `loads` (YAML list items) and S a ground point to
+// attach them to.
+models::Scene pendulum(const std::string& name, const std::string& loads) {
+  return models::parse_scene("name: " + name + R"(
+ground_points: {O: [0, 0], S: [0.3, 0.2]}
+bodies:
+  - {name: arm, mass_kg: 1.5, com_m: [0.2, 0], inertia_kgm2: 0.02, points: {tip: [0.4, 0]}}
+joints:
+  - {name: swing, type: revolute, parent: ground, parent_point: O, child: arm, guess_deg: -60}
+independent: swing
+loads:
+)" + loads + R"(gravity: {enabled: true, g_m_s2: [0, -9.81]}
+initial: {q_deg: -60, qdot: 2.0}
+)",
+                             name + ".yaml");
 }
 
 models::TimeSeries run(const Case& c, const std::string& integrator, double h) {
@@ -134,30 +151,15 @@ TEST(MujocoPeer, FirstRowMissesTheVelocityTermInTheDynamicsNotInTheReport) {
 // RK4's own stage weights; wrong weights or a missed stage leave an O(h) residual).
 TEST(MujocoPeer, EveryLoadTypeMatchesTheFullModelAndTheEnergyBalanceCloses) {
   if (!mujoco_available()) GTEST_SKIP() << "rdyn was built without MuJoCo";
-  const auto s = models::parse_scene(R"(
-name: loaded-pendulum
-ground_points: {O: [0, 0], S: [0.3, 0.2]}
-bodies:
-  - {name: arm, mass_kg: 1.5, com_m: [0.2, 0], inertia_kgm2: 0.02, points: {tip: [0.4, 0]}}
-joints:
-  - {name: swing, type: revolute, parent: ground, parent_point: O, child: arm, guess_deg: -60}
-independent: swing
-loads:
-  - {type: joint_torque, name: push, joint: swing, torque_Nm: 0.8, active_when: {joint: swing, rate: positive}}
-  - {type: motor, name: m, joint: swing, stall_torque_Nm: 0.5, no_load_speed_rad_s: 4}
-  - {type: resistance, name: drag, body: arm, law: viscous, coefficient: 0.05}
-  - {type: spring, name: k, body_a: arm, point_a: tip, body_b: ground, point_b: S, stiffness_N_per_m: 40, rest_length_m: 0.1}
-gravity: {enabled: true, g_m_s2: [0, -9.81]}
-initial: {q_deg: -60, qdot: 2.0}
-)",
-                                     "loaded-pendulum.yaml");
-  Case c{{}, assembled(s), s};
-  FullModel full(s);
-  ForwardOptions fo;
-  fo.duration_s = 3.0;
-  fo.output_interval_s = 0.01;
-  fo.tolerance = 1e-11;
-  c.ref = simulate_full(full, fo);
+  const auto c = reference(
+      pendulum("loaded-pendulum",
+               "  - {type: joint_torque, name: push, joint: swing, torque_Nm: 0.8, active_when: {joint: swing, rate: "
+               "positive}}\n"
+               "  - {type: motor, name: m, joint: swing, stall_torque_Nm: 0.5, no_load_speed_rad_s: 4}\n"
+               "  - {type: resistance, name: drag, body: arm, law: viscous, coefficient: 0.05}\n"
+               "  - {type: spring, name: k, body_a: arm, point_a: tip, body_b: ground, point_b: S, "
+               "stiffness_N_per_m: 40, rest_length_m: 0.1}\n"),
+      3.0, 1e-11);
   const auto rk4 = run(c, "rk4", 1e-4), rk4_coarse = run(c, "rk4", 1e-3), euler = run(c, "euler", 1e-4);
   // Measured: RK4 1e-4 s q̇ 7.0e-5 (the gated torque switching inside a step: O(h)); Euler 2.3e-4.
   EXPECT_LT(max_rel(c.ref, c.ref.qdot, rk4.qdot), 2e-4);
@@ -179,29 +181,12 @@ initial: {q_deg: -60, qdot: 2.0}
 // balance, with the point force's power −T·L̇ in its work, closes.
 TEST(MujocoPeer, PointForceMatchesTheFullModelAndTheEnergyBalanceCloses) {
   if (!mujoco_available()) GTEST_SKIP() << "rdyn was built without MuJoCo";
-  const auto s = models::parse_scene(R"(
-name: pulled-pendulum
-ground_points: {O: [0, 0], S: [0.3, 0.2]}
-bodies:
-  - {name: arm, mass_kg: 1.5, com_m: [0.2, 0], inertia_kgm2: 0.02, points: {tip: [0.4, 0]}}
-joints:
-  - {name: swing, type: revolute, parent: ground, parent_point: O, child: arm, guess_deg: -60}
-independent: swing
-loads:
-  - {type: point_force, name: pull, body_a: ground, point_a: S, body_b: arm, point_b: tip, force_N: 6,
-     active_when: {joint: swing, rate: positive}, profile: {of: swing, fourier: {a0: 1, b: [0.3]}}}
-  - {type: resistance, name: drag, body: arm, law: viscous, coefficient: 0.05}
-gravity: {enabled: true, g_m_s2: [0, -9.81]}
-initial: {q_deg: -60, qdot: 2.0}
-)",
-                                     "pulled-pendulum.yaml");
-  Case c{{}, assembled(s), s};
-  FullModel full(s);
-  ForwardOptions fo;
-  fo.duration_s = 3.0;
-  fo.output_interval_s = 0.01;
-  fo.tolerance = 1e-11;
-  c.ref = simulate_full(full, fo);
+  const auto c = reference(
+      pendulum("pulled-pendulum",
+               "  - {type: point_force, name: pull, body_a: ground, point_a: S, body_b: arm, point_b: tip, force_N: 6,\n"
+               "     active_when: {joint: swing, rate: positive}, profile: {of: swing, fourier: {a0: 1, b: [0.3]}}}\n"
+               "  - {type: resistance, name: drag, body: arm, law: viscous, coefficient: 0.05}\n"),
+      3.0, 1e-11);
   const auto rk4 = run(c, "rk4", 1e-4);
   EXPECT_LT(max_rel(c.ref, c.ref.qdot, rk4.qdot), 2e-4);
   const auto eb = models::energy_balance(rk4);

@@ -226,29 +226,52 @@ std::tuple<double, double, double> max_differences(const models::TimeSeries& a, 
   return {dq, dqdot, dF};
 }
 
-TEST(ReducedSource, ProfiledTorquesAgreeBetweenReducedAndFullModels) {
-  // The four-bar driven by a table profile of the rocker's angle (gated by the rocker's rate)
-  // and a Fourier profile of the crank's angle: the reduced model's tau_<load> columns against
-  // Simbody applying value·τ(θ) from the current joint angle, over 3 s (about 5 turns).
-  const char* loads =
-      "  - {type: joint_torque, name: push, joint: crank, torque_Nm: 0.5, active_when: {joint: rocker, rate: "
-      "negative},\n"
-      "     profile: {of: rocker, table_deg: [[0, 0.2], [60, 0.5], [85, 1.0], [100, 1.4], [120, 0.6], [240, 0.1]]}}\n"
-      "  - {type: joint_torque, name: wave, joint: crank, profile: {of: crank, fourier: {a0: 1.5, a: [0.5], b: [0, "
-      "0.3]}}}\n";
-  const auto scene = models::parse_scene(test::fourbar_with_loads(loads, "0.05"), "profiled.yaml");
+// The four-bar with profiled, gated drive loads against a viscous bearing (0.05 N·m·s) over 3 s:
+// the reduced model's tau_<load> (and Qpf/Qxpf) columns against Simbody applying value·τ(θ) from
+// the current joint angle (a point force's tension along its current line).
+struct ProfiledLoads {
+  const char* what;
+  const char* loads;  // the scene's extra `loads` entries
+  double min_turns;   // > 0: the loads drive the crank at least this far round [rev]
+  double min_swing;   // > 0: |q − q0| reaches this [rad] (a large motion, not a twitch about the start)
+  long min_events;    // ≥ 0: the full model's gate switches exceed this
+};
+void PrintTo(const ProfiledLoads& c, std::ostream* os) { *os << c.what; }
+
+class ReducedSourceProfiledLoads : public ::testing::TestWithParam<ProfiledLoads> {};
+
+TEST_P(ReducedSourceProfiledLoads, AgreeBetweenReducedAndFullModels) {
+  const ProfiledLoads& c = GetParam();
+  const auto scene = models::parse_scene(test::fourbar_with_loads(c.loads, "0.05"), "profiled.yaml");
   const auto [red, full] = reduced_and_full_3s(scene);
   ASSERT_EQ(red.t.size(), full.t.size());
   const auto [dq, dqdot, dF] = max_differences(red, full);
   const double peak_F = max_abs(full.forces[0]);
-  std::printf("profiled four-bar, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| %.3g N (of %.3g)\n",
-              dq, dqdot, max_abs(full.qdot), dF, peak_F);
-  EXPECT_GT(full.q.back() - full.q.front(), 4 * 2 * M_PI);  // the profiles drive it round
-  EXPECT_EQ(red.stats.events, full.stats.events);            // the same gate switches
+  std::printf("four-bar, %s, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| %.3g N (of %.3g)\n",
+              c.what, dq, dqdot, max_abs(full.qdot), dF, peak_F);
+  if (c.min_turns > 0) {
+    EXPECT_GT(full.q.back() - full.q.front(), c.min_turns * 2 * M_PI);
+  }
+  if (c.min_swing > 0) {
+    double swing = 0;
+    for (double q : full.q) swing = std::max(swing, std::abs(q - full.q.front()));
+    EXPECT_GT(swing, c.min_swing);
+  }
+  if (c.min_events >= 0) {
+    EXPECT_GT(full.stats.events, c.min_events);
+  }
+  EXPECT_EQ(red.stats.events, full.stats.events);  // the same gate switches
   EXPECT_LT(dq, 1e-4);
   EXPECT_LT(dqdot, 1e-4 * max_abs(full.qdot));
   EXPECT_LT(dF, 1e-3 * peak_F);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    FourBar, ReducedSourceProfiledLoads,
+    ::testing::Values(
+        ProfiledLoads{"ProfiledTorques", test::kFourbarProfiledTorques, 4, 0, -1},
+        ProfiledLoads{"ProfiledGatedPointForce", test::kFourbarGatedPointForce, 0, 2.0, 2}),
+    [](const ::testing::TestParamInfo<ProfiledLoads>& info) { return std::string(info.param.what); });
 
 // A point force's column Qpf_<load> is its generalized force per unit tension, −dL/dq, from the
 // velocity ratio of its line: the closed form of the pulled crank at every grid point; the
@@ -272,33 +295,6 @@ TEST(ReducedSource, PointForceColumnIsMinusTheLengthRateAndRoundTrips) {
     const double m1 = 2.0e-3 + 1.0 * 0.05 * 0.05;  // I about O
     EXPECT_NEAR(qdd, -8.0 * test::pulled_crank_dL_dq(q) / m1, 1e-4 * 8.0 * 0.1 / m1) << q;
   }
-}
-
-// The four-bar pulled by a profiled, gated point force from a ground point to the coupler (it
-// reads the rocker's angle, on while the rocker turns back) against a viscous bearing: the
-// reduced model's Qpf/Qxpf/tau columns against Simbody applying the tension along the current
-// line, over 3 s.
-TEST(ReducedSource, ProfiledGatedPointForceAgreesBetweenReducedAndFullModels) {
-  const char* loads =
-      "  - {type: point_force, name: m, body_a: ground, point_a: [0.1, 0.35], body_b: coupler, point_b: [0.2, 0.03],\n"
-      "     force_N: 6, active_when: {joint: rocker, rate: negative},\n"
-      "     profile: {of: rocker, fourier: {a0: 1, a: [0.4], b: [0.2]}}}\n";
-  const auto scene = models::parse_scene(test::fourbar_with_loads(loads, "0.05"), "muscle.yaml");
-  const auto [red, full] = reduced_and_full_3s(scene);
-  ASSERT_EQ(red.t.size(), full.t.size());
-  const auto [dq, dqdot, dF] = max_differences(red, full);
-  const double peak_F = max_abs(full.forces[0]);
-  std::printf("four-bar with a point force, 5° table: max |Δq| %.3g rad, max |Δq̇| %.3g rad/s (of %.3g), max |ΔF| "
-              "%.3g N (of %.3g)\n",
-              dq, dqdot, max_abs(full.qdot), dF, peak_F);
-  double swing = 0;  // a large motion, not a twitch about the start
-  for (double q : full.q) swing = std::max(swing, std::abs(q - full.q.front()));
-  EXPECT_GT(swing, 2.0);
-  EXPECT_GT(full.stats.events, 2);
-  EXPECT_EQ(red.stats.events, full.stats.events);  // the same gate switches
-  EXPECT_LT(dq, 1e-4);
-  EXPECT_LT(dqdot, 1e-4 * max_abs(full.qdot));
-  EXPECT_LT(dF, 1e-3 * peak_F);
 }
 
 TEST(ReducedSource, RunawayContinuationTargetIsRefusedNotWalked) {
@@ -336,19 +332,33 @@ initial: {q: 0, qdot: 0}
 namespace rdyn::engine {
 namespace {
 
+// A scene whose independent coordinate moves within a range: its domain and the range table
+// over it (kinetostatic, `step_deg` at most between grid points).
+struct RangeTable {
+  IndependentDomain domain;
+  reduced::Samples samples;
+};
+RangeTable range_table(const models::Scene& scene, double step_deg) {
+  FullModel model(scene);
+  RangeTable t{calc_independent_domain(model), {}};
+  if (t.domain.periodic) return t;  // the caller's ASSERT_FALSE(domain.periodic) fails
+  FullKinetostaticSource src(model);
+  reduced::ExtractOptions opt;
+  opt.step_rad = step_deg * M_PI / 180;
+  const auto& d = t.domain;
+  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
+  t.samples = reduced::extract_samples(src, scene, opt);
+  return t;
+}
+
 // Issue #10: the slider-crank driven from its slider. Same kinetic energy as driven from the
 // crank, so m1(s) = m1_θ(θ)·(dθ/ds)² with m1_θ the crank-driven closed form (test::SliderCrank)
 // and θ(s) from s² = r² + l² ... (law of cosines: l² = r² + s² − 2rs cos θ, crank above the line).
 TEST(ReducedSourceRange, SliderDrivenSliderCrankMatchesTheClosedForm) {
-  const auto scene = models::load_scene("slider-crank-slider");
-  FullModel model(scene);
-  const auto d = calc_independent_domain(model);
+  const auto t = range_table(models::load_scene("slider-crank-slider"), 5);  // 72 intervals over the stroke
+  const auto& d = t.domain;
+  const auto& s = t.samples;
   ASSERT_FALSE(d.periodic);
-  FullKinetostaticSource src(model);
-  reduced::ExtractOptions opt;
-  opt.step_rad = 5 * M_PI / 180;  // 72 intervals over the stroke
-  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
-  const auto s = reduced::extract_samples(src, scene, opt);
   EXPECT_FALSE(s.periodic);
   EXPECT_FALSE(s.revolute);
   ASSERT_EQ(s.q.size(), 73u);
@@ -385,18 +395,13 @@ namespace {
 // Q_cons = −dV/dL; the static equilibrium stroke, where the 4 kN pressure balances it
 // (virtual work: F = dV/dL), follows from the table and from the closed form alike.
 TEST(ReducedSourceRange, CraneGeneralizedForceAndEquilibriumStrokeMatchVirtualWork) {
-  const auto scene = models::load_scene("crane-luffing");
-  FullModel model(scene);
-  const auto d = calc_independent_domain(model);
+  const auto t = range_table(models::load_scene("crane-luffing"), 10);
+  const auto& d = t.domain;
+  const auto& s = t.samples;
   ASSERT_FALSE(d.periodic);
   EXPECT_EQ(d.min, 1.0);
   EXPECT_EQ(d.max, 1.9);
   EXPECT_EQ(d.max_edge, "declared limit");
-  FullKinetostaticSource src(model);
-  reduced::ExtractOptions opt;
-  opt.step_rad = 10 * M_PI / 180;
-  opt.range = reduced::ExtractRange{d.min, d.max, d.min_edge, d.max_edge};
-  const auto s = reduced::extract_samples(src, scene, opt);
   ASSERT_EQ(s.q.size(), 37u);
 
   const double g = 9.81, Ax = 0.6, Ay = -0.4, OB = 1.5, k = 40000, L0 = 1.583;

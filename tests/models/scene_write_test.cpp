@@ -45,6 +45,30 @@ class Dump {
     for (const auto& [name, p] : pts) str(tag, name).vec(tag, p);
     return *this;
   }
+  template <class T>
+  Dump& count(const char* tag, const std::vector<T>& v) {
+    return integer(tag, static_cast<long>(v.size()));
+  }
+  // The two attachments of a loop, spring or point force.
+  Dump& ends(const std::string& a, const Vec2& pa, const std::string& b, const Vec2& pb) {
+    return str("a", a).vec("pa", pa).str("b", b).vec("pb", pb);
+  }
+  // A drive load's rate gate and profile, each present or not.
+  Dump& gate(const std::optional<RateGate>& g) {
+    integer("gate", g ? 1 : 0);
+    return g ? str("gate_joint", g->joint).integer("gate_sign", g->sign) : *this;
+  }
+  Dump& profile(const std::optional<LoadProfile>& p) {
+    integer("profile", p ? 1 : 0);
+    if (!p) return *this;
+    return str("of", p->of)
+        .num("a0", p->a0)
+        .nums("a", p->a)
+        .nums("b", p->b)
+        .nums("theta", p->table_theta_rad)
+        .nums("tau", p->table_value)
+        .nums("d2", p->table_d2);
+  }
   std::string text;
 
  private:
@@ -54,20 +78,10 @@ class Dump {
   }
 };
 
-void dump_profile(Dump& d, const LoadProfile& p) {
-  d.str("of", p.of)
-      .num("a0", p.a0)
-      .nums("a", p.a)
-      .nums("b", p.b)
-      .nums("theta", p.table_theta_rad)
-      .nums("tau", p.table_value)
-      .nums("d2", p.table_d2);
-}
-
 std::string dump(const Scene& s) {
   Dump d;
   d.str("name", s.name).str("description", s.description);
-  d.integer("bodies", static_cast<long>(s.bodies.size()));
+  d.count("bodies", s.bodies);
   for (const auto& b : s.bodies)
     d.str("body", b.name)
         .num("mass", b.mass_kg)
@@ -75,7 +89,7 @@ std::string dump(const Scene& s) {
         .num("inertia", b.inertia_kgm2)
         .points("pts", b.points);
   d.points("ground_points", s.ground_points);
-  d.integer("joints", static_cast<long>(s.joints.size()));
+  d.count("joints", s.joints);
   for (const auto& j : s.joints)
     d.str("joint", j.name)
         .integer("type", static_cast<long>(j.type))
@@ -86,61 +100,39 @@ std::string dump(const Scene& s) {
         .vec("axis", j.axis)
         .num("offset", j.offset_rad)
         .num("guess", j.guess);
-  d.integer("loops", static_cast<long>(s.loops.size()));
+  d.count("loops", s.loops);
   for (const auto& l : s.loops) {
-    d.str("loop", l.name)
-        .str("a", l.body_a)
-        .vec("pa", l.point_a)
-        .str("b", l.body_b)
-        .vec("pb", l.point_b);
-    d.integer("branch", l.branch ? 1 : 0);
+    d.str("loop", l.name).ends(l.body_a, l.point_a, l.body_b, l.point_b).integer("branch", l.branch ? 1 : 0);
     if (l.branch) d.str("branch_joint", l.branch->joint).integer("sign", l.branch->sign);
   }
-  d.integer("gears", static_cast<long>(s.gears.size()));
+  d.count("gears", s.gears);
   for (const auto& g : s.gears)
     d.str("gear", g.name).str("driver", g.driver).str("driven", g.driven).num("ratio", g.ratio);
   d.str("independent", s.independent).integer("range", s.independent_range ? 1 : 0);
   if (s.independent_range)
     d.num("min", s.independent_range->min).num("max", s.independent_range->max);
-  d.integer("torques", static_cast<long>(s.joint_torques.size()));
-  for (const auto& t : s.joint_torques) {
-    d.str("torque", t.name)
-        .str("joint", t.joint)
-        .num("value", t.value)
-        .integer("gate", t.active_when ? 1 : 0);
-    if (t.active_when)
-      d.str("gate_joint", t.active_when->joint).integer("gate_sign", t.active_when->sign);
-    d.integer("profile", t.profile ? 1 : 0);
-    if (t.profile) dump_profile(d, *t.profile);
-  }
-  d.integer("resistances", static_cast<long>(s.resistances.size()));
+  d.count("torques", s.joint_torques);
+  for (const auto& t : s.joint_torques)
+    d.str("torque", t.name).str("joint", t.joint).num("value", t.value).gate(t.active_when).profile(t.profile);
+  d.count("resistances", s.resistances);
   for (const auto& r : s.resistances)
     d.str("resistance", r.name)
         .str("body", r.body)
         .integer("law", static_cast<long>(r.law))
         .num("c", r.coefficient);
-  d.integer("springs", static_cast<long>(s.springs.size()));
+  d.count("springs", s.springs);
   for (const auto& sp : s.springs)
     d.str("spring", sp.name)
-        .str("a", sp.body_a)
-        .vec("pa", sp.point_a)
-        .str("b", sp.body_b)
-        .vec("pb", sp.point_b)
+        .ends(sp.body_a, sp.point_a, sp.body_b, sp.point_b)
         .num("k", sp.stiffness_N_per_m)
         .num("L0", sp.rest_length_m);
-  d.integer("point_forces", static_cast<long>(s.point_forces.size()));
-  for (const auto& pf : s.point_forces) {
+  d.count("point_forces", s.point_forces);
+  for (const auto& pf : s.point_forces)
     d.str("point_force", pf.name)
-        .str("a", pf.body_a)
-        .vec("pa", pf.point_a)
-        .str("b", pf.body_b)
-        .vec("pb", pf.point_b)
+        .ends(pf.body_a, pf.point_a, pf.body_b, pf.point_b)
         .num("value", pf.value)
-        .integer("gate", pf.active_when ? 1 : 0);
-    if (pf.active_when) d.str("gate_joint", pf.active_when->joint).integer("gate_sign", pf.active_when->sign);
-    d.integer("profile", pf.profile ? 1 : 0);
-    if (pf.profile) dump_profile(d, *pf.profile);
-  }
+        .gate(pf.active_when)
+        .profile(pf.profile);
   d.integer("optimize", s.optimize ? 1 : 0);
   if (s.optimize) {
     const auto& o = *s.optimize;
@@ -153,18 +145,18 @@ std::string dump(const Scene& s) {
         .str("objective", o.objective)
         .num("p", o.p);
   }
-  d.integer("motors", static_cast<long>(s.motors.size()));
+  d.count("motors", s.motors);
   for (const auto& m : s.motors)
     d.str("motor", m.name)
         .str("joint", m.joint)
         .num("stall", m.stall_torque)
         .num("w0", m.no_load_speed);
   d.integer("gravity", s.gravity.enabled ? 1 : 0).vec("g", s.gravity.g_m_s2);
-  d.integer("constraint_forces", static_cast<long>(s.outputs.constraint_forces.size()));
+  d.count("constraint_forces", s.outputs.constraint_forces);
   for (const auto& c : s.outputs.constraint_forces)
     d.str("cf", c.name).str("joint", c.joint).vec("dir", c.direction);
   for (const auto* list : {&s.outputs.bodies, &s.outputs.joints, &s.outputs.reactions}) {
-    d.integer("list", static_cast<long>(list->size()));
+    d.count("list", *list);
     for (const auto& n : *list) d.str("item", n);
   }
   d.integer("shaking", s.outputs.shaking ? 1 : 0);
@@ -176,7 +168,7 @@ std::string dump(const Scene& s) {
   d.num("v_duration", v.duration_s)
       .num("ref_tol", v.reference_tolerance)
       .str("ref_int", v.reference_integrator);
-  d.integer("thresholds", static_cast<long>(v.thresholds.size()));
+  d.count("thresholds", v.thresholds);
   for (const auto& t : v.thresholds)
     d.str("quantity", t.quantity)
         .num("grid", t.grid_deg)

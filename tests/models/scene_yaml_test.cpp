@@ -45,6 +45,22 @@ int line_in(const std::string& yaml, const std::string& text) {
   return 1 + static_cast<int>(std::count(yaml.begin(), yaml.begin() + static_cast<long>(at), '\n'));
 }
 
+// The refusal of `yaml` (with overrides `o`), checked: from test.yaml, naming `field`, with `says`
+// in its message (empty: not checked) and, when `on_line` is given, on the line that holds it.
+SceneError expect_refused(const std::string& yaml, const std::string& field, const std::string& says,
+                          const std::string& on_line = "", std::vector<Override> o = {}) {
+  const SceneError e = refusal(yaml, std::move(o));
+  EXPECT_EQ(e.file(), "test.yaml") << field;
+  EXPECT_EQ(e.field(), field) << e.what();
+  if (!says.empty()) {
+    EXPECT_NE(e.message().find(says), std::string::npos) << says << " | " << e.what();
+  }
+  if (!on_line.empty()) {
+    EXPECT_EQ(e.line(), line_in(yaml, on_line)) << on_line << " | " << e.what();
+  }
+  return e;
+}
+
 // `yaml` with the first `from` replaced by `to`.
 std::string with(std::string yaml, const std::string& from, const std::string& to) {
   const auto at = yaml.find(from);
@@ -188,12 +204,7 @@ TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {
        "duration_s: 2"},
       {bike, "bicycle_leg.flywheel.gear_ratio", "gear_ratio: 2"},
   };
-  for (const auto& c : cases) {
-    const SceneError e = refusal(c.yaml);
-    EXPECT_EQ(e.field(), c.field) << e.what();
-    EXPECT_EQ(e.line(), line_in(c.yaml, c.second)) << e.what();
-    EXPECT_NE(std::string(e.what()).find("duplicate key"), std::string::npos) << e.what();
-  }
+  for (const auto& c : cases) expect_refused(c.yaml, c.field, "duplicate key", c.second);
 }
 
 TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
@@ -214,13 +225,7 @@ TEST(SceneYaml, NamesWithUnsafeCharactersAreRefusedWithTheirField) {
         {"name: bearing", "name: " + bad, "loads[0].name"},
         {"name: axial", "name: " + bad, "outputs.constraint_forces[0].name"},
     };
-    for (const auto& c : cases) {
-      const std::string y = with(fb, c.from, c.to);
-      const SceneError e = refusal(y);
-      EXPECT_EQ(e.field(), c.field) << e.what();
-      EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
-      EXPECT_NE(std::string(e.what()).find("is not a valid name"), std::string::npos) << e.what();
-    }
+    for (const auto& c : cases) expect_refused(with(fb, c.from, c.to), c.field, "is not a valid name", c.to);
   }
   // Point names too (they are map keys).
   const std::string y = with(fb, "points: {B: [0.08, 0]}", "points: {B: [0.08, 0], 'a b': [0, 0]}");
@@ -307,12 +312,7 @@ TEST(SceneYaml, NumbersOutsideTheirRangesNameFieldAndLine) {
       {"gravity: {enabled: true}", "validation: {reference_tolerance: 0.1}",
        "validation.reference_tolerance"},
   };
-  for (const auto& c : cases) {
-    const std::string y = with(fb, c.from, c.to);
-    const SceneError e = refusal(y);
-    EXPECT_EQ(e.field(), c.field) << e.what();
-    EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
-  }
+  for (const auto& c : cases) expect_refused(with(fb, c.from, c.to), c.field, "", c.to);
 }
 
 // validation.calibrate: power_W is optional (mean-speed mode), load names the drive load.
@@ -403,11 +403,7 @@ TEST(SceneYaml, MalformedOverridesAreRefusedNamingThem) {
       {"bodies=3", "--set bodies", "only scalar values"},
       {"independent.x=3", "--set independent.x", "not a mapping"},
   };
-  for (const auto& c : cases) {
-    const SceneError e = refusal(kFourbar, {parse_override(c.override_text)});
-    EXPECT_EQ(e.field(), c.field) << e.what();
-    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
-  }
+  for (const auto& c : cases) expect_refused(kFourbar, c.field, c.says, "", {parse_override(c.override_text)});
 }
 
 TEST(SceneYaml, HostileStructuresAreRefusedQuickly) {
@@ -571,12 +567,7 @@ TEST(SceneYaml, IndependentRangeIsReadInItsUnitAndChecked) {
       {"independent_range: [0.1, 2]\nindependent_range_deg: [10, 120]\n", "independent_range", "not both"},
       {"independent_range: [0.1, 1e7]\n", "independent_range[1]", "rad"},
   };
-  for (const auto& c : cases) {
-    const SceneError e = refusal(fb + c.extra);
-    EXPECT_EQ(e.field(), c.field) << c.extra;
-    EXPECT_NE(e.message().find(c.words), std::string::npos) << c.extra << ": " << e.what();
-    EXPECT_GT(e.line(), 0) << c.extra << ": " << e.what();
-  }
+  for (const auto& c : cases) EXPECT_GT(expect_refused(fb + c.extra, c.field, c.words).line(), 0) << c.extra;
 }
 
 TEST(SceneYaml, PrismaticIndependentRangeIsInMetres) {
@@ -670,12 +661,7 @@ TEST(SceneYaml, BadProfilesAreRefusedNamingLineAndField) {
   };
   for (const auto& b : bad) {
     const std::string line = "  - {type: joint_torque, name: p, joint: crank, " + b.load + "}\n";
-    const std::string yaml = std::string(kFourbar) + line;
-    const SceneError e = refusal(yaml);
-    EXPECT_EQ(e.file(), "test.yaml") << b.load;
-    EXPECT_EQ(e.field(), b.field) << b.load << "\n" << e.what();
-    EXPECT_EQ(e.line(), line_in(yaml, line)) << b.load << "\n" << e.what();
-    EXPECT_NE(e.message().find(b.message), std::string::npos) << b.load << "\n" << e.what();
+    expect_refused(std::string(kFourbar) + line, b.field, b.message, line);
   }
 }
 
@@ -742,10 +728,7 @@ TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
   };
   for (const auto& c : cases) {
     const std::string bad = with(y, c.from, c.to);
-    const SceneError e = refusal(bad);
-    EXPECT_EQ(e.field(), c.field) << c.to << ": " << e.what();
-    EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
-    EXPECT_GT(e.line(), line_in(bad, "optimize:") - 1) << e.what();
+    EXPECT_GT(expect_refused(bad, c.field, c.says).line(), line_in(bad, "optimize:") - 1) << c.to;
   }
   // pnorm with its exponent parses.
   const Scene p = parse_scene(with(y, "objective: peak", "objective: pnorm\n  p: 12"), "b.yaml");
@@ -886,12 +869,7 @@ TEST(SceneYaml, BadPointForcesAreRefusedNamingLineAndField) {
   };
   for (const auto& b : bad) {
     const std::string line = "  - {type: point_force, name: p, " + b.load + "}\n";
-    const std::string yaml = std::string(kFourbar) + line;
-    const SceneError e = refusal(yaml);
-    EXPECT_EQ(e.file(), "test.yaml") << b.load;
-    EXPECT_EQ(e.field(), b.field) << b.load << "\n" << e.what();
-    EXPECT_EQ(e.line(), line_in(yaml, line)) << b.load << "\n" << e.what();
-    EXPECT_NE(e.message().find(b.message), std::string::npos) << b.load << "\n" << e.what();
+    expect_refused(std::string(kFourbar) + line, b.field, b.message, line);
   }
 }
 
