@@ -49,7 +49,7 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     const auto* roots = s.roots_of("r_" + active_when->joint);
     if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
       // Orient the product of sines like r at the grid sample farthest from any root.
-      g.roots = *roots;
+      set_gate_roots(g, *roots);
       double best = -1, q_best = s.q[0];
       for (double q : s.q) {
         double d = INFINITY;
@@ -126,7 +126,8 @@ ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)
       torque_value(m.torques.size()),
       scratch(m.rhs_cols.size()),
       scratch_out(m.out_cols.size()),
-      scratch_rec(m.record_cols.size()) {
+      scratch_rec(m.record_cols.size()),
+      switching(m.gates.size()) {
   for (size_t i = 0; i < m.torques.size(); ++i) torque_value[i] = m.torques[i].value;
 }
 
@@ -185,8 +186,35 @@ double calc_switching(const ReducedModel& m, int g, double q, double qdot) {
   const double P = m.table.period;
   const double qw = q - P * std::floor((q - m.table.q0) / P);
   double prod = gate.root_sign;
-  for (double r : gate.roots) prod *= std::sin(0.5 * (qw - r));
+  if (2 * gate.pairs.size() == gate.roots.size()) {
+    for (const auto& p : gate.pairs) prod *= 0.5 * (p.cos_half_gap - std::cos(qw - p.mid));
+  } else {
+    for (double r : gate.roots) prod *= std::sin(0.5 * (qw - r));
+  }
   return gate.sign * prod * qdot;
+}
+
+const double* calc_switching_all(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot) {
+  if (q != ws.switching_q || qdot != ws.switching_qdot) {
+    for (size_t g = 0; g < m.gates.size(); ++g) ws.switching[g] = calc_switching(m, static_cast<int>(g), q, qdot);
+    ws.switching_q = q, ws.switching_qdot = qdot;
+  }
+  return ws.switching.data();
+}
+
+void set_gate_roots(ReducedModel::Gate& gate, std::vector<double> roots) {
+  gate.roots = std::move(roots);
+  gate.pairs.clear();
+  if (gate.roots.size() % 2 != 0) return;
+  // Neighbouring roots pair up; a pair closer than 1e-3 rad keeps the product of sines (the
+  // difference of cosines would lose about −log10(gap²) digits near its roots).
+  std::vector<ReducedModel::Gate::RootPair> pairs;
+  for (size_t k = 0; k + 1 < gate.roots.size(); k += 2) {
+    const double a = gate.roots[k], b = gate.roots[k + 1];
+    if (!(std::abs(std::sin(0.5 * (a - b))) > 1e-3)) return;
+    pairs.push_back({std::cos(0.5 * (a - b)), 0.5 * (a + b)});
+  }
+  gate.pairs = std::move(pairs);
 }
 
 void init_gates(const ReducedModel& m, ReducedWorkspace& ws) {
@@ -286,13 +314,15 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
     const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
     double s0[32], fr[32];
-    for (size_t g = 0; g < ng; ++g) s0[g] = calc_switching(m, static_cast<int>(g), q0, v0);
+    const double* sw = calc_switching_all(m, ws, q0, v0);
+    for (size_t g = 0; g < ng; ++g) s0[g] = sw[g];
     // The given start derivative holds until a gate flips (pass 0 and its shortened step).
     const double* k1_now = pass == 0 ? k1 : nullptr;
     rk4(m, ws, remaining, k1_now);
     double frac = 2.0;
+    const double* sw1 = calc_switching_all(m, ws, ws.q, ws.qdot);
     for (size_t g = 0; g < ng; ++g) {
-      const double s1 = calc_switching(m, static_cast<int>(g), ws.q, ws.qdot);
+      const double s1 = sw1[g];
       fr[g] = 2.0;
       if (s1 == 0.0 || static_cast<bool>(ws.gate_on[g]) == (s1 > 0)) continue;  // agrees at the end
       fr[g] = ((s0[g] > 0) != (s1 > 0) && s0[g] != s1) ? s0[g] / (s0[g] - s1) : 0.0;

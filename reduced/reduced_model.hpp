@@ -37,6 +37,14 @@ struct ReducedModel {
     int sign = +1;
     std::vector<double> roots;
     double root_sign = 1.0;  // c
+    // The roots taken two by two (ρ_a, ρ_b), as sin((q−ρ_a)/2)·sin((q−ρ_b)/2) =
+    // ½[cos((ρ_a−ρ_b)/2) − cos(q − (ρ_a+ρ_b)/2)]: one cosine per pair instead of two sines (the
+    // sines were a quarter of a fixed-step run's time). Pairs closer than 1e-3 rad, where the
+    // difference of cosines would cancel, and roots set without pairs use the product itself.
+    struct RootPair {
+      double cos_half_gap = 0.0, mid = 0.0;
+    };
+    std::vector<RootPair> pairs;  // filled by set_gate_roots; empty: the product of sines
   };
   struct Torque {
     double value = 0.0;   // [N·m or N]
@@ -94,6 +102,10 @@ struct ReducedWorkspace {
   std::vector<double> scratch;      // rhs_cols values
   std::vector<double> scratch_out;  // out_cols values
   std::vector<double> scratch_rec;  // record_cols values
+  // The gates' switching functions at (switching_q, switching_qdot): a fixed step starts where
+  // the last one ended, so its start values are the last end values (reduced/simulate_reduced).
+  std::vector<double> switching;
+  double switching_q = NAN, switching_qdot = NAN;
   explicit ReducedWorkspace(const ReducedModel& m);
 };
 
@@ -104,6 +116,13 @@ void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, do
 
 // Switching function of gate g: its sign decides whether the gated load acts.
 double calc_switching(const ReducedModel& m, int gate, double q, double qdot);
+
+// Every gate's switching function at (q, q̇) into ws.switching, reusing the values when the
+// workspace last evaluated them at the same state.
+const double* calc_switching_all(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot);
+
+// Sets a gate's exact switch angles and their pairs (ReducedModel::Gate::pairs).
+void set_gate_roots(ReducedModel::Gate& gate, std::vector<double> roots);
 
 // Sets every gate from the state (from rest: from the sign of the acceleration the load
 // would produce, as the full model does).

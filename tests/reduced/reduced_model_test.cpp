@@ -346,3 +346,54 @@ TEST(ReducedModel, CliRefusesAFourbarTableForTheBicycle) {
 
 }  // namespace
 }  // namespace rdyn::reduced
+
+// The switching function of a gate with exact roots: the pairwise cosine form (one cos per
+// two roots) must equal the product of sines it replaces, c·Π sin((q − ρ_k)/2), which is
+// computed here independently; and roots closer than 1e-3 rad keep the product itself, whose
+// values near the close pair would otherwise lose digits.
+TEST(ReducedModel, SwitchingPairsEqualTheProductOfSines) {
+  rdyn::reduced::ReducedModel m;
+  m.table.periodic = true;
+  m.table.q0 = 0.0;
+  m.table.period = 2 * M_PI;
+  for (const std::vector<double>& roots : {std::vector<double>{0.7, 3.9}, std::vector<double>{0.2, 1.1, 2.9, 5.0},
+                                           std::vector<double>{1.0, 1.0 + 4e-4}}) {
+    rdyn::reduced::ReducedModel::Gate g;
+    g.sign = -1;
+    g.root_sign = -1.0;
+    rdyn::reduced::set_gate_roots(g, roots);
+    EXPECT_EQ(g.pairs.size(), roots[1] - roots[0] > 1e-3 ? roots.size() / 2 : 0u);
+    m.gates = {g};
+    for (double q = -20.0; q < 20.0; q += 0.0137) {
+      const double qw = q - 2 * M_PI * std::floor(q / (2 * M_PI));
+      double prod = -1.0;
+      for (double r : roots) prod *= std::sin(0.5 * (qw - r));
+      const double want = -prod * 1.7;
+      EXPECT_NEAR(rdyn::reduced::calc_switching(m, 0, q, 1.7), want, 4e-15) << q;
+    }
+    // Just either side of each root the sign is right (1e-9 rad away).
+    for (double r : roots)
+      for (double d : {-1e-9, 1e-9}) {
+        double prod = -1.0;
+        for (double r2 : roots) prod *= std::sin(0.5 * (r + d - r2));
+        EXPECT_EQ(rdyn::reduced::calc_switching(m, 0, r + d, 1.0) > 0, -prod > 0) << r << " " << d;
+      }
+  }
+}
+
+// A fixed step reuses the switching values of the state where the previous step ended, and
+// recomputes them at any other state.
+TEST(ReducedModel, SwitchingCacheFollowsTheState) {
+  rdyn::reduced::ReducedModel m;
+  m.table.period = 2 * M_PI;
+  rdyn::reduced::ReducedModel::Gate g;
+  rdyn::reduced::set_gate_roots(g, {0.5, 2.5});
+  m.gates = {g};
+  rdyn::reduced::ReducedWorkspace ws(m);
+  const double a = rdyn::reduced::calc_switching_all(m, ws, 1.0, 2.0)[0];
+  EXPECT_DOUBLE_EQ(a, rdyn::reduced::calc_switching(m, 0, 1.0, 2.0));
+  const double b = rdyn::reduced::calc_switching_all(m, ws, 3.0, 2.0)[0];
+  EXPECT_DOUBLE_EQ(b, rdyn::reduced::calc_switching(m, 0, 3.0, 2.0));
+  EXPECT_LT(a * b, 0.0);  // 1.0 and 3.0 lie on either side of the root 2.5
+  EXPECT_DOUBLE_EQ(rdyn::reduced::calc_switching_all(m, ws, 3.0, -2.0)[0], -b);
+}
