@@ -45,7 +45,7 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
   // The gate of a load: its index in m.gates, −1 when the load always acts.
   auto add_gate = [&](const std::optional<models::RateGate>& active_when) {
     if (!active_when) return -1;
-    ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0};
+    ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0, {}};
     const auto* roots = s.roots_of("r_" + active_when->joint);
     if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
       // Orient the product of sines like r at the grid sample farthest from any root.
@@ -181,16 +181,17 @@ void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, do
 double calc_switching(const ReducedModel& m, int g, double q, double qdot) {
   const auto& gate = m.gates[g];
   if (gate.roots.empty()) return gate.sign * m.table.eval(gate.c_r, q) * qdot;
+  double prod = gate.root_sign;
+  if (2 * gate.pairs.size() == gate.roots.size()) {
+    // cos(q − mid) is 2π-periodic itself: no wrap (its rounding, ~|q|·eps, is the wrap's own).
+    for (const auto& p : gate.pairs) prod *= 0.5 * (p.cos_half_gap - std::cos(q - p.mid));
+    return gate.sign * prod * qdot;
+  }
   // Wrap q into the table's period first (even root count: the product is 2π-periodic), so
   // long runs keep small sine arguments.
   const double P = m.table.period;
   const double qw = q - P * std::floor((q - m.table.q0) / P);
-  double prod = gate.root_sign;
-  if (2 * gate.pairs.size() == gate.roots.size()) {
-    for (const auto& p : gate.pairs) prod *= 0.5 * (p.cos_half_gap - std::cos(qw - p.mid));
-  } else {
-    for (double r : gate.roots) prod *= std::sin(0.5 * (qw - r));
-  }
+  for (double r : gate.roots) prod *= std::sin(0.5 * (qw - r));
   return gate.sign * prod * qdot;
 }
 
@@ -233,7 +234,11 @@ void init_gates(const ReducedModel& m, ReducedWorkspace& ws) {
 }
 
 double calc_energy(const ReducedModel& m, double q, double qdot) {
-  return 0.5 * m.table.eval(m.c_m1, q) * qdot * qdot + m.table.eval(m.c_V, q);
+  // Both columns from one interval search (Table::eval_cols: the same values as two evals).
+  const int cols[2] = {m.c_m1, m.c_V};
+  double v[2];
+  m.table.eval_cols(q, cols, 2, v);
+  return 0.5 * v[0] * qdot * qdot + v[1];
 }
 
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
