@@ -387,6 +387,10 @@ void calc_first_screen(ValidationResult& v) {
 
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
   ValidationResult v = describe(scene);
+  // The scene's operating point is checked before any work (the calibration itself runs last):
+  // an unknown load or a scene that cannot be calibrated is bad input, refused at once.
+  if (scene.validation.calibrate_cadence_Hz > 0)
+    check_calibratable(scene, calibration_options_of(scene, 0.0, 0.0, ""));
   // 1. Reference: full model at a tight tolerance, and the change when it is halved; the
   //    scene's time scale from it sets the fixed steps of the ladder.
   engine::FullModel full(scene);

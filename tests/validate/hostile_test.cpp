@@ -285,6 +285,17 @@ void outputs(std::vector<Case>& cs) {
     e.limits.file_size_limit = 4096;
     cs.push_back(e);
   }
+  // A bad operating point is refused before any work: validation runs its calibration last
+  // (about a minute and a half in), but the load it names is checked first. The time limit makes
+  // the late refusal this replaced (68 s) a failure.
+  {
+    Case c{"validate_calibrate_load_unknown_refused_first",
+           {"validate", "bicycle", "--set", "validation.calibrate.load=nope", "--out", "o"}, 2,
+           "--set validation.calibrate.load"};
+    c.out = "o";
+    c.limits.time_limit_s = 10.0;
+    cs.push_back(c);
+  }
   // Interrupted runs leave nothing (the signal's own status: 128 + signal).
   for (const auto& [tag, sig] : std::vector<std::pair<std::string, int>>{{"int", SIGINT}, {"term", SIGTERM}, {"hup", SIGHUP}}) {
     Case c{"simulate_interrupted_" + tag, {"simulate", "bicycle", "--duration", "500", "--out", "x/o"}, 128 + sig, ""};
