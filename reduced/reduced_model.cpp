@@ -89,6 +89,9 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     m.rhs_cols.push_back(pf.c_r);
     if (pf.c_tau >= 0) m.rhs_cols.push_back(pf.c_tau);
   }
+  // Last, V: a fixed step's end point has its energy (the divergence guard) from the same lookup
+  // as its q̈ (calc_acceleration_energy), not from a second interval search.
+  m.rhs_cols.push_back(m.c_V);
   m.out_cols = {m.c_m1, m.c_V};
   for (size_t k = 0; k < m.c_me1.size(); ++k) {
     m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
@@ -178,6 +181,14 @@ void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, do
   acceleration_from(m, ws, v, qdot, qddot, power_nc);
 }
 
+double calc_acceleration_energy(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                                double& power_nc) {
+  double* v = ws.scratch.data();
+  eval_block(m.table, m.rhs_block, q, v);
+  acceleration_from(m, ws, v, qdot, qddot, power_nc);
+  return 0.5 * v[0] * qdot * qdot + v[m.rhs_cols.size() - 1];  // ½ m1 q̇² + V, V the last rhs column
+}
+
 double calc_switching(const ReducedModel& m, int g, double q, double qdot) {
   const auto& gate = m.gates[g];
   if (gate.roots.empty()) return gate.sign * m.table.eval(gate.c_r, q) * qdot;
@@ -213,7 +224,8 @@ void set_gate_roots(ReducedModel::Gate& gate, std::vector<double> roots) {
   for (size_t k = 0; k + 1 < gate.roots.size(); k += 2) {
     const double a = gate.roots[k], b = gate.roots[k + 1];
     if (!(std::abs(std::sin(0.5 * (a - b))) > 1e-3)) return;
-    pairs.push_back({std::cos(0.5 * (a - b)), 0.5 * (a + b)});
+    const double c = std::cos(0.5 * (a - b));
+    pairs.push_back({c, 0.5 * (a + b), std::acos(std::clamp(c, -1.0, 1.0))});
   }
   gate.pairs = std::move(pairs);
 }
@@ -303,6 +315,97 @@ void rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, const double* k1
   ws.t += h;
 }
 
+constexpr double kTwoPi = 2 * 3.14159265358979323846;
+
+// Whether gate g's switching is known in closed form: its switch angles in pairs.
+bool predictable(const ReducedModel::Gate& gate) {
+  return !gate.pairs.empty() && 2 * gate.pairs.size() == gate.roots.size();
+}
+
+// x − 2πk with k the nearest integer to x/2π (|result| ≤ π up to rounding), without libm: the
+// truncating cast and one correction, as Table::locate (std::round is a library call here).
+double wrap_to_pi(double x) {
+  const double r = x * (1.0 / kTwoPi);
+  if (!(std::abs(r) < 4.0e18)) return x - x;  // NaN (or beyond exact integers): no sign, no undefined cast
+  const double k = static_cast<double>(static_cast<long>(r + (r >= 0 ? 0.5 : -0.5)));
+  return x - k * kTwoPi;
+}
+
+// Sign (+1, −1, or 0 on a switch angle) of a predictable gate's switching function at (q, q̇)
+// without a cosine: each pair's factor ½[cos((ρa−ρb)/2) − cos(q − mid)] is positive exactly
+// where |wrap(q − mid)| exceeds half the gap (cos decreases on [0, π]). The same sign as
+// calc_switching except within rounding of a switch angle.
+int switching_sign(const ReducedModel::Gate& gate, double q, double qdot) {
+  double sgn = gate.sign * gate.root_sign * (qdot > 0 ? 1.0 : qdot < 0 ? -1.0 : 0.0);
+  for (const auto& p : gate.pairs) {
+    const double x = std::abs(wrap_to_pi(q - p.mid));
+    sgn *= x > p.half_gap ? 1.0 : x < p.half_gap ? -1.0 : 0.0;
+  }
+  return sgn > 0 ? 1 : sgn < 0 ? -1 : 0;
+}
+
+// The first switch of the predictable gates along the Taylor path q(τ) = q0 + v0 τ + ½ a0 τ²,
+// τ ∈ (0, h]: for each gate, the first switch angle (any image ρ + 2πk) the path reaches where
+// the gate, as it stands, disagrees with the switching function's sign just beyond that angle
+// (a gate already set for the far side, e.g. just switched a rounding short of its angle, is
+// not switched again). Fills after[g] with that sign (1 on, 0 off) for the gates switching at
+// the returned τ (±1e-9 relative; others −1), and returns τ, or +∞ when no switch is predicted.
+// Only where q̇ keeps its sign over the step and the path spans less than a turn; elsewhere +∞
+// and the switches are left to the check at the step's end.
+double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, double v0, double a0, double h,
+                      size_t ng, int* after) {
+  for (size_t g = 0; g < ng; ++g) after[g] = -1;
+  const double v1 = v0 + a0 * h;
+  if (!(v0 * v1 > 0) || !(std::abs(q0) < 1e15)) return INFINITY;  // also NaN; a huge q has no angle left
+  const double dir = v0 > 0 ? 1.0 : -1.0;
+  const double reach = dir * h * (v0 + 0.5 * a0 * h);  // |q(h) − q0|, monotone path
+  if (!(reach < kTwoPi)) return INFINITY;
+  double tau_min = INFINITY, R_min = 0.0;
+  double tau_g[32];
+  for (size_t g = 0; g < ng; ++g) {
+    tau_g[g] = INFINITY;
+    const auto& gate = m.gates[g];
+    if (!predictable(gate)) continue;
+    for (double rho : gate.roots) {
+      // Distance from q0 to the next image of ρ in the direction of motion, in [0, 2π).
+      const double x = dir * (rho - q0) * (1.0 / kTwoPi);
+      double fl = static_cast<double>(static_cast<long>(x));
+      if (fl > x) fl -= 1.0;
+      const double dist = (x - fl) * kTwoPi;
+      if (!(dist > 0 && dist <= reach)) continue;  // not reached in this step (the usual case)
+      const double R = q0 + dir * dist;
+      // Sign just beyond R in the direction of motion (a rounding-size step past the angle).
+      const int sgn = switching_sign(gate, R + dir * 1e-9 * (1.0 + std::abs(R)), v0);
+      if (sgn == 0 || (sgn > 0) == static_cast<bool>(ws.gate_on[g])) continue;  // nothing to switch
+      // ½ a0 τ² + v0 τ − (R − q0) = 0, the root on the monotone branch (stable form).
+      const double d = R - q0, disc = v0 * v0 + 2 * a0 * d;
+      if (!(disc >= 0)) continue;
+      const double tau = 2 * d / (v0 + dir * std::sqrt(disc));
+      if (tau > 0 && tau <= h && tau < tau_g[g]) tau_g[g] = tau, after[g] = sgn > 0;
+      if (tau > 0 && tau <= h && tau < tau_min) tau_min = tau, R_min = R;
+    }
+  }
+  if (!std::isfinite(tau_min)) return INFINITY;
+  // The quadratic path is off by O(τ³) (a few 1e-5 s at 20 ms steps on a lever whose inertia
+  // varies fast, no better than the linear estimate after the step). One right-hand side at
+  // its predicted crossing gives the jerk j = (q̈ − a0)/τ, and Newton on the cubic
+  // q0 + v0 τ + ½ a0 τ² + ⅙ j τ³ = R the crossing to O(τ⁴): one evaluation per switch.
+  double a_mid, p_mid;
+  calc_acceleration(m, ws, q0 + tau_min * (v0 + 0.5 * a0 * tau_min), v0 + a0 * tau_min, a_mid, p_mid);
+  const double j = (a_mid - a0) / tau_min;
+  double tau = tau_min;
+  for (int it = 0; it < 4 && std::isfinite(j); ++it) {
+    const double f = q0 - R_min + tau * (v0 + tau * (0.5 * a0 + tau * j / 6.0));
+    const double df = v0 + tau * (a0 + 0.5 * j * tau);
+    if (!(df * dir > 0)) break;  // the cubic turns back: keep the last estimate
+    tau -= f / df;
+  }
+  if (!(tau > 0 && tau <= h)) tau = tau_min;  // a correction leaving the step: the quadratic's
+  for (size_t g = 0; g < ng; ++g)
+    if (!(tau_g[g] <= tau_min * (1 + 1e-9))) after[g] = -1;
+  return tau;
+}
+
 }  // namespace
 
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) { return step_fixed_rk4(m, ws, h, nullptr); }
@@ -314,18 +417,60 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   // Each switch instant is estimated by linear interpolation of the switching function and
   // the step is split there. Allocation-free: at most 32 gates are tracked.
   const size_t ng = std::min<size_t>(m.gates.size(), 32);
+  bool any_predictable = false;
+  for (size_t g = 0; g < ng; ++g) any_predictable |= predictable(m.gates[g]);
   double t_first = NAN;
   double remaining = h;
   for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
     const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
     double s0[32], fr[32];
-    const double* sw = calc_switching_all(m, ws, q0, v0);
-    for (size_t g = 0; g < ng; ++g) s0[g] = sw[g];
     // The given start derivative holds until a gate flips (pass 0 and its shortened step).
     const double* k1_now = pass == 0 ? k1 : nullptr;
+    double k1_own[2];
+    if (any_predictable) {
+      // Predict a switch of the gates with known switch angles from the start derivative (which
+      // the step needs anyway) and cut the step there: one partial step instead of the whole
+      // step, its partial repeat and the rest (issue #11 item 6: 7 fewer right-hand sides per
+      // switch on the bicycle's RK4 runs, and no cosine per step).
+      if (!k1_now) {
+        calc_acceleration(m, ws, q0, v0, k1_own[0], k1_own[1]);
+        k1_now = k1_own;
+      }
+      int after[32];
+      const double tau = predict_switch(m, ws, q0, v0, k1_now[0], remaining, ng, after);
+      if (tau < remaining * (1 - 1e-12)) {
+        rk4(m, ws, tau, k1_now);
+        if (std::isnan(t_first)) t_first = ws.t;
+        for (size_t g = 0; g < ng; ++g)
+          if (after[g] >= 0) ws.gate_on[g] = static_cast<char>(after[g]);
+        remaining -= tau;
+        continue;
+      }
+    }
     rk4(m, ws, remaining, k1_now);
+    // The check at the step's end: every gate agrees with its switching function's sign there,
+    // or the step is split where the first disagreeing one crossed zero (linear interpolation
+    // between the ends). Predictable gates are checked by sign first (no cosine); their values
+    // are computed only when one disagrees.
+    bool disagree = false;
+    for (size_t g = 0; g < ng && !disagree; ++g) {
+      const auto& gate = m.gates[g];
+      if (!predictable(gate)) {
+        disagree = true;  // checked on the values below
+        break;
+      }
+      const int s1 = switching_sign(gate, ws.q, ws.qdot);
+      disagree = s1 != 0 && static_cast<bool>(ws.gate_on[g]) != (s1 > 0);
+    }
+    if (!disagree) {
+      remaining = 0.0;  // the step to the end stands
+      break;
+    }
+    const double q1 = ws.q, v1 = ws.qdot;
+    const double* sw = calc_switching_all(m, ws, q0, v0);
+    for (size_t g = 0; g < ng; ++g) s0[g] = sw[g];
     double frac = 2.0;
-    const double* sw1 = calc_switching_all(m, ws, ws.q, ws.qdot);
+    const double* sw1 = calc_switching_all(m, ws, q1, v1);
     for (size_t g = 0; g < ng; ++g) {
       const double s1 = sw1[g];
       fr[g] = 2.0;

@@ -43,6 +43,7 @@ struct ReducedModel {
     // difference of cosines would cancel, and roots set without pairs use the product itself.
     struct RootPair {
       double cos_half_gap = 0.0, mid = 0.0;
+      double half_gap = 0.0;  // acos(cos_half_gap) ∈ [0, π]: the factor is > 0 where |wrap(q − mid)| > half_gap
     };
     std::vector<RootPair> pairs;  // filled by set_gate_roots; empty: the product of sines
   };
@@ -74,7 +75,8 @@ struct ReducedModel {
   std::vector<Brake> brakes;
 
   // Columns the right-hand side needs, in this order: m1, m2, Q_cons, then each torque's r
-  // (and its tau when profiled), each motor's r, each brake's w, each point force's Qpf (and tau).
+  // (and its tau when profiled), each motor's r, each brake's w, each point force's Qpf (and tau),
+  // and last V (for calc_acceleration_energy).
   std::vector<int> rhs_cols;
   // Columns the outputs need (one fused lookup): m1, V, then per constraint force k:
   // me1, me2, Qx_cons, each torque's rx (and tau), each motor's r and rx, each brake's w and wx,
@@ -114,6 +116,11 @@ struct ReducedWorkspace {
 void calc_acceleration(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                        double& power_nc);
 
+// calc_acceleration, and the energy ½ m1 q̇² + V at (q, q̇) from the same table lookup [J] (the
+// same value as calc_energy).
+double calc_acceleration_energy(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
+                                double& power_nc);
+
 // Switching function of gate g: its sign decides whether the gated load acts.
 double calc_switching(const ReducedModel& m, int gate, double q, double qdot);
 
@@ -146,9 +153,12 @@ inline bool energy_balance_diverged(double E, double E0, double work, double E_s
 }
 
 // One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside
-// the step is located by linear interpolation of the switching function and the step is
-// split there (at most 8 splits; the step always advances t by h). Returns the time of the
-// first switch, or NaN when none happened.
+// the step splits it there (at most 8 splits; the step always advances t by h). A gate whose
+// switch angles are known (Gate::pairs) has its switch predicted before the step, from the
+// Taylor path q0 + q̇0 τ + ½ q̈0 τ² meeting a switch angle: the step is cut at that τ without
+// first taking the whole step. Any other switch (and a predicted one that the step's end
+// contradicts) is located after the step by linear interpolation of the switching function.
+// Returns the time of the first switch, or NaN when none happened.
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
 // The same with the start derivative k1 = (q̈, power) at (ws.q, ws.q̇) under ws's gates when
 // the caller has it already (simulate_reduced keeps each step's end point): one right-hand

@@ -123,7 +123,7 @@ void not_a_knot_coefficients(const std::vector<double>& y, double h, int col, in
 }  // namespace
 
 int Table::locate(double q, double& dx) const {
-  const double u = (q - q0) / step;
+  const double u = (q - q0) * inv_step;
   // NaN, or beyond the exactly representable integers: no interval (the cast would be undefined);
   // dx is NaN for NaN so callers see a non-finite value and report it.
   if (!(std::abs(u) < 4.0e18)) {
@@ -245,6 +245,7 @@ Table build_table(const Samples& samples, Interpolation interp, bool energy_cons
   t.periodic = s.periodic;
   t.q0 = s.q0;
   t.step = s.step;
+  t.inv_step = 1.0 / s.step;
   t.period = s.periodic ? s.step * n : 0.0;
   t.intervals = s.periodic ? n : n - 1;
   t.cols = static_cast<int>(s.names.size());

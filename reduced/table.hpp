@@ -24,6 +24,9 @@ struct Table {
   bool periodic = true;
   double q0 = 0.0;    // first grid point
   double step = 0.0;  // grid step
+  // 1 / step, set with it by build_table: locate multiplies instead of dividing (a division's
+  // latency sits on the chain from one RK stage to the next).
+  double inv_step = 0.0;
   double period = 0.0;
   int intervals = 0;  // periodic: N (wrapping), otherwise N − 1
   int cols = 0;

@@ -50,8 +50,14 @@ std::vector<double> steps_from_fractions(const TimeScale& ts, const std::vector<
 
 }  // namespace
 
+// Below period/50 the fractions step by about 1.2: RK4's error goes as h⁴, so neighbouring rungs
+// differ by about 2× in error, and the matched-error selection (the cheapest run within a
+// baseline's error) lands within about 20 % of the cheapest step that would meet it. With rungs
+// 1.4× apart (35, 25) a baseline whose error fell just short of a rung's was matched by a step
+// 1.4× shorter than needed (issue #11 item 6: the ratio measured the ladder's spacing).
 std::vector<double> calc_fixed_step_ladder(const TimeScale& ts, bool quick) {
-  return steps_from_fractions(ts, quick ? std::vector<double>{200} : std::vector<double>{1000, 200, 100, 70, 50, 35, 25});
+  return steps_from_fractions(ts, quick ? std::vector<double>{200}
+                                        : std::vector<double>{1000, 200, 100, 70, 50, 42, 35, 30, 25, 21, 18, 15});
 }
 
 std::vector<double> calc_peer_step_ladder(const TimeScale& ts, bool quick) {

@@ -196,9 +196,10 @@ TEST(Table, FusedEvaluationMatchesSingleColumns) {
 }
 
 // The interval and offset as first written (std::floor, wrap by %): locate's faster floor and
-// wrap must give the same index and the same dx bit for bit.
-int locate_reference(const Table& t, double q, double& dx) {
-  const double u = (q - t.q0) / t.step;
+// wrap must give the same index and the same dx bit for bit. `divide`: u = (q − q0)/step as
+// first written; otherwise times the stored 1/step, as locate computes it.
+int locate_reference(const Table& t, double q, double& dx, bool divide = false) {
+  const double u = divide ? (q - t.q0) / t.step : (q - t.q0) * t.inv_step;
   const double fl = std::floor(u);
   long i = static_cast<long>(fl);
   dx = (u - fl) * t.step;
@@ -244,6 +245,22 @@ TEST(Table, ColumnBlockEqualsPerColumnEvaluationBitForBit) {
       double dx, dx_ref;
       ASSERT_EQ(t.locate(q, dx), locate_reference(t, q, dx_ref)) << "q = " << q;
       ASSERT_EQ(dx, dx_ref) << "q = " << q;
+      // Multiplying by 1/step instead of dividing moves the point by rounding only: the same
+      // interval with dx within 1e-12 of a step, or (q on a grid point) the neighbouring one with
+      // dx at the other end.
+      double dx_div;
+      const int i_div = locate_reference(t, q, dx_div, true);
+      const int i = t.locate(q, dx);
+      const double tol = 1e-12 * t.step * (1 + std::abs(q));
+      if (i == i_div) {
+        ASSERT_NEAR(dx, dx_div, tol) << "q = " << q;
+      } else {
+        const int n = t.intervals;
+        const bool next = t.periodic ? (i_div + 1) % n == i : i_div + 1 == i;
+        const bool prev = t.periodic ? (i + 1) % n == i_div : i + 1 == i_div;
+        ASSERT_TRUE((next && dx <= tol && dx_div >= t.step - tol) || (prev && dx_div <= tol && dx >= t.step - tol))
+            << "q = " << q << " intervals " << i << " vs " << i_div;
+      }
     }
   }
 }

@@ -18,12 +18,14 @@ TEST(LadderPlan, FullAndQuickLadders) {
   EXPECT_EQ(p.grids_deg.front(), 30);
   EXPECT_EQ(p.grids_deg.back(), 0.5);
   EXPECT_EQ(p.tightest_tolerance(), 1e-10);
-  // Fixed steps about √2 apart from period/100 to period/25: the cheap corner of RK4 between
-  // an error within the matched target and one beyond it (bicycle: 19.7 ms 6.9e-6, 39.4 ms 1.6e-4).
-  EXPECT_EQ(p.fixed_steps_s.size(), 7u);
-  EXPECT_NEAR(p.fixed_steps_s[5], 1.0 / 35, 1e-15);  // period 1 s
-  // 7 grids × 6 variants × (3 rk8pd + rkck + 7 rk4).
-  EXPECT_EQ(p.reduced_runs(), 7 * 6 * 11);
+  // Fixed steps about 1.2 apart from period/50 to the cap of duration/100 = 50 ms (period/18 and
+  // period/15 both capped there): the cheap corner of RK4 resolved to about 2× in error (bicycle:
+  // 28.2 ms 3.2e-5, 39.4 ms 1.6e-4).
+  EXPECT_EQ(p.fixed_steps_s.size(), 11u);
+  EXPECT_NEAR(p.fixed_steps_s[6], 1.0 / 35, 1e-15);  // period 1 s
+  EXPECT_NEAR(p.fixed_steps_s.back(), 5.0 / kMinFixedSteps, 1e-15);
+  // 7 grids × 6 variants × (3 rk8pd + rkck + 11 rk4).
+  EXPECT_EQ(p.reduced_runs(), 7 * 6 * 15);
   EXPECT_TRUE(p.time_reduced_without_outputs);  // one timing rule for every engine
   EXPECT_TRUE(p.time_peers_without_outputs);
   EXPECT_EQ(p.extraction_repeats_10deg, 3);
