@@ -351,15 +351,17 @@ int switching_sign(const ReducedModel::Gate& gate, double q, double qdot) {
 // not switched again). Fills after[g] with that sign (1 on, 0 off) for the gates switching at
 // the returned τ (±1e-9 relative; others −1), and returns τ, or +∞ when no switch is predicted.
 // Only where q̇ keeps its sign over the step and the path spans less than a turn; elsewhere +∞
-// and the switches are left to the check at the step's end.
+// and the switches are left to the check at the step's end. angle: the switch angle's image R
+// the returned τ reaches; reach: |q(h) − q0| along the path.
 double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, double v0, double a0, double h,
-                      size_t ng, int* after) {
+                      size_t ng, int* after, double& angle, double& reach_out) {
   for (size_t g = 0; g < ng; ++g) after[g] = -1;
   const double v1 = v0 + a0 * h;
   if (!(v0 * v1 > 0) || !(std::abs(q0) < 1e15)) return INFINITY;  // also NaN; a huge q has no angle left
   const double dir = v0 > 0 ? 1.0 : -1.0;
   const double reach = dir * h * (v0 + 0.5 * a0 * h);  // |q(h) − q0|, monotone path
   if (!(reach < kTwoPi)) return INFINITY;
+  reach_out = reach;
   double tau_min = INFINITY, R_min = 0.0;
   double tau_g[32];
   for (size_t g = 0; g < ng; ++g) {
@@ -369,6 +371,7 @@ double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, do
     for (double rho : gate.roots) {
       // Distance from q0 to the next image of ρ in the direction of motion, in [0, 2π).
       const double x = dir * (rho - q0) * (1.0 / kTwoPi);
+      if (!(std::abs(x) < 1e15)) continue;  // a root far outside the turn (a hand-made table): no angle
       double fl = static_cast<double>(static_cast<long>(x));
       if (fl > x) fl -= 1.0;
       const double dist = (x - fl) * kTwoPi;
@@ -401,6 +404,7 @@ double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, do
     tau -= f / df;
   }
   if (!(tau > 0 && tau <= h)) tau = tau_min;  // a correction leaving the step: the quadratic's
+  angle = R_min;
   for (size_t g = 0; g < ng; ++g)
     if (!(tau_g[g] <= tau_min * (1 + 1e-9))) after[g] = -1;
   return tau;
@@ -417,8 +421,11 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   // Each switch instant is estimated by linear interpolation of the switching function and
   // the step is split there. Allocation-free: at most 32 gates are tracked.
   const size_t ng = std::min<size_t>(m.gates.size(), 32);
-  bool any_predictable = false;
-  for (size_t g = 0; g < ng; ++g) any_predictable |= predictable(m.gates[g]);
+  // Prediction only when every gate has its angles: a cut at a predicted switch would otherwise
+  // pass over a switch of another gate before it, found only after the cut (and applied there,
+  // late). A mixed model takes the check at the step's end for all its gates.
+  bool all_predictable = ng > 0;
+  for (size_t g = 0; g < ng; ++g) all_predictable &= predictable(m.gates[g]);
   double t_first = NAN;
   double remaining = h;
   for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
@@ -427,7 +434,7 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
     // The given start derivative holds until a gate flips (pass 0 and its shortened step).
     const double* k1_now = pass == 0 ? k1 : nullptr;
     double k1_own[2];
-    if (any_predictable) {
+    if (all_predictable) {
       // Predict a switch of the gates with known switch angles from the start derivative (which
       // the step needs anyway) and cut the step there: one partial step instead of the whole
       // step, its partial repeat and the rest (issue #11 item 6: 7 fewer right-hand sides per
@@ -437,13 +444,22 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
         k1_now = k1_own;
       }
       int after[32];
-      const double tau = predict_switch(m, ws, q0, v0, k1_now[0], remaining, ng, after);
+      double angle = 0.0, reach = 0.0;
+      const double tau = predict_switch(m, ws, q0, v0, k1_now[0], remaining, ng, after, angle, reach);
       if (tau < remaining * (1 - 1e-12)) {
         rk4(m, ws, tau, k1_now);
-        if (std::isnan(t_first)) t_first = ws.t;
-        for (size_t g = 0; g < ng; ++g)
-          if (after[g] >= 0) ws.gate_on[g] = static_cast<char>(after[g]);
         remaining -= tau;
+        // The switch stands where the step reached its angle, or fell short of it by at most
+        // 1e-4 of the step's travel (the linear estimate it replaces was off by ~1e-3). A path
+        // that fell further short (the Taylor path overshot: strongly varying q̈ over a long
+        // step) has not switched: the next pass predicts again from here, closer, or finds the
+        // angle beyond the step.
+        const double short_by = (v0 > 0 ? 1.0 : -1.0) * (angle - ws.q);
+        if (short_by <= 1e-4 * reach) {
+          if (std::isnan(t_first)) t_first = ws.t;
+          for (size_t g = 0; g < ng; ++g)
+            if (after[g] >= 0) ws.gate_on[g] = static_cast<char>(after[g]);
+        }
         continue;
       }
     }

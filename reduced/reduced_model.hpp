@@ -156,8 +156,10 @@ inline bool energy_balance_diverged(double E, double E0, double work, double E_s
 // the step splits it there (at most 8 splits; the step always advances t by h). A gate whose
 // switch angles are known (Gate::pairs) has its switch predicted before the step, from the
 // Taylor path q0 + q̇0 τ + ½ q̈0 τ² meeting a switch angle: the step is cut at that τ without
-// first taking the whole step. Any other switch (and a predicted one that the step's end
-// contradicts) is located after the step by linear interpolation of the switching function.
+// first taking the whole step; the switch is made only where the step reached the angle. This
+// needs every gate's angles; a model with a gate without them, and any switch the prediction
+// does not see (q̇ changing sign), are located after the step by linear interpolation of the
+// switching function.
 // Returns the time of the first switch, or NaN when none happened.
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h);
 // The same with the start derivative k1 = (q̈, power) at (ws.q, ws.q̇) under ws's gates when

@@ -491,5 +491,73 @@ TEST(ReducedModel, FixedStepAppliesAGateOpenForLessThanAStep) {
   EXPECT_NEAR(ws.work, want, 0.01 * want);
 }
 
+// A predicted switch stands only where the step reached its angle: with the angle placed just
+// beyond where the step really ends (q1 + ε), no switch is made or reported, whatever the Taylor
+// path predicted; with it just inside (q1 − ε), the switch is made.
+TEST(ReducedModel, FixedStepSwitchesOnlyWhereTheStepReachesTheAngle) {
+  ReducedModel m = gated_lever(0.05);
+  const double q0 = 1.0, v0 = 6.0, h = 0.03;
+  set_gate_roots(m.gates[0], {3.0, 5.0});  // far away: the free step's end
+  ReducedWorkspace free(m);
+  free.q = q0, free.qdot = v0;
+  init_gates(m, free);
+  step_fixed_rk4(m, free, h);
+  const double q1 = free.q;
+  for (double eps : {1e-7, 1e-6, 1e-5, 1e-4, 1e-3}) {
+    for (double side : {+1.0, -1.0}) {
+      ReducedModel g = m;
+      set_gate_roots(g.gates[0], {q1 + side * eps, 5.0});
+      ReducedWorkspace ws(g);
+      ws.q = q0, ws.qdot = v0;
+      init_gates(g, ws);
+      const bool before = ws.gate_on[0];
+      const double t = step_fixed_rk4(g, ws, h);
+      const bool reached = side < 0;
+      EXPECT_EQ(std::isnan(t), !reached) << eps << " " << side;
+      EXPECT_EQ(static_cast<bool>(ws.gate_on[0]), reached ? !before : before) << eps << " " << side;
+    }
+  }
+}
+
+// Prediction needs every gate's angles: with one gate without them (its pairs cleared), a cut at
+// the other's predicted switch would pass over this one's switch before it. Such a model takes
+// the check at the step's end for all its gates: the same steps as with no angle pairs at all
+// (to rounding: the paired switching function is the product of sines written differently). Roots far outside a turn (a hand-made table) are no angles either (and no
+// undefined cast: UBSan in CI).
+TEST(ReducedModel, FixedStepPredictsOnlyWhenEveryGateHasItsAngles) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"a", "lever", 0.01, models::RateGate{"lever", +1}});
+  scene.joint_torques.push_back({"b", "lever", 0.03, models::RateGate{"lever", +1}});
+  ReducedModel mixed = make_reduced_model(analytic_samples(0.0, scene, 5), scene, Interpolation::Fourier);
+  ASSERT_EQ(mixed.gates.size(), 2u);
+  set_gate_roots(mixed.gates[0], {1.65, 4.0});
+  set_gate_roots(mixed.gates[1], {1.64, 4.5});
+  mixed.gates[1].pairs.clear();
+  ReducedModel none = mixed;
+  none.gates[0].pairs.clear();
+  ReducedWorkspace a(mixed), b(none);
+  a.q = b.q = 1.5, a.qdot = b.qdot = 6.0;
+  init_gates(mixed, a);
+  init_gates(none, b);
+  int switches = 0;
+  for (int i = 0; i < 300; ++i) {
+    const double ta = step_fixed_rk4(mixed, a, 0.01), tb = step_fixed_rk4(none, b, 0.01);
+    switches += !std::isnan(ta);
+    ASSERT_NEAR(a.q, b.q, 1e-12 * std::abs(b.q)) << i;
+    ASSERT_NEAR(a.qdot, b.qdot, 1e-12 * std::abs(b.qdot)) << i;
+    ASSERT_EQ(a.gate_on, b.gate_on) << i;
+    ASSERT_EQ(std::isnan(ta), std::isnan(tb)) << i;
+  }
+  EXPECT_GE(switches, 4);
+  ReducedModel far = gated_lever(0.05);
+  set_gate_roots(far.gates[0], {0.5, 1e20});
+  ASSERT_EQ(far.gates[0].pairs.size(), 1u);
+  ReducedWorkspace w(far);
+  w.q = 1.0, w.qdot = 6.0;
+  init_gates(far, w);
+  for (int i = 0; i < 50; ++i) step_fixed_rk4(far, w, 0.02);
+  EXPECT_TRUE(std::isfinite(w.q) && std::isfinite(w.qdot) && std::isfinite(w.work));
+}
+
 }  // namespace
 }  // namespace rdyn::reduced
