@@ -179,8 +179,9 @@ BENCHMARK(BM_ReducedPerSimulatedSecond)->Args({10, 0})->Args({5, 0})->Args({2, 1
 // The reduced settings `rdyn validate bicycle` matches at the knee errors of its baselines, timed
 // like every engine there (5 s, one output at the end): range(0) 0 — 1° fourier with energy-
 // consistent m2, RK4 at period/35 (28.2 ms; knee 3.2e-5, within Simbody's 5.8e-5); 1 — 5° cubic,
-// RK4 at period/25 (39.4 ms; knee 2.3e-4, within MuJoCo Euler's 8.1e-4 at 0.83 ms). The period
-// is the reference's one revolution at its peak speed, 0.98569 s.
+// RK4 at the ladder's largest step, duration/100 = 50 ms (knee 7.1e-4, within MuJoCo Euler's
+// 8.1e-4 at 0.83 ms; MuJoCo RK4's 4.5e-4 takes period/21, 46.9 ms). The period is the
+// reference's one revolution at its peak speed, 0.98569 s.
 void BM_ReducedMatchedSetting(benchmark::State& st) {
   const bool simbody_match = st.range(0) == 0;
   static const reduced::ReducedModel fine_ec =
@@ -190,7 +191,7 @@ void BM_ReducedMatchedSetting(benchmark::State& st) {
   o.duration_s = 5.0;
   o.output_interval_s = 5.0;
   o.integrator = "rk4-fixed";
-  o.fixed_step_s = 0.98569 / (simbody_match ? 35 : 25);
+  o.fixed_step_s = simbody_match ? 0.98569 / 35 : 0.05;
   for (auto _ : st) benchmark::DoNotOptimize(reduced::simulate_reduced(m, 0, 2 * M_PI, o).q.back());
 }
 BENCHMARK(BM_ReducedMatchedSetting)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
