@@ -430,12 +430,28 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       finite &= std::isfinite(out.me1.back()) && std::isfinite(out.me2.back());
     }
     // This point anchors the next prediction: q' = N r, q'' = N b (Ṅ = 0 for the pins and
-    // sliders rdyn builds).
+    // sliders rdyn builds). At a singular configuration r and b are least-squares values of no
+    // particular branch (a parallelogram's aligned position, where the antiparallelogram branch
+    // crosses): extrapolating along them led the next projection onto the other branch (the
+    // hard parallelogram's table turned antiparallelogram after 180°, and its reduced run
+    // diverged). There the prediction follows the chord from the previous grid point instead,
+    // the branch the sweep came along (positions are determined at the singular point; only
+    // the rates are not).
+    const bool singular = out.near_singular || out.conditioning < kSingularConditioning;
+    Vector q_before;
+    double x_before = 0.0;
+    const bool had_anchor = w.anchor_set && w.anchor_q.size() == s.getNQ();
+    if (had_anchor) q_before = w.anchor_q, x_before = w.anchor_x;
     w.anchor_set = true;
     w.anchor_x = q;
     w.anchor_q = s.getQ();
     m.matter.multiplyByN(s, false, u, w.anchor_dq);
     m.matter.multiplyByN(s, false, b, w.anchor_ddq);
+    const double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
+    if (singular && had_anchor && std::abs(dx) > 1e-9 && std::abs(dx) <= 2 * max_extrapolation) {
+      w.anchor_dq = (w.anchor_q - q_before) / dx;
+      w.anchor_ddq = 0.0 * w.anchor_dq;
+    }
   }
   if (!finite)
     throw models::NumericalError(fmt::format("{}: the full model returned a non-finite reduced parameter or velocity "

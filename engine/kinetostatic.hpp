@@ -49,6 +49,10 @@ struct VelocityRatios {
 VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, double q, bool with_q = true,
                                     bool with_x = true);
 
+// A configuration is singular (its velocities not determined by the constraints) below this
+// conditioning: it grows like 0.3 × (distance in rad) from a parallelogram's aligned position.
+inline constexpr double kSingularConditioning = 1e-5;
+
 // Conditioning of the loop closure at the workspace's configuration: smallest over largest
 // singular value of the constraint Jacobian restricted to the mobilities the constraints
 // must determine (all but the prescribed ones). Near 0 at a singular configuration

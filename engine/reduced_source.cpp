@@ -126,7 +126,7 @@ reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_cons
     g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
   }
   // Singular configuration: as sample_here.
-  g.singular = model_.impl().near_singular_projections > singular_before || k.conditioning < 1e-5;
+  g.singular = model_.impl().near_singular_projections > singular_before || k.conditioning < kSingularConditioning;
   return g;
 }
 
@@ -154,7 +154,7 @@ reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_cons
   // Singular configuration: the loop Jacobian lost rank (or the projection needed its
   // fallback tolerance). The constraints do not determine the velocities there.
   g.singular = model_.impl().near_singular_projections > singular_before ||
-               calc_loop_conditioning(model_, ws_) < 1e-5;  // ≈ 0.3·(distance in rad) near an aligned position
+               calc_loop_conditioning(model_, ws_) < kSingularConditioning;
   return g;
 }
 

@@ -139,6 +139,26 @@ TEST(ReducedSource, FourBarInertiaMatchesClosedForm) {
   }
 }
 
+// models/scenes/hard/parallelogram.yaml turns through its aligned positions (0° and 180°), where
+// the antiparallelogram branch crosses. On the parallelogram branch the coupler translates
+// (its joint on the crank turns back: r_coupler = −1), the rocker turns with the crank (r_rocker = 1) and m1 is the constant of
+// test::parallelogram_m1 (the same bodies). A sweep that leaves the singular point along
+// least-squares rates lands on the other branch, where none of the three holds.
+TEST(ReducedSource, ParallelogramSweepKeepsItsBranchThroughTheAlignedPositions) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  for (double deg : {10.0, 5.0, 15.0}) {
+    const auto s = extract(scene, deg, reduced::Method::Kinetostatic);
+    ASSERT_EQ(s.q.size(), static_cast<size_t>(std::lround(360 / deg)));
+    const auto &m1 = s.columns[s.require("m1")], &rc = s.columns[s.require("r_coupler")],
+               &rr = s.columns[s.require("r_rocker")];
+    for (size_t i = 0; i < s.q.size(); ++i) {
+      EXPECT_NEAR(m1[i], test::parallelogram_m1(), 1e-12) << deg << "° grid at " << s.q[i];
+      EXPECT_NEAR(rc[i], -1.0, 1e-9) << deg << "° grid at " << s.q[i];
+      EXPECT_NEAR(rr[i], 1.0, 1e-9) << deg << "° grid at " << s.q[i];
+    }
+  }
+}
+
 TEST(ReducedSource, FourMethodsAgreeOnTheBicycle) {
   const auto scene = models::load_scene("bicycle");
   const auto ks = extract(scene, 10, reduced::Method::Kinetostatic);
