@@ -653,6 +653,38 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
   return c;
 }
 
+struct CyclePasses::Impl {
+  FirstIntegral fi;
+  Impl(const ReducedModel& m, const SteadyCycleOptions& opt) : fi(m, opt) {}
+};
+
+CyclePasses::CyclePasses(const ReducedModel& m, const SteadyCycleOptions& opt) {
+  check_steady_cycle_options(opt);
+  if (!m.table.periodic)
+    throw models::NumericalError("steady cycle: the table is not periodic (the independent coordinate does not turn "
+                                 "a full period), so there is no cycle");
+  impl_ = std::make_unique<Impl>(m, opt);
+}
+
+CyclePasses::~CyclePasses() = default;
+
+CyclePasses::Pass CyclePasses::run(double u0) {
+  Pass p;
+  if (!(u0 > 0 && std::isfinite(u0))) return p;
+  ++passes_;
+  auto& fi = impl_->fi;
+  // The workspace copied the joint torques' values when it was made; the caller may have
+  // changed them since (the gates and the switching cache do not depend on values).
+  for (size_t i = 0; i < fi.m.torques.size(); ++i) fi.ws.torque_value[i] = fi.m.torques[i].value;
+  if (!fi.pass(u0)) return p;
+  p.completed = true;
+  p.u_end = fi.y_end[0];
+  p.period_s = fi.y_end[1];
+  p.work_nc_J = fi.y_end[2];
+  p.work_brakes_J = fi.y_end[3];
+  return p;
+}
+
 SteadyCycle find_steady_cycle(const ReducedModel& m, const SteadyCycleOptions& opt) {
   check_steady_cycle_options(opt);
   try {

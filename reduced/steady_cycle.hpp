@@ -11,6 +11,7 @@
 // q̇ does not keep its sign, and the cross-check.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -79,5 +80,38 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
 // First integral first, time stepping when it does not apply (its NumericalError); throws the
 // time-stepping route's NumericalError when neither finds a cycle.
 SteadyCycle find_steady_cycle(const ReducedModel& m, const SteadyCycleOptions& opt);
+
+// Single passes of the first integral, for callers that solve for the cycle together with
+// other unknowns (calibration: the steady cycle and the load that holds a cadence, in one
+// Newton iteration instead of a search over loads each holding a search over speeds). The
+// breakpoints are fixed at construction: the model's load values (torques, motors,
+// resistance coefficients) may change between passes, its gates and table may not. Passes
+// after the first replay its step grid (§6a), so a pass is a smooth function of u0 and of
+// the load values, as finite differences need.
+class CyclePasses {
+ public:
+  // opt.qdot_guess gives the direction (its sign); opt.q_section the section. Throws TableError
+  // on options out of range, NumericalError on a table that is not periodic.
+  CyclePasses(const ReducedModel& m, const SteadyCycleOptions& opt);
+  ~CyclePasses();
+  CyclePasses(const CyclePasses&) = delete;
+  CyclePasses& operator=(const CyclePasses&) = delete;
+
+  struct Pass {
+    bool completed = false;  // false: q̇ reached zero within the period (a stall)
+    double u_end = 0.0;      // u = q̇²/2 after one period [rad²/s²]
+    double period_s = 0.0;   // its duration
+    double work_nc_J = 0.0;  // work of every non-conservative load over it
+    double work_brakes_J = 0.0;  // of the resistances (≤ 0)
+  };
+  // One period from u0 = q̇0²/2 > 0 (finite) at the section.
+  Pass run(double u0);
+  int passes() const { return passes_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int passes_ = 0;
+};
 
 }  // namespace rdyn::reduced

@@ -14,6 +14,7 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
+#include "validate/operating_point.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/confirm_full.hpp"
 
@@ -253,7 +254,11 @@ std::string load_value_column(const models::Scene& scene, const CalibrationOptio
   return "drive_load";
 }
 
-void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
+namespace {
+
+// check_calibratable without the full model: options, the load, the resistance, a revolute
+// without a range.
+void check_calibration_input(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw models::SceneError(scene.source_file, 0, field, msg);
   };
@@ -269,8 +274,6 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
     if (!models::fixed_speed_ratio(scene, res.body))
       fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
   }
-  const engine::FullModel model(scene);
-  const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
   // A mean rate in rev/s needs a coordinate that turns fully: a rocker or a stroke moves within
   // a range (docs/theory.md §6c) and has no steady revolution to hold.
   const auto* indep = scene.find_joint(scene.independent);
@@ -278,10 +281,22 @@ void check_calibratable(const models::Scene& scene, const CalibrationOptions& op
     fail("independent", fmt::format("calibration holds a mean rate in rev/s, so '{}' must be a revolute that turns "
                                     "fully; it moves within a range",
                                     scene.independent));
-  if (!engine::calc_independent_domain(model).periodic)
-    fail("independent", fmt::format("calibration holds a mean rate in rev/s, so '{}' must turn fully; it cannot "
-                                    "(it meets dead points: see rdyn inspect)",
-                                    scene.independent));
+}
+
+void fail_dead_points(const models::Scene& scene) {
+  throw models::SceneError(scene.source_file, 0, "independent",
+                           fmt::format("calibration holds a mean rate in rev/s, so '{}' must turn fully; it cannot "
+                                       "(it meets dead points: see rdyn inspect)",
+                                       scene.independent));
+}
+
+}  // namespace
+
+void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
+  check_calibration_input(scene, opt);
+  const engine::FullModel model(scene);
+  const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
+  if (!engine::calc_independent_domain(model).periodic) fail_dead_points(scene);
 }
 
 double calc_resistance_coefficient(const models::Scene& scene, const CalibrationOptions& opt) {
@@ -425,29 +440,58 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
                                    opt.cadence_hz, W_other, sel.name));
     r.initial_guess = -W_other / W_unit;
 
-    // Brent (GSL) on the load's magnitude: mean steady cadence = F.
-    RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
-    gsl_function fn{cadence_error, &ctx};
-    double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
-    double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
-    for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
-    for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
-      hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
-    if (!(flo <= 0 && fhi >= 0))
-      throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
-                                               sel.name, lo, hi, sel.unit, opt.cadence_hz));
-    gsl_set_error_handler_off();
-    std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
-        gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
-    gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
-    T = r.initial_guess;
-    for (int it = 0; it < 100; ++it) {
-      gsl_root_fsolver_iterate(solver.get());
-      T = gsl_root_fsolver_root(solver.get());
-      progress.count("calibrate: load search", it + 1, it + 1);
-      if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
-                                 1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
-        break;
+    // One Newton iteration for the cycle, the load and (power mode) the coefficient together,
+    // from the energy balance's guess; the nested searches where it does not converge.
+    std::optional<OperatingPoint> direct;
+    if (opt.direct && pass == 0) {
+      OperatingPointTargets tg;
+      tg.q_section = scene.initial.q;
+      tg.qdot_guess = qd;
+      tg.cadence_hz = opt.cadence_hz;
+      tg.power_w = power_mode ? opt.power_w : NAN;
+      tg.tolerance = opt.tolerance;
+      progress.note("calibrate: operating point (Newton on the first integral)");
+      try {
+        direct = solve_operating_point(
+            m, tg, r.initial_guess, r.resistance_coefficient,
+            [&](double load, double c) {
+              set_load(m, sel, load);
+              if (power_mode) m.brakes[0].coefficient = c;
+            },
+            evals);
+      } catch (const models::NumericalError&) {
+        direct.reset();  // no first integral here (a table that is not periodic): the nested route
+      }
+    }
+    if (direct) {
+      T = direct->load;
+      if (power_mode) r.resistance_coefficient = direct->coefficient;
+    } else {
+      if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
+      // Brent (GSL) on the load's magnitude: mean steady cadence = F.
+      RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
+      gsl_function fn{cadence_error, &ctx};
+      double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
+      double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
+      for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
+      for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
+        hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
+      if (!(flo <= 0 && fhi >= 0))
+        throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
+                                                 sel.name, lo, hi, sel.unit, opt.cadence_hz));
+      gsl_set_error_handler_off();
+      std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
+          gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
+      gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
+      T = r.initial_guess;
+      for (int it = 0; it < 100; ++it) {
+        gsl_root_fsolver_iterate(solver.get());
+        T = gsl_root_fsolver_root(solver.get());
+        progress.count("calibrate: load search", it + 1, it + 1);
+        if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
+                                   1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
+          break;
+      }
     }
     progress.note("");
     // A value the scene format refuses (|load| or |amplitude|·max|τ| above limits::kMaxForce, a
@@ -464,7 +508,7 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
     r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
     r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
     set_load(m, sel, T);
-    cy = steady_cycle(m, scene.initial.q, qd, opt.tolerance, evals, true);
+    cy = steady_cycle(m, scene.initial.q, direct ? direct->qdot_section : qd, opt.tolerance, evals, true);
     if (!cy.ok)
       throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
                                                "({:.6g} {})", r.load_value, sel.unit));
@@ -534,12 +578,25 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
 
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  check_calibratable(scene, opt);
+  // The full-model part of check_calibratable is the extraction's own: its assembly names a
+  // loop that cannot close, and its sweep of the full turn meets any dead point (a range table
+  // then). A separate domain walk cost as much as the extraction (2.9 ms of 10.7 on the bicycle).
+  check_calibration_input(scene, opt);
   const Selection sel = select_load(scene, opt);
 
   // The table does not depend on load values: extract once.
   progress.note("calibrate: extracting the reduced table");
-  const auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
+  const auto e = [&] {
+    try {
+      return extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
+    } catch (const engine::EngineError&) {
+      // A range between dead points that cannot be sampled either: the dead points are the cause.
+      const engine::FullModel model(scene);
+      if (!engine::calc_independent_domain(model).periodic) fail_dead_points(scene);
+      throw;
+    }
+  }();
+  if (e.range || !e.samples.periodic) fail_dead_points(scene);
   auto m = reduced::make_reduced_model(e.samples, with_unit_load(scene, opt),
                                        reduced::parse_interpolation(opt.interpolation));
   CalibrationResult r = calibrate_reduced(m, scene, opt, progress);

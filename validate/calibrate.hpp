@@ -6,6 +6,8 @@
 // steady cycle at F (starting from c = P/ω_Fⁿ, exact only at constant speed; a secant around the
 // load search); without, the resistances stay as given. Solved on the reduced model (GSL Brent on the load value), confirmed with the
 // full model.
+// The reduced part is one Newton iteration on the first integral for the steady cycle, the load
+// and the coefficient together (validate/operating_point.hpp), the nested searches its fallback.
 #pragma once
 
 #include <string>
@@ -27,6 +29,10 @@ struct CalibrationOptions {
   std::string interpolation = "fourier";
   double tolerance = 1e-10;    // reduced integrator
   double full_check_s = 6.0;   // full-model confirmation run, from the steady cycle (0: skip)
+  // The operating point by one Newton iteration on the first integral (validate/operating_point.hpp);
+  // false, or where it does not converge: the nested searches (Brent on the load, each value a
+  // fixed-point search, a secant on the coefficient around them), the cross-check.
+  bool direct = true;
 };
 
 struct CalibrationResult {
