@@ -488,18 +488,6 @@ void check_scene(const Scene& s) {
   }
 }
 
-double resistance_torque(ResistanceLaw law, double c, double w) {
-  switch (law) {
-    case ResistanceLaw::Constant:
-      return w > 0 ? -c : w < 0 ? c : 0.0;
-    case ResistanceLaw::Viscous:
-      return -c * w;
-    case ResistanceLaw::Quadratic:
-      return -c * w * std::abs(w);
-  }
-  return 0.0;
-}
-
 int dissipation_exponent(ResistanceLaw law) {
   return law == ResistanceLaw::Constant ? 1 : law == ResistanceLaw::Viscous ? 2 : 3;
 }

@@ -373,7 +373,19 @@ void check_scene(const Scene& scene);
 std::string where(const Scene& scene, const std::string& key);
 
 // Resistance torque at angular rate ω [rad/s]: −c0·sgn ω, −c1·ω or −c2·ω|ω| [N·m].
-double resistance_torque(ResistanceLaw law, double coefficient, double omega);
+// Inline: the reduced model's right-hand side calls it at every stage (an out-of-line call and
+// its switch sat on the RK4 chain's critical path).
+inline double resistance_torque(ResistanceLaw law, double c, double w) {
+  switch (law) {
+    case ResistanceLaw::Constant:
+      return w > 0 ? -c : w < 0 ? c : 0.0;
+    case ResistanceLaw::Viscous:
+      return -c * w;
+    case ResistanceLaw::Quadratic:
+      return -c * w * (w < 0 ? -w : w);
+  }
+  return 0.0;
+}
 // Exponent n of the dissipated power P = c·ωⁿ (1 constant, 2 viscous, 3 quadratic).
 int dissipation_exponent(ResistanceLaw law);
 

@@ -140,6 +140,9 @@ namespace {
 void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const double* v, double qdot,
                        double& qddot, double& power_nc) {
   const double m1 = v[0], m2 = v[1];
+  // 1/m1 first: the division then runs beside the load sums instead of after them (RK4's
+  // stages form one chain, so its latency is the step's; issue #11 item 6).
+  const double inv_m1 = 1.0 / m1;
   double F_nc = 0.0;  // generalized force of the non-conservative loads on q
   const double* r = v + 3;
   for (size_t i = 0; i < m.torques.size(); ++i) {
@@ -164,7 +167,7 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
     r += f.c_tau >= 0 ? 2 : 1;
   }
   // Eksergian: m1 q̈ + m2 q̇² = Q_cons + F_nc
-  qddot = (v[2] + F_nc - m2 * qdot * qdot) / m1;
+  qddot = (v[2] + F_nc - m2 * qdot * qdot) * inv_m1;
   power_nc = F_nc * qdot;
 }
 

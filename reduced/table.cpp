@@ -176,6 +176,18 @@ void not_a_knot_coefficients(const std::vector<double>& y, double h, int col, in
 
 }  // namespace
 
+namespace {
+
+// a + b dx + c dx² + d dx³ by Estrin's scheme, (a + b dx) + dx² (c + d dx): two levels of
+// multiply-add instead of Horner's three, which matters on the RK4 chain, where each stage's
+// table lookup waits for the previous stage (issue #11 item 6). eval_block spells out the same
+// operations.
+inline double cubic(double a, double b, double c, double d, double dx) {
+  return (a + dx * b) + (dx * dx) * (c + dx * d);
+}
+
+}  // namespace
+
 int Table::locate(double q, double& dx) const {
   const double u = (q - q0) * inv_step;
   // NaN, or beyond the exactly representable integers: no interval (the cast would be undefined);
@@ -216,7 +228,7 @@ bool Table::in_range(double q) const {
 double Table::eval(int col, double q) const {
   double dx;
   const double* c = &coef[(static_cast<size_t>(locate(q, dx)) * cols + col) * 4];
-  return c[0] + dx * (c[1] + dx * (c[2] + dx * c[3]));
+  return cubic(c[0], c[1], c[2], c[3], dx);
 }
 
 double Table::eval_deriv(int col, double q) const {
@@ -230,7 +242,7 @@ void Table::eval_cols(double q, const int* idx, int n, double* out) const {
   const double* row = &coef[static_cast<size_t>(locate(q, dx)) * cols * 4];
   for (int k = 0; k < n; ++k) {
     const double* c = row + idx[k] * 4;
-    out[k] = c[0] + dx * (c[1] + dx * (c[2] + dx * c[3]));
+    out[k] = cubic(c[0], c[1], c[2], c[3], dx);
   }
 }
 
@@ -253,8 +265,9 @@ void eval_block(const Table& t, const ColumnBlock& b, double q, double* __restri
   const double* __restrict c1 = c0 + n;
   const double* __restrict c2 = c1 + n;
   const double* __restrict c3 = c2 + n;
-  // Horner, as Table::eval_cols: a + dx (b + dx (c + dx d)).
-  for (size_t k = 0; k < n; ++k) out[k] = c0[k] + dx * (c1[k] + dx * (c2[k] + dx * c3[k]));
+  const double dx2 = dx * dx;
+  // As Table::eval_cols (cubic(): the same operations, so the same bits).
+  for (size_t k = 0; k < n; ++k) out[k] = (c0[k] + dx * c1[k]) + dx2 * (c2[k] + dx * c3[k]);
 }
 
 int Table::column(const std::string& name) const {

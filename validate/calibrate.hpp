@@ -3,11 +3,11 @@
 // or of every joint torque together, signs kept — that holds the mean steady rate of the
 // independent coordinate at F revolutions per second. Two operating points: with a power P the
 // scene's one resistance's coefficient is set too, so that it dissipates P on average over the
-// steady cycle at F (starting from c = P/ω_Fⁿ, exact only at constant speed; a secant around the
-// load search); without, the resistances stay as given. Solved on the reduced model (GSL Brent on the load value), confirmed with the
-// full model.
-// The reduced part is one Newton iteration on the first integral for the steady cycle, the load
-// and the coefficient together (validate/operating_point.hpp), the nested searches its fallback.
+// steady cycle at F (c = P/ω_Fⁿ is exact only at constant speed); without, the resistances stay
+// as given. Solved on the reduced model, confirmed with the full model. The reduced part is one
+// Newton iteration on the first integral for the steady cycle, the load and the coefficient
+// together (validate/operating_point.hpp); where it does not converge, the nested searches:
+// GSL Brent on the load value (each value a steady-cycle search) inside a secant on ln c.
 #pragma once
 
 #include <string>
@@ -99,15 +99,17 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 
 // calibrate()'s reduced part on a model already built from the scene's table and
 // with_unit_load(scene, opt): the first guess from the energy balance per revolution, the
-// refusals that need the table (SceneError), Brent on the load value, the steady cycle there
-// (extremes and peak forces). Leaves `m` at the calibrated value; the full-model fields are NaN.
+// refusals that need the table (SceneError), the operating point (Newton on the first integral,
+// or the nested searches), the steady cycle there (extremes and peak forces). Leaves `m` at the calibrated value; the full-model fields are NaN.
 // Does not call check_calibratable (the caller has). Throws NumericalError when no value
 // reaches F to 1e-6. A search over load shapes calls it once per shape on the same table.
 CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress);
 
-// Throws as check_calibratable, and models::NumericalError when no value reaches F or the
-// result misses its target (reduced 1e-6, full 1 % of F).
+// Throws as check_calibratable (its full-model part from the extraction itself: the assembly
+// names a loop that cannot close, the sweep of the full turn meets dead points), and
+// models::NumericalError when no value reaches F or the result misses its target (reduced
+// 1e-6, full 1 % of F).
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress);
 
 // The scene's YAML rewritten with the calibrated load value (and, with a power, the
