@@ -413,6 +413,36 @@ double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, do
   return tau;
 }
 
+// The gates as a bit mask (at most 32 gates are tracked).
+unsigned gate_mask(const ReducedWorkspace& ws, size_t ng) {
+  unsigned mask = 0;
+  for (size_t g = 0; g < ng; ++g)
+    if (ws.gate_on[g]) mask |= 1u << g;
+  return mask;
+}
+
+// Records, at the workspace's state, where the next switch angle of any gate lies ahead in the
+// direction of q̇ (the gates agree with their switching functions here: the caller has just
+// checked). No record at rest, at a huge q, or on an angle itself.
+void mark_ahead(const ReducedModel& m, ReducedWorkspace& ws, size_t ng) {
+  ws.ahead_q = NAN;
+  const double q = ws.q, v = ws.qdot;
+  if (!(v != 0) || !(std::abs(q) < 1e15)) return;
+  const double dir = v > 0 ? 1.0 : -1.0;
+  double nearest = INFINITY;
+  for (size_t g = 0; g < ng; ++g)
+    for (double rho : m.gates[g].roots) {
+      const double x = dir * (rho - q) * (1.0 / kTwoPi);  // as predict_switch
+      if (!(std::abs(x) < 1e15)) continue;
+      double fl = static_cast<double>(static_cast<long>(x));
+      if (fl > x) fl -= 1.0;
+      nearest = std::min(nearest, (x - fl) * kTwoPi);
+    }
+  if (!(nearest > 1e-12 * (1.0 + std::abs(q)) && std::isfinite(nearest))) return;
+  ws.ahead_q = q, ws.ahead_qdot = v, ws.ahead_limit = q + dir * nearest;
+  ws.ahead_gates = gate_mask(ws, ng);
+}
+
 }  // namespace
 
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) { return step_fixed_rk4(m, ws, h, nullptr); }
@@ -431,6 +461,32 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   for (size_t g = 0; g < ng; ++g) all_predictable &= predictable(m.gates[g]);
   double t_first = NAN;
   double remaining = h;
+  // No switch angle ahead within this step's reach (the record mark_ahead left at this very
+  // state and gates): the step alone, without the prediction or the check at its end, which
+  // would find nothing (the same arithmetic, the same result). Issue #11 item 6: the bicycle's
+  // RK4 steps cross an angle about one step in five.
+  double k1_ahead[2];  // outlives the block: k1 may point to it after
+  if (all_predictable && ws.q == ws.ahead_q && ws.qdot == ws.ahead_qdot && gate_mask(ws, ng) == ws.ahead_gates) {
+    const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
+    double* k1_own = k1_ahead;
+    const double* k1_now = k1;
+    if (!k1_now) {
+      calc_acceleration(m, ws, q0, v0, k1_own[0], k1_own[1]);
+      k1_now = k1_own;
+    }
+    const double dir = v0 > 0 ? 1.0 : -1.0, a0 = k1_now[0];
+    const double reach = dir * h * (v0 + 0.5 * a0 * h);  // predict_switch's
+    if (v0 * (v0 + a0 * h) > 0 && reach < dir * (ws.ahead_limit - q0)) {
+      rk4(m, ws, h, k1_now);
+      if (ws.qdot * v0 > 0 && dir * (ws.ahead_limit - ws.q) > 0) {
+        ws.ahead_q = ws.q, ws.ahead_qdot = ws.qdot;  // the same angle is still ahead
+        return t_first;
+      }
+      ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;  // it passed the angle after all: the full step
+    }
+    k1 = k1_now;
+  }
+  bool agreed_at_end = false;
   for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
     const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
     double s0[32], fr[32];
@@ -483,6 +539,7 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
     }
     if (!disagree) {
       remaining = 0.0;  // the step to the end stands
+      agreed_at_end = true;
       break;
     }
     const double q1 = ws.q, v1 = ws.qdot;
@@ -499,6 +556,7 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
     }
     if (frac > 1.0) {
       remaining = 0.0;  // the step to the end stands
+      agreed_at_end = true;
       break;
     }
     ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;
@@ -513,6 +571,8 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   // switching function back through zero (sliding). Time must still advance by h, so the rest
   // of the step runs with the gates as they now are.
   if (remaining > 0) rk4(m, ws, remaining);
+  if (agreed_at_end && all_predictable) mark_ahead(m, ws, ng);
+  else ws.ahead_q = NAN;
   return t_first;
 }
 

@@ -108,6 +108,13 @@ struct ReducedWorkspace {
   // the last one ended, so its start values are the last end values (reduced/simulate_reduced).
   std::vector<double> switching;
   double switching_q = NAN, switching_qdot = NAN;
+  // Fixed-step RK4 with predictable gates (every gate's switch angles known): at the state
+  // (ahead_q, ahead_qdot) with the gates ahead_gates (bit g: gate g on), the gates agree with
+  // their switching functions and no switch angle lies strictly between q and ahead_limit in
+  // the direction of q̇. A step that stays short of it needs neither the switch prediction nor
+  // the check at its end (step_fixed_rk4).
+  double ahead_q = NAN, ahead_qdot = NAN, ahead_limit = NAN;
+  unsigned ahead_gates = 0;
   explicit ReducedWorkspace(const ReducedModel& m);
 };
 

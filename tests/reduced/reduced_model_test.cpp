@@ -273,6 +273,52 @@ TEST(ReducedModel, FixedStepWithKnownStartDerivativeIsTheSameStep) {
   EXPECT_GE(switches, 5);  // the split steps were exercised
 }
 
+// A step that stays short of the next switch angle (recorded where the gates were last
+// checked) skips the prediction and the check at its end: the same steps, bit for bit, as the
+// full path (the record cleared before every step), through every switch; most steps take the
+// short path. A gate changed from outside at the recorded state is not trusted: the record
+// holds only for the gates it was made with.
+TEST(ReducedModel, FixedStepWithoutAnAngleAheadIsTheFullStep) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
+  const auto s = analytic_samples(0.0, scene, 5);
+  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  ASSERT_FALSE(m.gates.empty());
+  ASSERT_FALSE(m.gates[0].roots.empty());  // predictable: the table's switch angles
+  ReducedWorkspace a(m), b(m);
+  a.q = b.q = 0.0, a.qdot = b.qdot = 10.0;
+  init_gates(m, a);
+  init_gates(m, b);
+  long switches = 0, short_steps = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const bool recorded = a.q == a.ahead_q;
+    b.ahead_q = NAN;
+    const double t_a = step_fixed_rk4(m, a, 2e-3);
+    const double t_b = step_fixed_rk4(m, b, 2e-3);
+    if (!std::isnan(t_a)) ++switches;
+    if (recorded && std::isnan(t_a)) ++short_steps;
+    ASSERT_EQ(std::isnan(t_a), std::isnan(t_b)) << "step " << i;
+    ASSERT_EQ(a.q, b.q) << "step " << i;
+    ASSERT_EQ(a.qdot, b.qdot) << "step " << i;
+    ASSERT_EQ(a.work, b.work) << "step " << i;
+    ASSERT_EQ(a.gate_on, b.gate_on) << "step " << i;
+  }
+  EXPECT_GE(switches, 5);
+  EXPECT_GT(short_steps, 3000 / 2);
+  // At a recorded state, the gate flipped from outside (it now disagrees with its switching
+  // function): the step checks and switches it back, as the full path does.
+  ASSERT_EQ(a.q, a.ahead_q);
+  a.gate_on[0] = !a.gate_on[0];
+  b.gate_on[0] = !b.gate_on[0];
+  b.ahead_q = NAN;
+  const double t_a = step_fixed_rk4(m, a, 2e-3), t_b = step_fixed_rk4(m, b, 2e-3);
+  EXPECT_FALSE(std::isnan(t_a));  // the disagreement was found and switched at once
+  EXPECT_EQ(std::isnan(t_a), std::isnan(t_b));
+  EXPECT_EQ(a.q, b.q);
+  EXPECT_EQ(a.gate_on, b.gate_on);
+}
+
 TEST(ReducedModel, RefusesATableFromAnotherScene) {
   auto scene = test::analytic_scene();
   scene.joint_torques.push_back({"drive", "lever", 2.0, models::RateGate{"lever", +1}});
