@@ -1,4 +1,5 @@
 #include "engine/kinetostatic.hpp"
+#include "engine/independent_range.hpp"
 
 #include <cmath>
 #include <initializer_list>
@@ -325,6 +326,12 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   m.set_law(s, 0, poly_law(q, 1.0, 0.0));
   for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
   m.set_load_mode(s, kLoadsOff);
+  // Without an anchor (the first grid point) the configuration this sample starts from — the
+  // assembly or the last continuation move — gives the direction the sweep comes from, which
+  // a singular first grid point needs (below).
+  Vector q_start;
+  double x_start = 0.0;
+  if (!w.anchor_set) q_start = s.getQ(), x_start = m.joint_q(s, m.independent);
   if (w.anchor_set && w.anchor_q.size() == s.getNQ()) {
     // Second-order predictor along the branch: Newton starts O(Δ³) from the solution.
     const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
@@ -447,8 +454,31 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
     w.anchor_q = s.getQ();
     m.matter.multiplyByN(s, false, u, w.anchor_dq);
     m.matter.multiplyByN(s, false, b, w.anchor_ddq);
-    const double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
-    if (singular && had_anchor && std::abs(dx) > 1e-9 && std::abs(dx) <= 2 * max_extrapolation) {
+    double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
+    // How far a chord may reach: two extrapolation lengths from the previous grid point; from
+    // the start, wherever it was (the first grid point is the one nearest the start, and the
+    // first call has no extrapolation length yet).
+    double chord_limit = 2 * max_extrapolation;
+    if (singular && !had_anchor && q_start.size() == s.getNQ()) {
+      // The first grid point: the chord from the configuration the sample started from.
+      const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+      q_before = q_start;
+      dx = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
+      chord_limit = INFINITY;
+      // Started on the singular configuration itself: branches cross there and nothing says
+      // which one the sweep should follow (a parallelogram started aligned). Bad input, not a
+      // failed move to retry.
+      if (!(std::abs(dx) > 1e-9)) {
+        w.anchor_set = false;
+        throw models::SceneError(
+            m.scene.source_file, m.scene.line_of("initial.q_deg"), "initial.q_deg",
+            fmt::format("the mechanism starts at a singular configuration of '{}' ({}: the loop Jacobian loses rank "
+                        "and assembly branches cross there), so the branch to follow is not determined; start it a "
+                        "little away from there",
+                        m.scene.independent, format_coordinate(q, revolute)));
+      }
+    }
+    if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {
       w.anchor_dq = (w.anchor_q - q_before) / dx;
       w.anchor_ddq = 0.0 * w.anchor_dq;
     }
