@@ -1,6 +1,7 @@
 #include "reduced/reduced_model.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -9,10 +10,11 @@
 
 namespace rdyn::reduced {
 
-ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
-                                bool energy_consistent_m2) {
-  // A table fits only the scene it was extracted from (same mechanism, branch, grid anchor and
-  // load placement): compare the fingerprints before anything else.
+namespace {
+
+// A table fits only the scene it was extracted from (same mechanism, branch, grid anchor and
+// load placement): compare the fingerprints before anything else.
+void check_samples_fit(const Samples& s, const models::Scene& scene) {
   const std::string what = s.file.empty() ? fmt::format("the table of scene '{}'", s.scene) : "table " + s.file;
   if (!s.scene_hash)
     throw TableError(what + " does not record the scene it was extracted from; re-extract it with `rdyn extract`");
@@ -21,8 +23,20 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, In
     throw TableError(fmt::format("{} was extracted from a different scene (its mechanism, where loads act, or the initial q that picks the assembly branch differ: hash {} vs {}); "
                                  "re-extract it for scene '{}'",
                                  what, models::scene_hash_hex(*s.scene_hash), models::scene_hash_hex(h), scene.name));
+}
+
+}  // namespace
+
+ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
+                                bool energy_consistent_m2) {
+  check_samples_fit(s, scene);  // before the table is built
+  return make_reduced_model(s, scene, build_table(s, interp, energy_consistent_m2));
+}
+
+ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Table table) {
+  check_samples_fit(s, scene);
   ReducedModel m;
-  m.table = build_table(s, interp, energy_consistent_m2);
+  m.table = std::move(table);
   m.min_edge = s.min_edge;
   m.max_edge = s.max_edge;
   m.revolute = s.revolute;

@@ -94,6 +94,11 @@ struct ReducedModel {
 ReducedModel make_reduced_model(const Samples& samples, const models::Scene& scene, Interpolation interp,
                                 bool energy_consistent_m2 = false);
 
+// The same with the table already built from these samples (build_table(samples, …)): scenes
+// that differ only in what the scene hash leaves out (load values, resistance coefficients)
+// share one table; each gets its own loads. Throws as above.
+ReducedModel make_reduced_model(const Samples& samples, const models::Scene& scene, Table table);
+
 // Per-run state: the ODE state, the load gates, and scratch space sized once.
 struct ReducedWorkspace {
   double t = 0.0, q = 0.0, qdot = 0.0, work = 0.0;

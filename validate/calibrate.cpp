@@ -576,29 +576,36 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
   return r;
 }
 
+CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
+  // The domain walk stays although the extraction sweeps the full turn too: the extraction's
+  // second-order predictor can carry its sweep over a blocked range narrower than a grid step
+  // onto the other assembly (a periodic table of two branches), where the walk's plain moves
+  // fail and find the dead points (a non-Grashof four-bar blocked over 2° near 180°). It costs
+  // about an extraction (2.9 ms on the bicycle); sweeps pay it once per table.
+  check_calibratable(scene, opt);
+  auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
+  if (e.range || !e.samples.periodic) fail_dead_points(scene);
+  CalibrationTable t;
+  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
+  t.samples = std::move(e.samples);
+  return t;
+}
+
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  // The full-model part of check_calibratable is the extraction's own: its assembly names a
-  // loop that cannot close, and its sweep of the full turn meets any dead point (a range table
-  // then). A separate domain walk cost as much as the extraction (2.9 ms of 10.7 on the bicycle).
-  check_calibration_input(scene, opt);
-  const Selection sel = select_load(scene, opt);
-
   // The table does not depend on load values: extract once.
   progress.note("calibrate: extracting the reduced table");
-  const auto e = [&] {
-    try {
-      return extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
-    } catch (const engine::EngineError&) {
-      // A range between dead points that cannot be sampled either: the dead points are the cause.
-      const engine::FullModel model(scene);
-      if (!engine::calc_independent_domain(model).periodic) fail_dead_points(scene);
-      throw;
-    }
-  }();
-  if (e.range || !e.samples.periodic) fail_dead_points(scene);
-  auto m = reduced::make_reduced_model(e.samples, with_unit_load(scene, opt),
-                                       reduced::parse_interpolation(opt.interpolation));
+  auto r = calibrate(scene, extract_calibration_table(scene, opt), opt, progress);
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& table, const CalibrationOptions& opt,
+                            Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  check_calibration_input(scene, opt);
+  const Selection sel = select_load(scene, opt);
+  auto m = reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table);
   CalibrationResult r = calibrate_reduced(m, scene, opt, progress);
   const double T = std::abs(r.load_value);
 

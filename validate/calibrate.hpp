@@ -16,6 +16,8 @@
 #include "models/scene.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/reduced_model.hpp"
+#include "reduced/samples.hpp"
+#include "reduced/table.hpp"
 #include "validate/progress.hpp"
 
 namespace rdyn::validate {
@@ -105,6 +107,21 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 // reaches F to 1e-6. A search over load shapes calls it once per shape on the same table.
 CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress);
+
+// The calibration's table: the kinetostatic extraction at opt.grid_deg and its interpolant
+// (opt.interpolation). It depends on the mechanism and where loads act, not on load values,
+// resistance coefficients, cadence or power (the scene hash, models/scene_hash.hpp): scenes
+// that differ only there share it. Throws as calibrate() for a scene that cannot be calibrated.
+struct CalibrationTable {
+  reduced::Samples samples;
+  reduced::Table table;
+};
+CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt);
+
+// calibrate() on a table already extracted for a scene of the same hash (sweeps whose axes vary
+// only load values reuse one; reduced::TableError when the hashes differ).
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& table, const CalibrationOptions& opt,
+                            Progress& progress);
 
 // Throws as check_calibratable (its full-model part from the extraction itself: the assembly
 // names a loop that cannot close, the sweep of the full turn meets dead points), and

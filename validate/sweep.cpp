@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <mutex>
+#include <optional>
 #include <thread>
+#include <utility>
 
 #include <fmt/format.h>
 
+#include "models/scene_hash.hpp"
 #include "models/scene_yaml.hpp"
 #include "validate/calibrate.hpp"
 #include "validate/escape.hpp"
@@ -80,6 +84,10 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   const std::string value_column = load_value_column(base, copt);
   auto work = [&] {
     Progress quiet(false);
+    // The last table this thread extracted, by scene hash: cases that differ only in load
+    // values, resistance coefficients, cadence or power share it (calibrate's extraction and
+    // fit are 3/4 of a case; cases take consecutive indices and the last axis varies fastest).
+    std::optional<std::pair<std::uint64_t, CalibrationTable>> last;
     for (long k; (k = next.fetch_add(1)) < n;) {
       const long index = first + k;
       std::vector<models::Override> o = fixed;
@@ -94,7 +102,12 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
       std::string row;
       try {
         const auto scene = models::load_scene(opt.scene, o);
-        const auto r = calibrate(scene, copt, quiet);
+        const std::uint64_t hash = models::scene_hash(scene);
+        if (!last || last->first != hash) {
+          last.reset();  // a failed extraction leaves none
+          last.emplace(hash, extract_calibration_table(scene, copt));
+        }
+        const auto r = calibrate(scene, last->second, copt, quiet);
         // No constraint force requested: an empty field, never NaN.
         const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
         row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,

@@ -359,6 +359,26 @@ TEST(Calibrate, ALoadWithNothingLeftToDoNamesTheOtherDrives) {
   }
 }
 
+// A non-Grashof four-bar whose crank is blocked over only ~2° near 180° (crank 0.18004 m, the
+// ground pivot turned 2.5°): the extraction's 10° sweep can step over the blocked range onto
+// the other assembly and call the table periodic; the domain walk finds the dead points, so
+// calibration refuses it as bad input naming `independent`, as for a crank-rocker.
+TEST(Calibrate, ANarrowBlockedRangeIsRefused) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const auto scene = models::parse_scene(yaml, "fourbar-blocked.yaml",
+                                         {{"bodies.crank.points.B.0", "0.18004"},
+                                          {"ground_points.D.0", "0.299714"},
+                                          {"ground_points.D.1", "0.013089"},
+                                          {"initial.q_deg", "32"}});
+  const std::string f = refusal_of(scene, calibration_options_of(scene, 1.0, 0.0, "drive"));
+  EXPECT_EQ(f.rfind("independent: ", 0), 0u) << f;
+  EXPECT_NE(f.find("dead points"), std::string::npos) << f;
+}
+
 TEST(Calibrate, RefusalsNameTheField) {
   const auto fw = models::parse_scene(
       flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
