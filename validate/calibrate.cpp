@@ -30,6 +30,9 @@ constexpr double kReducedCadenceTolerance = 1e-6;
 // solved to 1e-12 and the load to 1e-10, so a converged secant reaches it), in at most 30 load
 // searches (the secant converges in 3–6).
 constexpr double kPowerTolerance = 1e-8;
+// Drive and dissipated power on the reduced steady cycle may differ by the table's
+// interpolation residual up to this fraction (the bicycle at 1 Hz, 125 W: 1.2e-6).
+constexpr double kEnergyBalanceTolerance = 1e-3;
 constexpr int kMaxPowerPasses = 30;
 
 // The load being calibrated: one joint torque, one motor's stall torque, or every joint
@@ -274,6 +277,20 @@ void check_calibration_input(const models::Scene& scene, const CalibrationOption
     if (!models::fixed_speed_ratio(scene, res.body))
       fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
   }
+  // The mean speed is set by losses that grow with speed (viscous, quadratic resistances) or a
+  // drive that falls with it (a motor). Resistances of constant magnitude take the same energy
+  // per revolution at every speed, and torques and forces depend on position only: then every
+  // speed is a steady cycle at the one load value that balances a revolution, and none is
+  // singled out (the calibrated "cadence" would be an accident of interpolation errors).
+  bool speed_sets_losses = !scene.motors.empty();
+  for (const auto& res : scene.resistances) speed_sets_losses |= res.law != models::ResistanceLaw::Constant;
+  if (!speed_sets_losses && !scene.resistances.empty())
+    fail("loads." + scene.resistances[0].name,
+         fmt::format("every resistance has a constant magnitude (law: constant), which takes the same energy per "
+                     "revolution at any speed, and no motor drives: every speed is then a steady cycle at one load "
+                     "value, so no load value holds {:g} Hz rather than another; give a resistance a viscous or "
+                     "quadratic law, or drive with a motor",
+                     opt.cadence_hz));
   // A mean rate in rev/s needs a coordinate that turns fully: a rocker or a stroke moves within
   // a range (docs/theory.md §6c) and has no steady revolution to hold.
   const auto* indep = scene.find_joint(scene.independent);
@@ -541,6 +558,22 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
     r.resistance_coefficient = std::exp(ln_c - f / slope);
   }
   r.mean_dissipated_power_w = cy.detail.dissipated_power_W;
+  // On a steady cycle the drive supplies what the resistances dissipate. The reduced model's
+  // own residual — an interpolated m2 that is not exactly ½ dm1/dq acts as a power ∝ q̇³
+  // (docs/theory.md §5; ~1.5e-4 W on the bicycle's 10° table at 1 Hz, 1e-6 of 125 W) — is
+  // small unless the operating point's energy flow is small against it (a very low power, a
+  // very high cadence): then the calibrated value is the interpolation error's, not the
+  // mechanism's, and that is no result.
+  {
+    const double drive = cy.detail.drive_power_W, diss = cy.detail.dissipated_power_W;
+    if (!(std::abs(drive - diss) <= kEnergyBalanceTolerance * std::max(std::abs(drive), std::abs(diss))))
+      throw models::NumericalError(fmt::format(
+          "calibration: on the reduced model's steady cycle at {:g} Hz the drive supplies {:.6g} W but the resistances "
+          "dissipate {:.6g} W ({:.2g} % apart, allowed {:g} %): the table's interpolation error is not small against "
+          "this operating point's energy flow; extract on a finer grid (--grid-deg)",
+          opt.cadence_hz, drive, diss, 100 * std::abs(drive - diss) / std::max(std::abs(drive), std::abs(diss)),
+          100 * kEnergyBalanceTolerance));
+  }
   r.evaluations = evals;
 
   // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).

@@ -44,7 +44,8 @@ struct CalibrationResult {
   std::string load_unit;  // N·m or N
   double load_value = 0.0;  // calibrated value, signed (joint_torques: the magnitude each gets, signs kept)
   double torque_Nm = 0.0;   // = |load_value| for joint torques on revolute joints, NaN for other kinds
-  double initial_guess = 0.0;           // from the energy balance per revolution [load unit]
+  double initial_guess = 0.0;           // from the energy balance per revolution [load unit] (power mode: at the
+                                        // starting coefficient P/ω_Fⁿ)
   // c0, c1 or c2 of the scene's resistance (NaN: mean-speed mode, unchanged): the one whose
   // steady cycle at F dissipates P on average (not P/ω_Fⁿ, which holds only at constant speed).
   double resistance_coefficient = 0.0;

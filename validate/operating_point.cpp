@@ -121,12 +121,13 @@ std::optional<OperatingPoint> solve_operating_point(const reduced::ReducedModel&
   bool started = residual(x, r);
   for (int k = 0; k < 4 && !started && cp.passes() < t.max_passes; ++k) x[0] += std::log(4.0), started = residual(x, r);
   if (!started || !difference_jacobian(x, r)) return std::nullopt;
+  auto result = [&] {
+    values(x);
+    return OperatingPoint{std::exp(x[1]), power ? std::exp(x[2]) : NAN,
+                          (t.qdot_guess > 0 ? 1.0 : -1.0) * std::sqrt(2 * std::exp(x[0]))};
+  };
   while (cp.passes() < t.max_passes) {
-    if (converged(r)) {
-      values(x);
-      return OperatingPoint{std::exp(x[1]), power ? std::exp(x[2]) : NAN,
-                            (t.qdot_guess > 0 ? 1.0 : -1.0) * std::sqrt(2 * std::exp(x[0]))};
-    }
+    if (converged(r)) return std::optional<OperatingPoint>(result());
     Vec minus_r{}, dx{};
     for (int i = 0; i < n; ++i) minus_r[i] = -r[i];
     if (!solve(J, minus_r, n, dx)) return std::nullopt;
@@ -161,6 +162,7 @@ std::optional<OperatingPoint> solve_operating_point(const reduced::ReducedModel&
       }
     }
   }
+  if (converged(r)) return std::optional<OperatingPoint>(result());  // on the last pass allowed
   return std::nullopt;
 }
 

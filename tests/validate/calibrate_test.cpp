@@ -379,6 +379,47 @@ TEST(Calibrate, ANarrowBlockedRangeIsRefused) {
   EXPECT_NE(f.find("dead points"), std::string::npos) << f;
 }
 
+// With only resistances of constant magnitude and position-only drives every speed is a steady
+// cycle at one torque (the energy per revolution does not depend on speed): no cadence is
+// singled out, so calibration refuses it, naming the resistance.
+TEST(Calibrate, ConstantMagnitudeResistanceCannotSetTheCadence) {
+  const auto scene = models::load_scene("bicycle", {{"bicycle_leg.resistance.law", "constant"}});
+  ASSERT_EQ(scene.resistances.size(), 1u);
+  ASSERT_EQ(scene.resistances[0].law, models::ResistanceLaw::Constant);
+  const std::string f = refusal_of(scene, calibration_options_of(scene, 0.0, 0.0, ""));
+  EXPECT_EQ(f.rfind("loads." + scene.resistances[0].name + ": ", 0), 0u) << f;
+  EXPECT_NE(f.find("law: constant"), std::string::npos) << f;
+  // A motor's torque falls with speed: with it the cadence is determined again.
+  const auto fw = models::parse_scene(
+      flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"),
+      "flywheel.yaml");
+  auto coulomb = fw;
+  coulomb.resistances[0].law = models::ResistanceLaw::Constant;
+  EXPECT_EQ(refusal_of(coulomb, calibration_options_of(coulomb, 2.0, 0.0, "motor")), "accepted");
+}
+
+// The reduced steady cycle must balance: at 1 mW the bicycle's 10° table's own residual
+// (~1.5e-4 W, from m2 not being exactly ½ dm1/dq) is 15 % of the flow, so the "calibrated"
+// torque would be the interpolation error's: a numerical failure naming both powers. At 125 W
+// the same residual is 1.2e-6 of the flow.
+TEST(Calibrate, AnUnbalancedReducedCycleIsAFailure) {
+  const auto scene = models::load_scene("bicycle");
+  CalibrationOptions opt = calibration_options_of(scene, 1.0, 1e-3, "");
+  opt.full_check_s = 0;
+  Progress quiet(false);
+  try {
+    calibrate(scene, opt, quiet);
+    ADD_FAILURE() << "a cycle whose drive and dissipation differ by 15 % was accepted";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("the resistances dissipate 0.001 W"), std::string::npos) << m;
+    EXPECT_NE(m.find("--grid-deg"), std::string::npos) << m;
+  }
+  opt.power_w = 125.0;
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_NEAR(r.mean_power_w, r.mean_dissipated_power_w, 1e-5 * r.mean_dissipated_power_w);
+}
+
 TEST(Calibrate, RefusalsNameTheField) {
   const auto fw = models::parse_scene(
       flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
