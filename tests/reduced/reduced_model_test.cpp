@@ -219,12 +219,17 @@ TEST(ReducedModel, ConstantProfileReproducesTheConstantTorque) {
   }
 }
 
-TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
+// The analytic lever with a drive gated on its forward rotation and a viscous brake on the
+// crank (5° fourier table): the fixed-step tests' switching model.
+ReducedModel braked_gated_lever() {
   auto scene = test::analytic_scene();
   scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
   scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
-  const auto s = analytic_samples(0.0, scene, 5);
-  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  return make_reduced_model(analytic_samples(0.0, scene, 5), scene, Interpolation::Fourier);
+}
+
+TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
+  const auto m = braked_gated_lever();
   ReducedWorkspace ws(m);
   ws.q = 0.0, ws.qdot = 10.0;
   init_gates(m, ws);
@@ -244,11 +249,7 @@ TEST(ReducedModel, FixedStepAllocatesNothingAndTracksTheAdaptiveSolution) {
 // previous step's end point): the same steps bit for bit as computing it anew, through gate
 // switches (split steps) too, and still allocation-free; calc_sample allocates nothing either.
 TEST(ReducedModel, FixedStepWithKnownStartDerivativeIsTheSameStep) {
-  auto scene = test::analytic_scene();
-  scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
-  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
-  const auto s = analytic_samples(0.0, scene, 5);
-  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  const auto m = braked_gated_lever();
   ReducedWorkspace a(m), b(m);
   a.q = b.q = 0.0, a.qdot = b.qdot = 10.0;
   init_gates(m, a);
@@ -279,11 +280,7 @@ TEST(ReducedModel, FixedStepWithKnownStartDerivativeIsTheSameStep) {
 // short path. A gate changed from outside at the recorded state is not trusted: the record
 // holds only for the gates it was made with.
 TEST(ReducedModel, FixedStepWithoutAnAngleAheadIsTheFullStep) {
-  auto scene = test::analytic_scene();
-  scene.joint_torques.push_back({"drive", "lever", 0.05, models::RateGate{"lever", +1}});
-  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
-  const auto s = analytic_samples(0.0, scene, 5);
-  const auto m = make_reduced_model(s, scene, Interpolation::Fourier);
+  const auto m = braked_gated_lever();
   ASSERT_FALSE(m.gates.empty());
   ASSERT_FALSE(m.gates[0].roots.empty());  // predictable: the table's switch angles
   ReducedWorkspace a(m), b(m);
