@@ -471,7 +471,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       if (!(std::abs(dx) > 1e-9)) {
         w.anchor_set = false;
         throw models::SceneError(
-            m.scene.source_file, m.scene.line_of("initial.q_deg"), "initial.q_deg",
+            m.scene.source_file, m.scene.line_of("initial"), "initial",
             fmt::format("the mechanism starts at a singular configuration of '{}' ({}: the loop Jacobian loses rank "
                         "and assembly branches cross there), so the branch to follow is not determined; start it a "
                         "little away from there",

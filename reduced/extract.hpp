@@ -58,4 +58,14 @@ struct ExtractOptions {
 // allocation). Throws TableError on bad options, NumericalError when a sample is not finite.
 Samples extract_samples(KinetostaticSource& source, const models::Scene& scene, const ExtractOptions& options);
 
+// A periodic sweep that does not come back to its start: one more sample at the first grid
+// point plus a turn differs from the first (m1 or a velocity ratio beyond 1e-7 of its column's
+// size), so the sweep changed assembly branch on the way, stepping over a dead point (a blocked
+// range narrower than a grid step) or an unflagged crossing. The caller (validate's
+// extract_from_full) then looks for dead points and samples the range between them.
+class SweepNotClosed : public TableError {
+ public:
+  using TableError::TableError;
+};
+
 }  // namespace rdyn::reduced

@@ -40,6 +40,11 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
     } catch (const engine::EngineError&) {
       domain = engine::calc_independent_domain(model);
       if (domain->periodic) throw;  // not a dead point: the sweep's own failure
+    } catch (const reduced::SweepNotClosed&) {
+      // The sweep changed branch on the way round (over a narrow blocked range): the dead points
+      // bound a range, when the walk finds them; otherwise the sweep's message stands.
+      domain = engine::calc_independent_domain(model);
+      if (domain->periodic) throw;
     }
   }
   // The declared range or the one between the dead points (engine/independent_range.hpp).

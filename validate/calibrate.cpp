@@ -285,7 +285,8 @@ void check_calibration_input(const models::Scene& scene, const CalibrationOption
   bool speed_sets_losses = !scene.motors.empty();
   for (const auto& res : scene.resistances) speed_sets_losses |= res.law != models::ResistanceLaw::Constant;
   if (!speed_sets_losses && !scene.resistances.empty())
-    fail("loads." + scene.resistances[0].name,
+    throw models::SceneError(
+        scene.source_file, scene.line_of("loads." + scene.resistances[0].name), "loads." + scene.resistances[0].name,
          fmt::format("every resistance has a constant magnitude (law: constant), which takes the same energy per "
                      "revolution at any speed, and no motor drives: every speed is then a steady cycle at one load "
                      "value, so no load value holds {:g} Hz rather than another; give a resistance a viscous or "
@@ -610,12 +611,12 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
 }
 
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
-  // The domain walk stays although the extraction sweeps the full turn too: the extraction's
-  // second-order predictor can carry its sweep over a blocked range narrower than a grid step
-  // onto the other assembly (a periodic table of two branches), where the walk's plain moves
-  // fail and find the dead points (a non-Grashof four-bar blocked over 2° near 180°). It costs
-  // about an extraction (2.9 ms on the bicycle); sweeps pay it once per table.
-  check_calibratable(scene, opt);
+  // The full-model part of check_calibratable is the extraction's own: its assembly names a
+  // loop that cannot close; its sweep of the full turn meets dead points, or steps over a
+  // blocked range narrower than a grid step onto the other assembly and then does not close
+  // the turn (reduced::SweepNotClosed): either way extract_from_full samples a range instead.
+  // A separate domain walk cost about an extraction (2.9 ms on the bicycle).
+  check_calibration_input(scene, opt);
   auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
   CalibrationTable t;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdint>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -87,7 +86,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
     // The last table this thread extracted, by scene hash: cases that differ only in load
     // values, resistance coefficients, cadence or power share it (calibrate's extraction and
     // fit are 3/4 of a case; cases take consecutive indices and the last axis varies fastest).
-    std::optional<std::pair<std::uint64_t, CalibrationTable>> last;
+    std::optional<std::pair<std::string, CalibrationTable>> last;
     for (long k; (k = next.fetch_add(1)) < n;) {
       const long index = first + k;
       std::vector<models::Override> o = fixed;
@@ -102,10 +101,14 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
       std::string row;
       try {
         const auto scene = models::load_scene(opt.scene, o);
-        const std::uint64_t hash = models::scene_hash(scene);
-        if (!last || last->first != hash) {
+        // The scene hash leaves out the loops' branch checks (they only refuse an assembly, which
+        // a reused table would skip): they are part of the key.
+        std::string key = models::scene_hash_hex(models::scene_hash(scene));
+        for (const auto& l : scene.loops)
+          if (l.branch) key += fmt::format("|{}:{}:{}", l.name, l.branch->joint, l.branch->sign);
+        if (!last || last->first != key) {
           last.reset();  // a failed extraction leaves none
-          last.emplace(hash, extract_calibration_table(scene, copt));
+          last.emplace(key, extract_calibration_table(scene, copt));
         }
         const auto r = calibrate(scene, last->second, copt, quiet);
         // No constraint force requested: an empty field, never NaN.

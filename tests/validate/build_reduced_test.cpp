@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "models/scene_yaml.hpp"
 
 namespace rdyn::validate {
@@ -32,6 +34,26 @@ TEST(BuildReduced, RangeExtractionTimesEachStage) {
   ASSERT_TRUE(e.range);
   EXPECT_FALSE(e.samples.periodic);
   expect_stages_add_up(e);
+}
+
+// A non-Grashof four-bar whose crank is blocked over only ~2° near 180° (crank 0.18004 m, the
+// ground pivot turned 2.5°): the 10° sweep steps over the blocked range onto the other assembly
+// and would call the table periodic. One more sample a turn later does not match the first
+// (the sweep did not close), so the dead points are looked for and the range between them is
+// sampled instead, on the assembled branch.
+TEST(BuildReduced, ASweepThatChangesBranchBecomesARangeTable) {
+  const auto scene = models::load_scene("fourbar", {{"bodies.crank.points.B.0", "0.18004"},
+                                                    {"ground_points.D.0", "0.299714"},
+                                                    {"ground_points.D.1", "0.013089"},
+                                                    {"initial.q_deg", "32"}});
+  const auto e = extract_from_full(scene, 10, reduced::Method::Kinetostatic);
+  ASSERT_TRUE(e.range);
+  EXPECT_FALSE(e.samples.periodic);
+  ASSERT_TRUE(e.dead_min && e.dead_max);
+  // The blocked range: from the upper dead point to the lower one a turn later, ~2° wide.
+  const double blocked = *e.dead_min + 2 * M_PI - *e.dead_max;
+  EXPECT_GT(blocked, 0.5 * M_PI / 180);
+  EXPECT_LT(blocked, 4.0 * M_PI / 180);
 }
 
 }  // namespace

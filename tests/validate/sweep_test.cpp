@@ -172,6 +172,39 @@ TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
     }
 }
 
+// The loops' branch checks are not in the scene hash (they only refuse an assembly): a case
+// whose check fails is an error row whatever case ran before it in the thread, never a reused
+// table of the other branch.
+TEST(Sweep, ABranchCheckIsNeverSkippedByAReusedTable) {
+  namespace fs = std::filesystem;
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("point_b: C}"), 11, "point_b: C, branch: {joint: rocker, sign: positive}}");
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_branch_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ofstream(scene) << yaml;
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 1.0;
+  o.load = "drive";
+  o.threads = 1;
+  for (const char* axis : {"loops.C.branch.sign=1:-1:2", "loops.C.branch.sign=-1:1:2"}) {
+    o.axes = {parse_sweep_axis(axis)};
+    const SweepResult r = run_sweep(o, false);
+    EXPECT_EQ(r.failed, 1) << axis << "\n" << r.csv;
+    std::istringstream lines(r.csv);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+      const bool negative = line.find(",-1,") != std::string::npos;
+      EXPECT_EQ(line.find(",error,") != std::string::npos, negative) << axis << ": " << line;
+    }
+  }
+}
+
 // A case on a reused table is the case calibrated on its own: a bicycle sweep over the rider's
 // height (a new table each) and the resistance's power (a value: the thread's table is reused)
 // against calibrate() of each scene, to the last digit the CSV prints.
