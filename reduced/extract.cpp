@@ -489,7 +489,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   }
   if (periodic)
     for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, n - 1, 0, 2 * kPi);  // the wrap-around interval
-  if (periodic && inertial_here && !singular[0]) {
+  if (periodic && inertial_here && opt.require_closed_turn && !singular[0]) {
     // The turn must close: the first grid point again, a turn later, on the same branch. A
     // sweep that stepped over a blocked range narrower than a grid step (a non-Grashof
     // four-bar blocked over 2°) lands on the other assembly and stays there: m1 and the

@@ -46,6 +46,10 @@ long range_intervals(double span, double step_rad, bool revolute);
 struct ExtractOptions {
   double step_rad = 10.0 * 3.14159265358979323846 / 180.0;  // grid step (revolute) [rad]
   Method method = Method::Kinetostatic;
+  // A periodic sweep must close its turn (SweepNotClosed otherwise). Off: a sweep that changed
+  // branch on the way still gives its table (validate's ladder, whose errors against the full
+  // model show what that costs; the hard high-saddle at grids of 2° and coarser).
+  bool require_closed_turn = true;
   // Set: a non-periodic table over the range (range_intervals); empty: one period of a
   // revolute coordinate that turns fully.
   std::optional<ExtractRange> range;

@@ -8,7 +8,8 @@
 
 namespace rdyn::validate {
 
-Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method) {
+Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method,
+                             bool require_closed_turn) {
   using clock = std::chrono::steady_clock;
   auto ms = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
   const auto start = clock::now();
@@ -17,6 +18,7 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
   reduced::ExtractOptions opt;
   opt.step_rad = grid_deg * 3.14159265358979323846 / 180.0;
   opt.method = method;
+  opt.require_closed_turn = require_closed_turn;
   Extraction e;
   e.stages.system_build_ms = ms(start, built);
   auto finish = [&](const engine::FullKinetostaticSource& source) {

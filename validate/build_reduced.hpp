@@ -26,7 +26,12 @@ struct Extraction {
   std::optional<double> dead_min, dead_max;
 };
 
-// Builds the full model of the scene and samples its reduced parameters.
-Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method);
+// Builds the full model of the scene and samples its reduced parameters. A revolute without a
+// declared range is swept as a full turn first; when it meets a dead point, or (with
+// require_closed_turn, reduced::ExtractOptions) does not close its turn, the dead points are
+// looked for and the range between them sampled; a periodic domain whose sweep does not close
+// throws reduced::SweepNotClosed (exit 2, the message says why).
+Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method,
+                             bool require_closed_turn = true);
 
 }  // namespace rdyn::validate

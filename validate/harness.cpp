@@ -197,7 +197,7 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
     Extraction e;
     std::vector<double> ms, build_ms, assembly_ms, kinetostatics_ms;
     for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
-      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic);
+      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
       ms.push_back(e.extraction_ms);
       build_ms.push_back(e.stages.system_build_ms);
       assembly_ms.push_back(e.stages.assembly_ms);
@@ -298,7 +298,7 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
     auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
     if (!tr) {
       const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
-      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic);
+      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
       const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
       RunRecord r;
       r.model = "reduced";
