@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <sstream>
 
@@ -135,6 +136,16 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
 
 // A named load through the sweep: a flywheel's motor against viscous drag c, calibrated to a
 // mean speed (no power): each row holds s = c·ω/(1 − ω/ω0) in a column named for the load's kind.
+// The sweep's CSV lines (the header first), with every case expected to succeed.
+std::vector<std::string> successful_rows(const SweepOptions& o) {
+  const SweepResult r = run_sweep(o, false);
+  EXPECT_EQ(r.failed, 0) << r.csv;
+  std::vector<std::string> rows;
+  std::istringstream lines(r.csv);
+  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  return rows;
+}
+
 TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
   namespace fs = std::filesystem;
   const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_motor_" + std::to_string(::getpid()) + ".yaml");
@@ -155,17 +166,15 @@ TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
   // thread's last table is reused): neither changes the closed form, s = c·ω/(1 − ω/ω0).
   o.axes = {parse_sweep_axis("bodies.wheel.inertia_kgm2=0.05:0.1:2"), parse_sweep_axis("loads.drag.coefficient=0.01:0.03:3")};
   o.threads = 1;
-  const SweepResult r = run_sweep(o, false);
-  ASSERT_EQ(r.failed, 0) << r.csv;
-  std::istringstream lines(r.csv);
-  std::string line;
-  std::getline(lines, line);
-  EXPECT_EQ(line.find("case,bodies.wheel.inertia_kgm2,loads.drag.coefficient,status,motor_stall_torque_Nm,"), 0u)
-      << line;
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_EQ(rows[0].find("case,bodies.wheel.inertia_kgm2,loads.drag.coefficient,status,motor_stall_torque_Nm,"), 0u)
+      << rows[0];
   const double w = 2 * M_PI * 2.0;
+  size_t k = 1;
   for (int inertia = 0; inertia < 2; ++inertia)
     for (double c : {0.01, 0.02, 0.03}) {
-      ASSERT_TRUE(std::getline(lines, line));
+      const std::string& line = rows[k++];
       double s = 0;
       ASSERT_EQ(std::sscanf(line.substr(line.find(",ok,") + 4).c_str(), "%lf", &s), 1) << line;
       EXPECT_NEAR(s, c * w / (1 - w / 30.0), 1e-8) << line;
@@ -214,14 +223,12 @@ TEST(Sweep, ReusedTableGivesTheCaseItsOwnCalibration) {
   o.axes = {parse_sweep_axis("bicycle_leg.subject.height_m=1.7:1.8:2"),
             parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:2")};
   o.threads = 1;
-  const SweepResult r = run_sweep(o, false);
-  ASSERT_EQ(r.failed, 0) << r.csv;
-  std::istringstream lines(r.csv);
-  std::string line;
-  std::getline(lines, line);
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 5u);
+  size_t k = 1;
   for (double h : {1.7, 1.8})
     for (double p : {100.0, 150.0}) {
-      ASSERT_TRUE(std::getline(lines, line));
+      const std::string& line = rows[k++];
       const auto scene = models::load_scene(
           "bicycle", {{"bicycle_leg.subject.height_m", fmt::format("{:.17g}", h)},
                       {"bicycle_leg.resistance.power_W", fmt::format("{:.17g}", p)}});
