@@ -489,12 +489,16 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   }
   if (periodic)
     for (size_t gj = 0; gj < gate_joints.size(); ++gj) bracket(gj, n - 1, 0, 2 * kPi);  // the wrap-around interval
-  if (periodic && inertial_here && opt.require_closed_turn && !singular[0]) {
+  // The first regular grid point (a singular one's values are least-squares, repaired below).
+  long first_regular = 0;
+  while (first_regular < n && singular[first_regular]) ++first_regular;
+  if (periodic && inertial_here && opt.require_closed_turn && first_regular < n) {
     // The turn must close: the first grid point again, a turn later, on the same branch. A
     // sweep that stepped over a blocked range narrower than a grid step (a non-Grashof
     // four-bar blocked over 2°) lands on the other assembly and stays there: m1 and the
     // velocity ratios differ at O(1) where on one branch they agree to the projection's 1e-12.
-    const GridSample g = src.sample(s.q[0] + 2 * kPi, false);
+    const long i0 = first_regular;
+    const GridSample g = src.sample(s.q[i0] + 2 * kPi, false);
     auto scale = [&](const std::vector<double>& col) {
       double v = 1e-300;
       for (double x : col) v = std::max(v, std::abs(x));
@@ -502,19 +506,20 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     };
     std::string off;
     if (!g.singular) {
-      if (!(std::abs(g.acceleration.driving_force - m1[0]) <= 1e-7 * scale(m1)))
-        off = fmt::format("m1 {:.6g} against {:.6g}", g.acceleration.driving_force, m1[0]);
+      if (!(std::abs(g.acceleration.driving_force - m1[i0]) <= 1e-7 * scale(m1)))
+        off = fmt::format("m1 {:.6g} against {:.6g}", g.acceleration.driving_force, m1[i0]);
       for (int j = 0; j < nj && off.empty() && static_cast<int>(g.ratios.wrt_q.size()) == nj; ++j)
-        if (!(std::abs(g.ratios.wrt_q[j] - r[j][0]) <= 1e-7 * std::max(1.0, scale(r[j]))))
+        if (!(std::abs(g.ratios.wrt_q[j] - r[j][i0]) <= 1e-7 * std::max(1.0, scale(r[j]))))
           off = fmt::format("the velocity ratio of joint '{}' {:.6g} against {:.6g}", scene.joints[j].name,
-                            g.ratios.wrt_q[j], r[j][0]);
+                            g.ratios.wrt_q[j], r[j][i0]);
     }
     if (!off.empty())
       throw SweepNotClosed(fmt::format(
-          "the sweep of '{}' over a full turn does not return to its start: a turn later at {:.6g}° it finds {} — it "
-          "changed assembly branch between two grid points, stepping over a dead point (a blocked range narrower "
-          "than the {:g}° grid step) or a crossing of branches; see rdyn inspect, or extract on a finer grid",
-          scene.independent, s.q[0] * 180 / kPi, off, h * 180 / kPi));
+          "{}: the sweep of '{}' over a full turn does not return to its start: a turn later at {:.6g}° it finds {} "
+          "— it changed assembly between two grid points of {:g}°, where the predictor from the last grid point "
+          "reached the other branch (a nearly singular stretch, a crossing of branches, or a dead point with a "
+          "blocked range narrower than the step); extract on a finer grid (--grid-deg)",
+          scene.source_file, scene.independent, s.q[i0] * 180 / kPi, off, h * 180 / kPi));
   }
   if (opt.method == Method::Integrated) {
     // m1(q) = m1(q_first) + ∫ dm1/dq dq with dm1/dq = 2 m2 (Eksergian: m2 = ½ dm1/dq).

@@ -611,12 +611,12 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
 }
 
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
-  // The full-model part of check_calibratable is the extraction's own: its assembly names a
-  // loop that cannot close; its sweep of the full turn meets dead points, or steps over a
-  // blocked range narrower than a grid step onto the other assembly and then does not close
-  // the turn (reduced::SweepNotClosed): either way extract_from_full samples a range instead.
-  // A separate domain walk cost about an extraction (2.9 ms on the bicycle).
-  check_calibration_input(scene, opt);
+  // Dead points are looked for twice, because each route alone misses some: the domain walk
+  // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts)
+  // and the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over
+  // the blocked range twice comes back on its branch and closes). The walk costs about an
+  // extraction (2.9 ms on the bicycle); sweeps pay it once per table.
+  check_calibratable(scene, opt);
   auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
   CalibrationTable t;

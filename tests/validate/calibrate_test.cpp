@@ -377,6 +377,14 @@ TEST(Calibrate, ANarrowBlockedRangeIsRefused) {
   const std::string f = refusal_of(scene, calibration_options_of(scene, 1.0, 0.0, "drive"));
   EXPECT_EQ(f.rfind("independent: ", 0), 0u) << f;
   EXPECT_NE(f.find("dead points"), std::string::npos) << f;
+  // From −158° on a 20° grid the sweep steps over the blocked range twice and closes its turn:
+  // only the domain walk finds the dead points there.
+  auto from_below = scene;
+  from_below.initial.q = -158 * M_PI / 180;
+  CalibrationOptions coarse = calibration_options_of(from_below, 1.0, 0.0, "drive");
+  coarse.grid_deg = 20;
+  const std::string g = refusal_of(from_below, coarse);
+  EXPECT_EQ(g.rfind("independent: ", 0), 0u) << g;
 }
 
 // With only resistances of constant magnitude and position-only drives every speed is a steady
