@@ -361,6 +361,17 @@ int switching_sign(const ReducedModel::Gate& gate, double q, double qdot) {
   return sgn > 0 ? 1 : sgn < 0 ? -1 : 0;
 }
 
+// Distance from q to the next image ρ + 2πk of a switch angle in the direction dir (±1), in
+// [0, 2π), by the truncating cast and one correction (no libm floor on the hot path); NaN for a
+// root far outside the turn (a hand-made table), which has no angle to reach.
+double distance_ahead(double rho, double q, double dir) {
+  const double x = dir * (rho - q) * (1.0 / kTwoPi);
+  if (!(std::abs(x) < 1e15)) return NAN;
+  double fl = static_cast<double>(static_cast<long>(x));
+  if (fl > x) fl -= 1.0;
+  return (x - fl) * kTwoPi;
+}
+
 // The first switch of the predictable gates along the Taylor path q(τ) = q0 + v0 τ + ½ a0 τ²,
 // τ ∈ (0, h]: for each gate, the first switch angle (any image ρ + 2πk) the path reaches where
 // the gate, as it stands, disagrees with the switching function's sign just beyond that angle
@@ -386,13 +397,8 @@ double predict_switch(const ReducedModel& m, ReducedWorkspace& ws, double q0, do
     const auto& gate = m.gates[g];
     if (!predictable(gate)) continue;
     for (double rho : gate.roots) {
-      // Distance from q0 to the next image of ρ in the direction of motion, in [0, 2π).
-      const double x = dir * (rho - q0) * (1.0 / kTwoPi);
-      if (!(std::abs(x) < 1e15)) continue;  // a root far outside the turn (a hand-made table): no angle
-      double fl = static_cast<double>(static_cast<long>(x));
-      if (fl > x) fl -= 1.0;
-      const double dist = (x - fl) * kTwoPi;
-      if (!(dist > 0 && dist <= reach)) continue;  // not reached in this step (the usual case)
+      const double dist = distance_ahead(rho, q0, dir);
+      if (!(dist > 0 && dist <= reach)) continue;  // not reached in this step (the usual case), or no angle
       const double R = q0 + dir * dist;
       // Sign just beyond R in the direction of motion (a rounding-size step past the angle).
       const int sgn = switching_sign(gate, R + dir * 1e-9 * (1.0 + std::abs(R)), v0);
@@ -446,11 +452,8 @@ void mark_ahead(const ReducedModel& m, ReducedWorkspace& ws, size_t ng) {
   double nearest = INFINITY;
   for (size_t g = 0; g < ng; ++g)
     for (double rho : m.gates[g].roots) {
-      const double x = dir * (rho - q) * (1.0 / kTwoPi);  // as predict_switch
-      if (!(std::abs(x) < 1e15)) continue;
-      double fl = static_cast<double>(static_cast<long>(x));
-      if (fl > x) fl -= 1.0;
-      nearest = std::min(nearest, (x - fl) * kTwoPi);
+      const double dist = distance_ahead(rho, q, dir);
+      if (!std::isnan(dist)) nearest = std::min(nearest, dist);
     }
   if (!(nearest > 1e-12 * (1.0 + std::abs(q)) && std::isfinite(nearest))) return;
   ws.ahead_q = q, ws.ahead_qdot = v, ws.ahead_limit = q + dir * nearest;
