@@ -8,19 +8,31 @@
 
 namespace rdyn::validate {
 
+namespace {
+using clock = std::chrono::steady_clock;
+double ms(clock::time_point a, clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+}  // namespace
+
 Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method,
                              bool require_closed_turn) {
-  using clock = std::chrono::steady_clock;
-  auto ms = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
   const auto start = clock::now();
-  engine::FullModel model(scene);
-  const auto built = clock::now();
+  const engine::FullModel model(scene);
+  const double build_ms = ms(start, clock::now());
+  Extraction e = extract_from_full(model, grid_deg, method, require_closed_turn);
+  e.stages.system_build_ms = build_ms;
+  e.extraction_ms += build_ms;
+  return e;
+}
+
+Extraction extract_from_full(const engine::FullModel& model, double grid_deg, reduced::Method method,
+                             bool require_closed_turn) {
+  const models::Scene& scene = model.scene();
+  const auto start = clock::now();
   reduced::ExtractOptions opt;
   opt.step_rad = grid_deg * 3.14159265358979323846 / 180.0;
   opt.method = method;
   opt.require_closed_turn = require_closed_turn;
   Extraction e;
-  e.stages.system_build_ms = ms(start, built);
   auto finish = [&](const engine::FullKinetostaticSource& source) {
     const auto end = clock::now();
     e.extraction_ms = ms(start, end);

@@ -7,6 +7,10 @@
 #include "reduced/extract.hpp"
 #include "reduced/samples.hpp"
 
+namespace rdyn::engine {
+class FullModel;
+}
+
 namespace rdyn::validate {
 
 // Wall time of extract_from_full by stage [ms] (issue #11 item 3).
@@ -32,6 +36,11 @@ struct Extraction {
 // looked for and the range between them sampled; a periodic domain whose sweep does not close
 // throws reduced::SweepNotClosed (exit 2, the message says why).
 Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method,
+                             bool require_closed_turn = true);
+
+// The same on a full model already built (stages.system_build_ms 0): calibration's dead-point
+// walk and its extraction share one system.
+Extraction extract_from_full(const engine::FullModel& model, double grid_deg, reduced::Method method,
                              bool require_closed_turn = true);
 
 }  // namespace rdyn::validate

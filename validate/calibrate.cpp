@@ -310,11 +310,19 @@ void fail_dead_points(const models::Scene& scene) {
 
 }  // namespace
 
-void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
-  check_calibration_input(scene, opt);
-  const engine::FullModel model(scene);
+namespace {
+
+// check_calibratable's full-model part on a built system.
+void check_full_turn(const models::Scene& scene, const engine::FullModel& model) {
   const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
   if (!engine::calc_independent_domain(model).periodic) fail_dead_points(scene);
+}
+
+}  // namespace
+
+void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
+  check_calibration_input(scene, opt);
+  check_full_turn(scene, engine::FullModel(scene));
 }
 
 double calc_resistance_coefficient(const models::Scene& scene, const CalibrationOptions& opt) {
@@ -615,9 +623,11 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
   // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts)
   // and the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over
   // the blocked range twice comes back on its branch and closes). The walk costs about an
-  // extraction (2.9 ms on the bicycle); sweeps pay it once per table.
-  check_calibratable(scene, opt);
-  auto e = extract_from_full(scene, opt.grid_deg, reduced::Method::Kinetostatic);
+  // extraction (2.9 ms on the bicycle); sweeps pay it once per table. One system serves both.
+  check_calibration_input(scene, opt);
+  const engine::FullModel model(scene);
+  check_full_turn(scene, model);
+  auto e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
   CalibrationTable t;
   t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
