@@ -300,6 +300,52 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   return false;
 }
 
+// Near a singular configuration the rates carry the loop residual magnified by the
+// conditioning κ: positions by 1/κ, velocity ratios by 1/κ², m2 (second-order terms) by 1/κ³;
+// a residual of 1e-13 put m2 off by 1e-6 at 4e-3 rad from a parallelogram chain's flat
+// configuration. Where κ < kPolishConditioning (regular mechanisms stay above: the bicycle
+// 0.06, the hard high-saddle 0.0075; a chain's samples 4e-3 rad from flat 5e-4…2e-3), full Newton steps (a fresh Jacobian each) drive
+// the residual down to rounding: at most 4, kept only while the residual falls.
+constexpr double kPolishConditioning = 5e-3;
+void polish_projection(const FullModel::Impl& m, State& s) {
+  auto worst = [&] {
+    const Vector& e = s.getQErr();
+    double w = 0.0;
+    for (int i = 0; i < e.size(); ++i) w = std::max(w, std::abs(e[i]));
+    return w;
+  };
+  if (s.getNQ() != s.getNU()) return;
+  double err = worst();
+  for (int it = 0; it < 4 && err > 0; ++it) {
+    const auto J = calc_split_jacobian(m, s);
+    if (J.G.nrow() != s.getNQErr() || J.G_free.ncol() == 0) return;
+    FactorSVD svd(J.G_free);
+    Vector rhs = s.getQErr(), dx;
+    rhs *= -1.0;
+    svd.solve(rhs, dx);
+    std::vector<int> q_of_u(s.getNU(), -1);  // each mobilizer's q's and u's pair up (nq = nu)
+    for (int b = 0; b < m.matter.getNumBodies(); ++b) {
+      const MobilizedBody& mb = m.matter.getMobilizedBody(MobilizedBodyIndex(b));
+      if (mb.getNumQ(s) != mb.getNumU(s)) return;
+      for (int k = 0; k < mb.getNumU(s); ++k) q_of_u[mb.getFirstUIndex(s) + k] = mb.getFirstQIndex(s) + k;
+    }
+    const Vector before = s.getQ();
+    Vector& q = s.updQ();
+    for (size_t c = 0; c < J.free_cols.size(); ++c) {
+      if (q_of_u[J.free_cols[c]] < 0) return;
+      q[q_of_u[J.free_cols[c]]] += dx[static_cast<int>(c)];
+    }
+    m.system.realize(s, Stage::Position);
+    const double next = worst();
+    if (!(next < err)) {  // rounding reached: keep the better configuration
+      s.updQ() = before;
+      m.system.realize(s, Stage::Position);
+      return;
+    }
+    err = next;
+  }
+}
+
 }  // namespace
 
 double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
@@ -329,9 +375,10 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   // Without an anchor (the first grid point) the configuration this sample starts from — the
   // assembly or the last continuation move — gives the direction the sweep comes from, which
   // a singular first grid point needs (below).
-  Vector q_start;
-  double x_start = 0.0;
-  if (!w.anchor_set) q_start = s.getQ(), x_start = m.joint_q(s, m.independent);
+  // With an anchor too far for the predictor (a grid coarser than a continuation move), it is
+  // the last move, on the branch a move away: the chord a singular point needs then.
+  const Vector q_start = s.getQ();
+  const double x_start = m.joint_q(s, m.independent);
   if (w.anchor_set && w.anchor_q.size() == s.getNQ()) {
     // Second-order predictor along the branch: Newton starts O(Δ³) from the solution.
     const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
@@ -364,10 +411,18 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   out.near_singular = m.near_singular_projections > singular_before;
   // G_free u_free = −(G u)_prescribed: the free mobilities from the prescribed ones (least
   // squares: G may carry redundant rows; the system is consistent).
-  const auto J = calc_split_jacobian(m, s);
+  auto J = calc_split_jacobian(m, s);
   std::optional<FactorSVD> svd;
   if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
-  if (parts == SampleParts::All) out.conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
+  double conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
+  // Near a singular configuration, not on it (there the rates are repaired, not computed).
+  if (conditioning >= kSingularConditioning && conditioning < kPolishConditioning) {
+    polish_projection(m, s);
+    J = calc_split_jacobian(m, s);
+    svd.emplace(J.G_free);
+    conditioning = conditioning_of(*svd, J.G_free);
+  }
+  if (parts == SampleParts::All) out.conditioning = conditioning;
   auto complete = [&](Vector& v, const Vector& rhs) {  // v: prescribed entries set, free ones solved
     if (!svd) return;
     Vector x;
@@ -481,6 +536,17 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
     if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {
       w.anchor_dq = (w.anchor_q - q_before) / dx;
       w.anchor_ddq = 0.0 * w.anchor_dq;
+    } else if (singular && had_anchor && q_start.size() == s.getNQ()) {
+      // Reached by continuation moves (the anchor lies beyond the chord's reach): the chord from
+      // the last move. Without it a prediction from here (the limit samples beside a singular
+      // grid point, reduced/extract.cpp) followed least-squares rates onto the other branch on
+      // 30° grids.
+      const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+      const double dm = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
+      if (std::abs(dm) > 1e-9) {
+        w.anchor_dq = (w.anchor_q - q_start) / dm;
+        w.anchor_ddq = 0.0 * w.anchor_dq;
+      }
     }
   }
   if (!finite)

@@ -236,6 +236,86 @@ std::optional<double> find_point_force_meeting(KinetostaticSource& src, long f, 
   return std::nullopt;
 }
 
+
+// The value a column takes at a singular grid point q_s (the loop Jacobian lost rank there, so
+// the constraints do not determine the rates and a sample there is a least-squares value of no
+// branch): the limit along the branch from both sides, by Richardson extrapolation of the
+// symmetric means f̄(d) = ½[f(q_s − d) + f(q_s + d)] = f(q_s) + O(d²):
+//   f(q_s) ≈ [4 f̄(δ/2) − f̄(δ)] / 3,  error O(δ⁴).
+// The side samples carry the projection's residual (~1e-12) magnified by the conditioning
+// twice (positions, then rates): measured on the parallelogram, a rate's error is ~1e-12/δ²
+// (1.5e-6 at δ = 1e-3, 3e-8 at 1e-2), against the truncation's O(δ⁴); δ = 1e-2 balances them
+// near 1e-8 of a column's size. A spline through the regular samples, the former patch, missed
+// by the interpolation error: a parallelogram chain's gravity term 19.6187 for 19.62.
+constexpr double kSingularLimitStep_rad = 1e-2;
+
+// Combines one value of the four samples at q_s − δ, q_s − δ/2, q_s + δ/2, q_s + δ.
+double richardson_limit(double m1, double m2, double p2, double p1) {
+  return (4 * 0.5 * (m2 + p2) - 0.5 * (m1 + p1)) / 3;
+}
+bool limit_values(double& out, const double* v[4]) {
+  out = richardson_limit(*v[0], *v[1], *v[2], *v[3]);
+  return std::isfinite(out);
+}
+bool limit_values(std::vector<double>& out, const std::vector<double>* v[4]) {
+  for (int k = 1; k < 4; ++k)
+    if (v[k]->size() != v[0]->size()) return false;
+  out.resize(v[0]->size());
+  bool ok = true;
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i] = richardson_limit((*v[0])[i], (*v[1])[i], (*v[2])[i], (*v[3])[i]);
+    ok &= std::isfinite(out[i]);
+  }
+  return ok;
+}
+bool limit_values(std::vector<std::vector<double>>& out, const std::vector<std::vector<double>>* v[4]) {
+  for (int k = 1; k < 4; ++k)
+    if (v[k]->size() != v[0]->size()) return false;
+  out.resize(v[0]->size());
+  bool ok = true;
+  for (size_t i = 0; i < out.size(); ++i) {
+    const std::vector<double>* row[4] = {&(*v[0])[i], &(*v[1])[i], &(*v[2])[i], &(*v[3])[i]};
+    ok &= limit_values(out[i], row);
+  }
+  return ok;
+}
+// Every field of the four samples' limit into `g` (positions included: they are determined
+// at q_s, and their limit is the same value). False when a side sample is itself singular or a
+// value is not finite: the caller keeps the spline repair then.
+template <class T, class Get>
+bool limit_field(T& out, const GridSample* side[4], Get get) {
+  const T* v[4] = {&get(*side[0]), &get(*side[1]), &get(*side[2]), &get(*side[3])};
+  return limit_values(out, v);
+}
+bool calc_singular_limit(KinetostaticSource& src, double q_s, double grid_step, bool conservative_loads,
+                         GridSample& g) {
+  const double d = std::min(kSingularLimitStep_rad, grid_step / 4);
+  // Away from q_s and back across it: each move is short, so the predictor stays on the branch
+  // the sweep came along (from q_s itself it follows the chord, see calc_kinetostatic_sample).
+  GridSample s[4] = {src.sample(q_s - d, conservative_loads), src.sample(q_s - d / 2, conservative_loads),
+                     src.sample(q_s + d / 2, conservative_loads), src.sample(q_s + d, conservative_loads)};
+  const GridSample* side[4] = {&s[0], &s[1], &s[2], &s[3]};
+  for (const auto& x : s)
+    if (x.singular) return false;
+  GridSample out = g;
+  bool ok = true;
+  ok &= limit_field(out.velocity.driving_force, side, [](const GridSample& x) -> const double& { return x.velocity.driving_force; });
+  ok &= limit_field(out.velocity.constraint_forces, side, [](const GridSample& x) -> const std::vector<double>& { return x.velocity.constraint_forces; });
+  ok &= limit_field(out.acceleration.driving_force, side, [](const GridSample& x) -> const double& { return x.acceleration.driving_force; });
+  ok &= limit_field(out.acceleration.constraint_forces, side, [](const GridSample& x) -> const std::vector<double>& { return x.acceleration.constraint_forces; });
+  ok &= limit_field(out.conservative.forces.driving_force, side, [](const GridSample& x) -> const double& { return x.conservative.forces.driving_force; });
+  ok &= limit_field(out.conservative.forces.constraint_forces, side, [](const GridSample& x) -> const std::vector<double>& { return x.conservative.forces.constraint_forces; });
+  ok &= limit_field(out.conservative.potential_energy, side, [](const GridSample& x) -> const double& { return x.conservative.potential_energy; });
+  ok &= limit_field(out.ratios.wrt_q, side, [](const GridSample& x) -> const std::vector<double>& { return x.ratios.wrt_q; });
+  ok &= limit_field(out.ratios.wrt_x, side, [](const GridSample& x) -> const std::vector<std::vector<double>>& { return x.ratios.wrt_x; });
+  ok &= limit_field(out.ratios.wrt_q_slope, side, [](const GridSample& x) -> const std::vector<double>& { return x.ratios.wrt_q_slope; });
+  ok &= limit_field(out.ratios.length_wrt_q, side, [](const GridSample& x) -> const std::vector<double>& { return x.ratios.length_wrt_q; });
+  ok &= limit_field(out.ratios.length_wrt_x, side, [](const GridSample& x) -> const std::vector<std::vector<double>>& { return x.ratios.length_wrt_x; });
+  if (!ok) return false;
+  out.velocity.joint_rates = out.ratios.wrt_q;
+  g = std::move(out);
+  return true;
+}
 }  // namespace
 
 Method parse_method(const std::string& name) {
@@ -387,7 +467,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   // position-only loads (only when the scene has some), and the velocity ratios.
   const bool conservative_loads = scene.gravity.enabled || !scene.springs.empty();
   const bool inertial_here = opt.method == Method::Kinetostatic || opt.method == Method::Integrated;
-  std::vector<char> singular(n, 0);
+  std::vector<char> singular(n, 0), limited(n, 0);  // limited: a singular point given its exact limit
   const bool joint_outputs = wants_joint_outputs(scene);
   std::vector<std::vector<double>> p(joint_outputs ? nj : 0, std::vector<double>(n));
   // Joints gating loads: their ratio's zeros are the switch angles (refined during the sweep).
@@ -430,6 +510,10 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     GridSample g;
     if (inertial_here) {
       g = src.sample(s.q[i], conservative_loads);
+      // A singular grid point gets the limit along the branch from both sides (a range's end
+      // points have one side only: they keep the repair below, which refuses them).
+      if (g.singular && (periodic || (i > 0 && i < n - 1)))
+        limited[i] = calc_singular_limit(src, s.q[i], h, conservative_loads, g);
       m2[i] = g.velocity.driving_force;      // (i) q̇ = 1, q̈ = 0
       m1[i] = g.acceleration.driving_force;  // (ii) q̇ = 0, q̈ = 1
       for (int k = 0; k < nk; ++k)
@@ -535,19 +619,19 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
   auto repair = [&](std::vector<double>& col) {
     std::vector<double> x, y;
     for (long i = 0; i < n; ++i)
-      if (!singular[i]) x.push_back(s.q[i]), y.push_back(col[i]);
+      if (!singular[i] || limited[i]) x.push_back(s.q[i]), y.push_back(col[i]);
     if (x.size() < 4 || x.size() == static_cast<size_t>(n)) return;
     if (!periodic) {
       // Inside a range: the natural spline through the regular samples (a singular end point
       // stays NaN and fails the finite check below: a range must stop short of singularities).
       const RangeSpline sp(x, y);
       for (long i = 0; i < n; ++i)
-        if (singular[i]) col[i] = sp.eval(s.q[i]);
+        if (singular[i] && !limited[i]) col[i] = sp.eval(s.q[i]);
       return;
     }
     const PeriodicSpline sp(x, y, 2 * kPi);
     for (long i = 0; i < n; ++i)
-      if (singular[i]) col[i] = sp.eval(s.q[i]);
+      if (singular[i] && !limited[i]) col[i] = sp.eval(s.q[i]);
   };
   if (std::count(singular.begin(), singular.end(), 1) > 0) {
     for (long i = 0; i < n; ++i)

@@ -270,6 +270,22 @@ double calc_energy(const ReducedModel& m, double q, double qdot) {
   return 0.5 * v[0] * qdot * qdot + v[1];
 }
 
+double calc_potential_min(const ReducedModel& m) {
+  const Table& t = m.table;
+  const int nodes = t.periodic ? t.intervals : t.intervals + 1;
+  double v_min = t.eval(m.c_V, t.q0);
+  for (int i = 1; i < nodes; ++i) v_min = std::min(v_min, t.eval(m.c_V, t.q0 + i * t.step));
+  return v_min;
+}
+
+DivergenceGuard start_divergence_guard(double energy0, double potential_min, double work0) {
+  DivergenceGuard g;
+  g.energy0 = energy0;
+  g.scale0 = std::max(0.0, energy0 - potential_min);
+  g.work_last = work0;
+  return g;
+}
+
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces) {
   double* v = ws.scratch_rec.data();

@@ -156,12 +156,31 @@ double calc_energy(const ReducedModel& m, double q, double qdot);
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces);
 
-// Divergence guard of the reduced integrators: the reduced equation's own energy balance
-// E − E0 = W (W: work of the non-conservative loads) holds to interpolation accuracy; off by
-// more than half the largest |E| seen so far (E_scale) means the table or the step is too
-// coarse for the run to be stable.
-inline bool energy_balance_diverged(double E, double E0, double work, double E_scale) {
-  return std::abs(E - E0 - work) > 0.5 * E_scale + 1e-9;
+// Divergence guard of the reduced integrators, the same in simulate_reduced, the runtime and
+// the C API. The reduced equation's own energy balance E − E0 = W (W: work of the
+// non-conservative loads) holds to interpolation accuracy; a residual above half the energy
+// scale means the table or the step is too coarse for the run to be stable. The scale must be
+// one the divergence cannot inflate and that does not depend on where V's zero lies (a guard
+// against half the largest |E| seen let a fixed-step run gain 20× its kinetic energy with exit
+// 0 when V was large, since the divergence itself raised |E|): the energy the run started with
+// above the table's lowest potential, E0 − min V ≥ ½ m1(q0) q̇0², plus the work the loads have
+// exchanged so far, Σ |ΔW| over the guard's checks (a motor's input and a brake's loss both
+// count, so a long driven run keeps a fair scale).
+struct DivergenceGuard {
+  double energy0 = 0.0;    // E0 [J or N·m]
+  double scale0 = 0.0;     // E0 − min V over the table's grid
+  double work_abs = 0.0;   // Σ |ΔW| so far
+  double work_last = 0.0;  // W at the last check
+};
+// Lowest potential over the table's grid points (the interpolant's nodes).
+double calc_potential_min(const ReducedModel& m);
+DivergenceGuard start_divergence_guard(double energy0, double potential_min, double work0);
+// Accumulates |ΔW| and returns true when |E − E0 − W| exceeds half the scale.
+inline bool divergence_guard_fires(DivergenceGuard& g, double E, double work) {
+  g.work_abs += std::abs(work - g.work_last);
+  g.work_last = work;
+  const double residual = std::abs(E - g.energy0 - work);
+  return !(residual <= 0.5 * (g.scale0 + g.work_abs) + 1e-9 * (1.0 + std::abs(g.energy0)));
 }
 
 // One fixed RK4 step of size h for real-time use, allocation-free; a gate switch inside

@@ -40,6 +40,7 @@ RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& sce
   RuntimeModel m;
   m.reduced = make_reduced_model(samples, scene, interp,
                                  options.energy_consistent_m2);  // checks the scene hash
+  m.potential_min = calc_potential_min(m.reduced);
   m.scene_name = scene.name;
   m.revolute = samples.revolute;
   m.initial_q = scene.initial.q;
@@ -138,8 +139,7 @@ Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double q
     std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
     return s;
   }
-  ws.energy0_ = ws.energy_;
-  ws.energy_scale_ = std::abs(ws.energy_);
+  ws.guard_ = start_divergence_guard(ws.energy_, model.potential_min, 0.0);
   ws.steps_ = ws.switches_ = 0;
   return Status::Ok;
 }
@@ -163,16 +163,15 @@ Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
     s = Status::LeftTable;
   else
     s = ws.calc_outputs(model);
-  if (s == Status::Ok && energy_balance_diverged(ws.energy_, ws.energy0_, st.work,
-                                                 std::max(ws.energy_scale_, std::abs(ws.energy_))))
-    s = Status::Diverged;
+  const DivergenceGuard guard0 = ws.guard_;
+  if (s == Status::Ok && divergence_guard_fires(ws.guard_, ws.energy_, st.work)) s = Status::Diverged;
   if (s != Status::Ok) {  // roll back: the caller sees the state before the call
     copy_state(ws.saved_, st);
     std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
     ws.qddot_ = qddot0, ws.power_nc_ = power0, ws.energy_ = energy0;
+    ws.guard_ = guard0;
     return s;
   }
-  ws.energy_scale_ = std::max(ws.energy_scale_, std::abs(ws.energy_));
   ++ws.steps_;
   if (!std::isnan(t_switch)) ++ws.switches_;
   return Status::Ok;

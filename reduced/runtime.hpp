@@ -63,6 +63,7 @@ struct RuntimeModel {
   double initial_qdot = 0.0;             // [rad/s or m/s]
   std::vector<std::string> drive_names;  // the scene's joint torques, in Drive order
   std::vector<double> drive_nominal;     // their scene values [N·m or N]
+  double potential_min = 0.0;            // min V over the table's grid (divergence guard) [J]
 };
 
 // Reads a table written by `rdyn extract` and the scene (a shipped name or a YAML path), and
@@ -105,7 +106,7 @@ class RuntimeWorkspace {
 
   ReducedWorkspace state_;
   double qddot_ = 0.0, power_nc_ = 0.0, energy_ = 0.0;
-  double energy0_ = 0.0, energy_scale_ = 0.0;  // divergence guard (energy_balance_diverged)
+  DivergenceGuard guard_;  // divergence guard (reduced_model.hpp)
   std::vector<double> forces_;
   long steps_ = 0, switches_ = 0;
   // Scratch for rolling back a failed step.

@@ -499,8 +499,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       return p;
     };
     record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
-    const double E0 = ts.energy.front();
-    double E_scale = std::abs(E0);
+    DivergenceGuard guard = start_divergence_guard(ts.energy.front(), calc_potential_min(m), 0.0);
     long i = 1;
     AdaptiveIntegrator::Point a = point(ws);
     std::vector<char> before(ws.gate_on.size());
@@ -534,12 +533,11 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       }
       const AdaptiveIntegrator::Point b = point(ws);
       const double E = E_point;  // divergence guard, as for the adaptive path
-      E_scale = std::max(E_scale, std::abs(E));
-      if (energy_balance_diverged(E, E0, b.work, E_scale))
+      if (divergence_guard_fires(guard, E, b.work))
         throw models::NumericalError(fmt::format(
-            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J — the table or the fixed "
-            "step is too coarse for this run",
-            b.t, E - E0 - b.work));
+            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
+            "initially {:.3g} J, work of the loads {:.3g} J) — the table or the fixed step is too coarse for this run",
+            b.t, E - guard.energy0 - b.work, E, guard.energy0, b.work));
       // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
       // interpolation there, with the gates that held at each sample's time (the fixed-step
       // path is the real-time one; accuracy is secondary).
@@ -572,8 +570,7 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
     integ.reset(0.0, q0, qdot0);
     ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
     record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
-    const double E0 = ts.energy.front();
-    double E_scale = std::abs(E0);
+    DivergenceGuard guard = start_divergence_guard(ts.energy.front(), calc_potential_min(m), 0.0);
     long i = 1;
     while (i <= n) {
       integ.step(opt.duration_s);
@@ -582,13 +579,12 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
       // Divergence guard: the reduced equation's own energy balance E − E0 = W must hold to
       // interpolation accuracy; a gross failure means the table is too coarse to be stable.
       const double E = calc_energy(m, b.q, b.qdot);
-      E_scale = std::max(E_scale, std::abs(E));
-      if (energy_balance_diverged(E, E0, b.work, E_scale))
+      if (divergence_guard_fires(guard, E, b.work))
         throw models::NumericalError(fmt::format(
             "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
-            "initially {:.3g} J) — the table is too coarse for this run (refine the grid, or use "
-            "--energy-consistent)",
-            b.t, E - E0 - b.work, E, E0));
+            "initially {:.3g} J, work of the loads {:.3g} J) — the table is too coarse for this run (refine the "
+            "grid, or use --energy-consistent)",
+            b.t, E - guard.energy0 - b.work, E, guard.energy0, b.work));
       for (; i <= n && t_out(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
         double q, v, w;
         if (b.t - a.t <= 0 || t_out(i) >= b.t) {

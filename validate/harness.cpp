@@ -294,7 +294,16 @@ void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
 
 // Stage 6: the scene's thresholds; a grid outside the ladder is run now.
 void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
-  for (const auto& th : scene.validation.thresholds) {
+  v.default_thresholds = scene.validation.thresholds.empty();
+  for (const auto& th : thresholds_of(scene)) {
+    // A reference that moves by more than a threshold when its tolerance is halved cannot
+    // judge that threshold: the error measured would be the reference's own (a chain through
+    // its flat configuration passed with a reference whose q̇ changed by 100 % of its peak).
+    if (const SignalError* ch = v.reference_change.find(th.quantity); ch && !(ch->max_rel <= th.max_error))
+      v.fail(fmt::format("the reference does not converge: halving its tolerance changes {} by {:.3g} of its peak, "
+                         "more than the threshold {:.3g} it must judge (tighten validation.reference_tolerance or "
+                         "choose another validation.reference_integrator)",
+                         th.quantity, ch->max_rel, th.max_error));
     auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
     if (!tr) {
       const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
@@ -375,6 +384,12 @@ void analyse_runs(ValidationResult& v) {
 }
 
 void calc_first_screen(ValidationResult& v) {
+  // The validation's own target: a reduced setting within it on the speed and the headline
+  // quantity. None is a failure, not a pass with nothing recommended.
+  if (v.recommended < 0)
+    v.fail(fmt::format("no reduced run reached the error target {:.3g} on qdot and {} (refine the grid or check the "
+                       "reference)",
+                       v.matched_target, v.headline_quantity));
   const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
   v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
   v.baselines.clear();
@@ -384,6 +399,23 @@ void calc_first_screen(ValidationResult& v) {
   const SignalError* ref = v.reference_change.find(v.headline_quantity);
   v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
 }
+
+namespace {
+
+// A numerical failure after the reference ran is a finding of the validation, not its end: the
+// stage is recorded as failed and the report is still written (README, exit codes: "validate
+// still writes its report"). A leg press whose calibration missed exited 1 after 66 s with
+// nothing written. Bad input (scene, table, engine errors) still stops at once.
+template <class Stage>
+void run_stage(ValidationResult& v, const char* what, Stage&& stage) {
+  try {
+    stage();
+  } catch (const models::NumericalError& e) {
+    v.fail(fmt::format("{}: {}", what, e.what()));
+  }
+}
+
+}  // namespace
 
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
   ValidationResult v = describe(scene);
@@ -411,22 +443,24 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
                                         : "")
                       : "Full-model runs are timed on the output grid.";
   // 2–3. The ladders.
-  run_full_ladder(scene.name, full, plan, v, progress);
-  run_reduced_ladder(scene, plan, v, progress);
-  calc_dense_params(scene, v);
+  run_stage(v, "full-model ladder", [&] { run_full_ladder(scene.name, full, plan, v, progress); });
+  run_stage(v, "reduced ladder", [&] {
+    run_reduced_ladder(scene, plan, v, progress);
+    calc_dense_params(scene, v);
+  });
   // 3b. Peer engines (MuJoCo) on the same scene, timed like the full model.
   v.peer_steps = plan.peer_steps_s;
-  if (!opt.peers.empty()) run_peer_ladders(scene, opt.peers, plan, v, progress);
+  if (!opt.peers.empty()) run_stage(v, "peer ladders", [&] { run_peer_ladders(scene, opt.peers, plan, v, progress); });
   // 4. Pareto front, matched-error speedup, recommended setting, convergence.
   analyse_runs(v);
   // 5. Calibration (scenes that declare an operating point).
   if (scene.validation.calibrate_cadence_Hz > 0) {
     v.calibration_options = calibration_options_of(scene, 0.0, 0.0, "");
     progress.note(scene.name + ": calibrating the drive load");
-    v.calibration = calibrate(scene, v.calibration_options, progress);
+    run_stage(v, "calibration", [&] { v.calibration = calibrate(scene, v.calibration_options, progress); });
   }
   // 6–7. Thresholds, then the first screen: verdicts, baselines, error budget.
-  judge_thresholds(scene, v);
+  run_stage(v, "thresholds", [&] { judge_thresholds(scene, v); });
   calc_first_screen(v);
   return v;
 }

@@ -78,6 +78,7 @@ struct ValidationResult {
   std::optional<CalibrationResult> calibration;
   CalibrationOptions calibration_options;
   std::vector<ThresholdResult> thresholds;
+  bool default_thresholds = false;  // the scene declares none: judged on thresholds_of's defaults
   bool pass = true;
   std::vector<std::string> failures;  // why pass is false, in plain words
 

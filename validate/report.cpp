@@ -574,8 +574,11 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   h += " Below that floor an error measures the reference, not the table.</p>";
   if (s.contains("calibration")) h += calibration_section(s);
   if (!s.at("thresholds").empty()) {
-    h += "<h2>Acceptance "
-         "thresholds</h2><table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
+    h += "<h2>Acceptance thresholds</h2>";
+    if (s.value("thresholds_are_defaults", false))
+      h += "<p>The scene declares no thresholds: it is judged against the defaults (models/README.md, "
+           "\"Validation settings\").</p>";
+    h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
          "th><th>run</th>"
          "<th></th></tr>";
     for (const auto& t : s.at("thresholds")) {

@@ -254,6 +254,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
                   {"pass", t.pass},
                   {"run", t.run}});
   j["thresholds"] = th;
+  j["thresholds_are_defaults"] = v.default_thresholds;
   j["status"] = v.pass ? "pass" : "fail";
   j["failures"] = v.failures;
   j["figures"] = figures_json(v);

@@ -4,6 +4,14 @@
 
 namespace rdyn::validate {
 
+std::vector<models::Threshold> thresholds_of(const models::Scene& scene) {
+  if (!scene.validation.thresholds.empty()) return scene.validation.thresholds;
+  std::vector<models::Threshold> th{{"qdot", kDefaultThresholdGrid_deg, "", kDefaultThresholdMaxError}};
+  for (const auto& f : scene.outputs.constraint_forces)
+    th.push_back({f.name, kDefaultThresholdGrid_deg, "", kDefaultThresholdMaxError});
+  return th;
+}
+
 ThresholdResult judge_threshold_on(const models::Threshold& th, const RunRecord& r) {
   ThresholdResult t{th, r.error_of(th.quantity), false, r.label()};
   // An error relative to a peak of zero (a mechanism at rest, a force that never acts) is no
