@@ -132,7 +132,14 @@ class SceneLoads : public Force::Custom::Implementation {
     if (sc.gravity.enabled) {
       const Vec3 g = v3(sc.gravity.g_m_s2);
       for (size_t b = 0; b < sc.bodies.size(); ++b) {
-        if (m_.body_fold[b]) continue;
+        if (const auto& f = m_.body_fold[b]) {
+          // A folded body turns about its centre of mass, fixed at its ground joint
+          // (models/gear_fold.hpp): a constant, kept so that V has the same zero whether the
+          // body is folded or built (the leg press's energy columns differed by its m g y,
+          // 47.09 J, between the two models).
+          V -= sc.bodies[b].mass_kg * dot(g, v3(sc.joints[f->driven_joint].parent_point));
+          continue;
+        }
         const Vec3 p = m_.body_mobod[b].findStationLocationInGround(s, v3(sc.bodies[b].com_m));
         V -= sc.bodies[b].mass_kg * dot(g, p);  // V = −m g·p
       }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "models/scene_yaml.hpp"
 #include "tests/validate/run_records.hpp"
 
 namespace rdyn::validate {
@@ -37,6 +38,30 @@ TEST(Thresholds, AStoppedRunOrAMissingQuantityFails) {
   const auto t = judge_threshold_on({"qdot", 10.0, "", 1e9}, stopped);
   EXPECT_FALSE(t.pass);
   EXPECT_TRUE(std::isinf(t.error));
+}
+
+TEST(Thresholds, ASceneWithoutThresholdsIsJudgedOnTheDefaults) {
+  // Without defaults a validation whose every reduced run was 176 % off passed: nothing was
+  // judged. The defaults cover the speed and every requested constraint force.
+  auto scene = models::load_scene("fourbar");
+  ASSERT_TRUE(scene.validation.thresholds.empty());  // the shipped four-bar declares none
+  const auto th = thresholds_of(scene);
+  ASSERT_EQ(th.size(), 1 + scene.outputs.constraint_forces.size());
+  EXPECT_EQ(th[0].quantity, "qdot");
+  EXPECT_EQ(th[1].quantity, scene.outputs.constraint_forces[0].name);
+  for (const auto& t : th) {
+    EXPECT_EQ(t.grid_deg, kDefaultThresholdGrid_deg);
+    EXPECT_EQ(t.max_error, kDefaultThresholdMaxError);
+  }
+  // A run 176 % off fails them; a declared threshold replaces them all.
+  std::vector<RunRecord> runs{record("reduced", 1e-3, {{"qdot", 1.76}})};
+  runs[0].tolerance = 1e-10;
+  const auto t = judge_threshold(th[0], runs, 1e-10);
+  ASSERT_TRUE(t);
+  EXPECT_FALSE(t->pass);
+  scene.validation.thresholds = {{"qdot", 5.0, "", 0.01}};
+  ASSERT_EQ(thresholds_of(scene).size(), 1u);
+  EXPECT_EQ(thresholds_of(scene)[0].grid_deg, 5.0);
 }
 
 }  // namespace
