@@ -270,6 +270,21 @@ double calc_energy(const ReducedModel& m, double q, double qdot) {
   return 0.5 * v[0] * qdot * qdot + v[1];
 }
 
+double calc_drive(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot, double& power_nc,
+                  double* forces) {
+  ws.q = q, ws.qdot = qdot;
+  for (size_t g = 0; g < m.gates.size(); ++g) {
+    const double s = calc_switching(m, static_cast<int>(g), q, qdot);
+    ws.gate_on[g] = std::abs(s) > 1e-12 ? s > 0 : calc_switching(m, static_cast<int>(g), q, qddot) > 0;
+  }
+  double* v = ws.scratch_rec.data();
+  eval_block(m.table, m.record_block, q, v);
+  double qddot_free = 0.0;
+  acceleration_from(m, ws, v, qdot, qddot_free, power_nc);
+  outputs_from(m, ws, v + m.rhs_cols.size(), qdot, qddot, forces);
+  return v[0] * (qddot - qddot_free);  // m1 (q̈ − q̈_free)
+}
+
 double calc_potential_min(const ReducedModel& m) {
   const Table& t = m.table;
   const int nodes = t.periodic ? t.intervals : t.intervals + 1;

@@ -156,6 +156,16 @@ double calc_energy(const ReducedModel& m, double q, double qdot);
 double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double& qddot,
                    double& power_nc, double* forces);
 
+// Prescribed motion, the inverse form of Eksergian's equation: the generalized force a drive on
+// q must add for the mechanism to follow (q, q̇, q̈) under the model's loads,
+//   drive = m1 q̈ + m2 q̇² − F*(q, q̇) = m1 (q̈ − q̈_free(q, q̇)),
+// and the constraint forces F_E,k = me1_k q̈ + me2_k q̇² − Q_x,k at that q̈ (the drive acts on q
+// alone, so it enters no constraint line; docs/theory.md, "Prescribed motion"). Gates follow the
+// sign of the prescribed rate (of q̈ where q̇ = 0). Returns the drive [N·m or N]; `power_nc`
+// gets the loads' power F_nc q̇ [W]. Allocation-free.
+double calc_drive(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, double qddot, double& power_nc,
+                  double* forces);
+
 // Divergence guard of the reduced integrators, the same in simulate_reduced, the runtime and
 // the C API. The reduced equation's own energy balance E − E0 = W (W: work of the
 // non-conservative loads) holds to interpolation accuracy; a residual above half the energy

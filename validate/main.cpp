@@ -12,6 +12,7 @@
 #include "validate/commands.hpp"
 #include "validate/expand.hpp"
 #include "validate/inspect.hpp"
+#include "validate/drive_command.hpp"
 #include "validate/optimize_command.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/peers.hpp"
@@ -213,6 +214,26 @@ int main(int argc, char** argv) {
   optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
   add_scene_overrides(*optimize, opz.sets);
   add_output_folder(*optimize, opz.out, opz.force);
+  DriveArgs drv;
+  auto* drive = app.add_subcommand(
+      "drive",
+      "Prescribed motion: the independent coordinate follows a constant rate (--cadence-hz) or a profile q(t) "
+      "(--profile t,q_deg or t,q_m CSV, natural cubic spline) with every other load of the scene applied, and each "
+      "model says what the drive must supply. Writes DIR/timeseries.csv (t,q,qdot,qddot,drive_Nm or drive_N, "
+      "drive_W, F_<name>...) and DIR/run.json (drive RMS, peak, mean, mean and peak power, constraint-force peaks).");
+  drive->add_option("scene", drv.scene, "Scene name or YAML file")->required();
+  double drive_cadence = 0, drive_duration = 0, drive_dt = 0;
+  auto* drive_cadence_opt =
+      drive->add_option("--cadence-hz", drive_cadence, "Constant rate [rev/s] of a revolute coordinate (sign: direction)");
+  drive->add_option("--profile", drv.profile, "CSV of t,q_deg (revolute) or t,q_m (prismatic) to follow");
+  drive->add_option("--model", drv.model, "full (Simbody inverse dynamics, default) or reduced")
+      ->check(CLI::IsMember({"full", "reduced"}));
+  auto* drive_duration_opt =
+      drive->add_option("--duration", drive_duration, "Time [s] (default: one revolution, or the profile's span)");
+  auto* drive_dt_opt = drive->add_option("--dt-out", drive_dt, "Output interval [s] (default: the scene's)");
+  add_reduced_table_options(*drive, drv.grid_deg, drv.interpolation);
+  add_scene_overrides(*drive, drv.sets);
+  add_output_folder(*drive, drv.out, drv.force);
   ExpandArgs exp;
   auto* expand = app.add_subcommand(
       "expand",
@@ -240,6 +261,9 @@ int main(int argc, char** argv) {
   if (dt_out_opt->count()) sim.dt_out = dt_out;
   opz.force_name_given = opz_force_name->count() > 0;
   if (tolerance_opt->count()) sim.tolerance = tolerance;
+  if (drive_cadence_opt->count()) drv.cadence_hz = drive_cadence;
+  if (drive_duration_opt->count()) drv.duration = drive_duration;
+  if (drive_dt_opt->count()) drv.dt_out = drive_dt;
   try {
     if (*simulate) return run_simulate(sim);
     if (*extract) return run_extract(ext);
@@ -250,6 +274,7 @@ int main(int argc, char** argv) {
     if (*inspect) return run_inspect(ins);
     if (*export_mjcf) return run_export_mjcf(mj);
     if (*optimize) return run_optimize(opz);
+    if (*drive) return run_drive(drv);
     if (*expand) return run_expand(exp);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());

@@ -1,0 +1,111 @@
+#include "validate/drive_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "models/scene_yaml.hpp"
+#include "reduced/samples.hpp"
+#include "validate/build_reduced.hpp"
+#include "validate/drive.hpp"
+#include "validate/output_dir.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+// The same ranges as the other commands' (README, "Limits").
+constexpr double kMaxCadence_Hz = 1000.0, kMaxDuration_s = 1e5, kMinOutputInterval_s = 1e-6, kMaxRows = 1e7;
+
+void write_drive_csv(const std::string& path, const DriveRecord& r, bool revolute) {
+  TextSink sink(path);
+  std::string header = revolute ? "t,q,qdot,qddot,drive_Nm,drive_W" : "t,q,qdot,qddot,drive_N,drive_W";
+  for (const auto& n : r.force_names) header += ",F_" + n;  // names are checked by the scene reader
+  sink.add(header + "\n");
+  for (size_t i = 0; i < r.t.size(); ++i) {
+    std::string row = fmt::format("{:.10g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.t[i], r.q[i], r.qdot[i],
+                                  r.qddot[i], r.drive[i], r.power[i]);
+    for (const auto& c : r.forces) row += fmt::format(",{:.17g}", c[i]);
+    sink.add(row + "\n");
+  }
+  sink.close();
+}
+
+}  // namespace
+
+int run_drive(const DriveArgs& a) {
+  std::vector<models::Override> overrides;
+  for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
+  const models::Scene scene = models::load_scene(a.scene, overrides);
+  auto bad = [&](const std::string& option, const std::string& msg) {
+    throw models::SceneError(scene.source_file, 0, option, msg);
+  };
+  const auto* joint = scene.find_joint(scene.independent);
+  const bool revolute = joint->type == models::JointType::Revolute;
+  // Every number before any work.
+  if (a.cadence_hz.has_value() == !a.profile.empty()) bad("--cadence-hz", "give --cadence-hz or --profile (one of them)");
+  if (a.cadence_hz) {
+    if (!revolute) bad("--cadence-hz", "a constant rate needs a revolute independent coordinate: give --profile");
+    if (!(std::isfinite(*a.cadence_hz) && *a.cadence_hz != 0 && std::abs(*a.cadence_hz) <= kMaxCadence_Hz))
+      bad("--cadence-hz", fmt::format("must be a finite, non-zero rate with |F| ≤ {:g} rev/s (got {:g})",
+                                      kMaxCadence_Hz, *a.cadence_hz));
+  }
+  if (a.duration && !(std::isfinite(*a.duration) && *a.duration > 0 && *a.duration <= kMaxDuration_s))
+    bad("--duration", fmt::format("must be in (0, {:g}] s (got {:g})", kMaxDuration_s, *a.duration));
+  const double dt = a.dt_out.value_or(scene.simulation.output_interval_s);
+  if (!(std::isfinite(dt) && dt >= kMinOutputInterval_s && dt <= kMaxDuration_s))
+    bad("--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", kMinOutputInterval_s, kMaxDuration_s, dt));
+  if (!(a.grid_deg >= 0.05 && a.grid_deg <= 90)) bad("--grid-deg", "must be in [0.05, 90] deg");
+  if (a.model != "full" && a.model != "reduced") bad("--model", "full or reduced");
+
+  PrescribedMotion motion;
+  nlohmann::json run = {{"scene", scene.name}, {"scene_file", scene.source_file}, {"model", a.model}};
+  if (a.cadence_hz) {
+    const double duration = a.duration.value_or(1.0 / std::abs(*a.cadence_hz));  // one revolution
+    if (duration / dt > kMaxRows) bad("--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
+    motion = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, dt);
+    motion.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
+    run["cadence_hz"] = *a.cadence_hz;
+  } else {
+    motion = profile_motion(a.profile, revolute, a.duration, dt, kMaxRows);
+    motion.how = "profile " + a.profile + " (natural cubic spline)";
+    run["profile"] = a.profile;
+  }
+  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+
+  DriveRecord r;
+  if (a.model == "full") {
+    r = calc_drive_full(scene, motion);
+  } else {
+    auto e = extract_from_full(scene, a.grid_deg, reduced::Method::Kinetostatic);
+    const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(a.interpolation));
+    r = calc_drive_reduced(model, motion);
+    run.update({{"grid_deg", a.grid_deg}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
+  }
+  const DriveStats st = calc_drive_stats(r);
+  const char* unit = revolute ? "N·m" : "N";
+  run.update({{"motion", motion.how},
+              {"duration_s", r.t.back()},
+              {"output_interval_s", dt},
+              {"drive_unit", unit},
+              {"drive_rms", st.rms},
+              {"drive_peak", st.peak},
+              {"drive_mean", st.mean},
+              {"mean_power_W", st.mean_power_W},
+              {"peak_power_W", st.peak_power_W},
+              {"wall_s", r.wall_s}});
+  nlohmann::json peaks = nlohmann::json::object();
+  for (size_t c = 0; c < r.force_names.size(); ++c) peaks[r.force_names[c]] = st.force_peaks[c];
+  run["constraint_force_peaks_N"] = peaks;
+  write_drive_csv(out.file("timeseries.csv"), r, revolute);
+  write_text_file(out.file("run.json"), run.dump(2) + "\n");
+  out.commit();
+  std::fprintf(stderr, "rdyn: %s (%s model) driven by %s: drive RMS %.4g %s, peak %.4g %s, mean power %.4g W; wrote %s\n",
+               scene.name.c_str(), a.model.c_str(), motion.how.c_str(), st.rms, unit, st.peak, unit, st.mean_power_W,
+               (a.out + "/timeseries.csv").c_str());
+  return 0;
+}
+
+}  // namespace rdyn::validate
