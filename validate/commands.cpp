@@ -249,6 +249,8 @@ int run_calibrate(const CalibrateArgs& a) {
       {"resistance_coefficient", number_or_null(r.resistance_coefficient)},
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
       {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
+      {"full_revolutions", r.full_duration_s > 0 ? nlohmann::json(r.full_revolutions) : nlohmann::json(nullptr)},
+      {"full_duration_s", r.full_duration_s > 0 ? nlohmann::json(r.full_duration_s) : nlohmann::json(nullptr)},
       {"mean_power_w", r.mean_power_w},
       {"mean_dissipated_power_w", r.mean_dissipated_power_w},
       {"load_searches", r.load_searches},
