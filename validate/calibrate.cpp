@@ -720,7 +720,12 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& 
   r.peak_force_full_N = full.c.measures.peak_force_N;
   r.full_revolutions = full.c.measures.revolutions;
   r.full_duration_s = full.c.duration_s;
-  check_full(full, opt, sel, r);
+  try {
+    check_full(full, opt, sel, r);
+  } catch (const models::NumericalError& e) {
+    if (!opt.keep_unconfirmed) throw;
+    r.unconfirmed = e.what();
+  }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
@@ -809,12 +814,19 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
                                     "# power_W is nominal: the power of its coefficient at a constant {:.6g} Hz)",
                                     opt.power_w, opt.cadence_hz, opt.cadence_hz)
                       : std::string("with the resistances as given");
+  // An unconfirmed result (written with --force) says so in its first comment, on one line each.
+  std::string warning;
+  if (!r.unconfirmed.empty()) {
+    warning = "# NOT CONFIRMED on the full model (written with --force): ";
+    for (char c : r.unconfirmed) warning += c == '\n' ? ' ' : c;
+    warning += "\n";
+  }
   return fmt::format(
       "# Calibrated by `rdyn calibrate` from {}: {} ({}) = {:.6g} {} holds a mean cadence of {:.6g} Hz\n"
       "# (reduced) / {:.6g} Hz (full) {}. The initial\n"
-      "# conditions are a point of the steady cycle.\n{}",
+      "# conditions are a point of the steady cycle.\n{}{}",
       from, r.load, r.load_kind, r.load_value, r.load_unit, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, point,
-      body);
+      warning, body);
 }
 
 }  // namespace rdyn::validate

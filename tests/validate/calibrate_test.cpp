@@ -384,6 +384,17 @@ TEST(Calibrate, AnUnsteadyConfirmationNamesTheReducedPointAndWhatTheFullModelRea
         "the reduced operating point: drive = 0.251327 N·m, steady cycle through q = 0 rad at q̇ = 12.5664 rad/s, "
         "mean cadence 2 Hz"})
     EXPECT_NE(what.find(part), std::string::npos) << part << "\n" << what;
+  // Kept (`--write-scene FILE --force`): the result carries the message and the written scene
+  // says, in a comment, that it is not confirmed; it still loads.
+  opt.keep_unconfirmed = true;
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_EQ(r.unconfirmed, what);
+  const std::string text = flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n");
+  const std::string out = calibrated_scene_yaml("flywheel.yaml", text, {}, scene, opt, r);
+  EXPECT_NE(out.find("\n# NOT CONFIRMED on the full model (written with --force): calibration not confirmed"),
+            std::string::npos)
+      << out;
+  EXPECT_NEAR(models::parse_scene(out, "written.yaml").joint_torques[0].value, 0.02 * 4 * M_PI, 1e-9);
 }
 
 // A calibrated value the scene format would refuse (|torque| above 1e6 N·m) is a numerical
