@@ -222,6 +222,23 @@ TEST(Calibrate, FlywheelTorqueEqualsDampingTimesSpeed) {
   EXPECT_NEAR(p.mean_power_w, 40.0, 1e-6);
 }
 
+// The confirmation starts from the reduced steady point alone: a scene whose own initial speed
+// (given as cadence_Hz: 7 Hz, against a target of 2 Hz and a time constant J/c of 2.5 s) is far
+// off is confirmed in one run of 7 revolutions, as with the speed given as qdot at the target.
+TEST(Calibrate, TheSceneInitialSpeedIsReplacedNotCombined) {
+  auto text = flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n");
+  const std::string given = "initial: {q_deg: 0, qdot: 5.0}";
+  for (const std::string initial : {"initial: {q_deg: 0, cadence_Hz: 7.0}", "initial: {q_deg: 30, qdot: 12.566}"}) {
+    auto t = text;
+    t.replace(t.find(given), given.size(), initial);
+    const auto r = calibrate_load(models::parse_scene(t, "flywheel.yaml"), 2.0, "drive", true);
+    EXPECT_NEAR(r.mean_cadence_hz_full, 2.0, 1e-6) << initial;
+    EXPECT_EQ(r.full_revolutions, 7) << initial;
+    EXPECT_NEAR(r.full_duration_s, 1.02 * 7 / 2.0, 1e-9) << initial;  // the first run: steady at once
+    EXPECT_NEAR(r.steady_qdot, 4 * M_PI, 1e-9) << initial;
+  }
+}
+
 TEST(Calibrate, FlywheelMotorStallTorqueKeepsItsNoLoadSpeed) {
   const auto scene = models::parse_scene(
       flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"),
