@@ -823,10 +823,11 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   }
   return fmt::format(
       "# Calibrated by `rdyn calibrate` from {}: {} ({}) = {:.6g} {} holds a mean cadence of {:.6g} Hz\n"
-      "# (reduced) / {:.6g} Hz (full) {}. The initial\n"
+      "# (reduced) / {} (full) {}. The initial\n"
       "# conditions are a point of the steady cycle.\n{}{}",
-      from, r.load, r.load_kind, r.load_value, r.load_unit, r.mean_cadence_hz_reduced, r.mean_cadence_hz_full, point,
-      warning, body);
+      from, r.load, r.load_kind, r.load_value, r.load_unit, r.mean_cadence_hz_reduced,
+      std::isfinite(r.mean_cadence_hz_full) ? fmt::format("{:.6g} Hz", r.mean_cadence_hz_full) : "no measure",
+      point, warning, body);
 }
 
 }  // namespace rdyn::validate
