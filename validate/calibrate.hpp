@@ -30,7 +30,13 @@ struct CalibrationOptions {
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
   double tolerance = 1e-10;    // reduced integrator
-  double full_check_s = 6.0;   // full-model confirmation run, from the steady cycle (0: skip)
+  // Full-model confirmation from the reduced steady cycle's point: run until the mean cadence
+  // over whole revolutions is steady, at most this simulated time [s] (0: no confirmation).
+  double full_max_s = 120.0;
+  // A full-model miss (not steady by the cap, or steady off F by more than 1 %) is a
+  // NumericalError; with this set it is returned instead, in CalibrationResult::unconfirmed
+  // (`calibrate --write-scene FILE --force` writes the scene, then exits 1 with the message).
+  bool keep_unconfirmed = false;
   // The operating point by one Newton iteration on the first integral (validate/operating_point.hpp);
   // false, or where it does not converge: the nested searches (Brent on the load, each value a
   // fixed-point search, a secant on the coefficient around them), the cross-check.
@@ -50,7 +56,13 @@ struct CalibrationResult {
   // steady cycle at F dissipates P on average (not P/ω_Fⁿ, which holds only at constant speed).
   double resistance_coefficient = 0.0;
   double mean_cadence_hz_reduced = 0.0;
-  double mean_cadence_hz_full = 0.0;     // NaN when the full-model check was skipped
+  // Mean over the full model's last 3 whole revolutions once steady [rev/s] (NaN when the check
+  // was skipped).
+  double mean_cadence_hz_full = 0.0;
+  // The full-model miss's message when opt.keep_unconfirmed kept it (empty: confirmed or skipped).
+  std::string unconfirmed;
+  int full_revolutions = 0;              // whole revolutions the full model's confirming run made
+  double full_duration_s = 0.0;          // simulated time of that run [s] (0: skipped)
   double mean_power_w = 0.0;            // mean power of the calibrated load over the steady cycle (reduced)
   // Mean power the resistances dissipate over the steady cycle (reduced) [W]: = P in power mode
   // (to 1e-8; the coefficient is adjusted until it is), whatever the speed fluctuation.

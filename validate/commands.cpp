@@ -230,6 +230,8 @@ int run_calibrate(const CalibrateArgs& a) {
   if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
   opt.grid_deg = a.grid_deg;
   opt.interpolation = a.interpolation;
+  // --write-scene with --force: a full-model miss still writes the scene (marked), then exit 1.
+  opt.keep_unconfirmed = a.force && !a.write_scene.empty();
   if (!a.write_scene.empty()) check_writable(text, scene, opt);
   std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
   if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
@@ -249,6 +251,8 @@ int run_calibrate(const CalibrateArgs& a) {
       {"resistance_coefficient", number_or_null(r.resistance_coefficient)},
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
       {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
+      {"full_revolutions", r.full_duration_s > 0 ? nlohmann::json(r.full_revolutions) : nlohmann::json(nullptr)},
+      {"full_duration_s", r.full_duration_s > 0 ? nlohmann::json(r.full_duration_s) : nlohmann::json(nullptr)},
       {"mean_power_w", r.mean_power_w},
       {"mean_dissipated_power_w", r.mean_dissipated_power_w},
       {"load_searches", r.load_searches},
@@ -273,6 +277,9 @@ int run_calibrate(const CalibrateArgs& a) {
     out->commit();
     j["written_scene"] = a.write_scene;
   }
+  if (!r.unconfirmed.empty())
+    throw models::NumericalError(r.unconfirmed + "; the scene was written to " + a.write_scene +
+                                 " all the same (--force), marked as not confirmed");
   std::printf("%s\n", j.dump(2).c_str());
   return 0;
 }

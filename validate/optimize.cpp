@@ -460,7 +460,7 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   copt.load_field = "optimize.loads";
   copt.grid_deg = opt.grid_deg;
   copt.interpolation = opt.interpolation;
-  copt.full_check_s = 0;
+  copt.full_max_s = 0;
   std::vector<double> x0(design.n, 0.0);
   for (const auto& g : design.groups)
     if (!g.fixed_a0) x0[g.offset] = g.a0_start;

@@ -46,7 +46,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
   CalibrationOptions copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
   copt.grid_deg = opt.grid_deg;
-  copt.full_check_s = 0.0;  // reduced model only: this is what sweeps are for
+  copt.full_max_s = 0.0;  // reduced model only: this is what sweeps are for
   if (!(copt.cadence_hz > 0))
     throw models::SceneError(base.source_file, 0, "--cadence-hz",
                              "give it, or a validation.calibrate block in the scene");

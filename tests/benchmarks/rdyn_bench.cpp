@@ -292,7 +292,7 @@ BENCHMARK(BM_SteadyCycle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 // cycle's extremes). BM_ExtractionPerGridPoint × 36 is the extraction's share.
 void BM_CalibrationWithoutFullCheck(benchmark::State& st) {
   validate::CalibrationOptions o;
-  o.full_check_s = 0.0;
+  o.full_max_s = 0.0;
   validate::Progress quiet(false);
   validate::CalibrationResult r;
   for (auto _ : st) r = validate::calibrate(bicycle(), o, quiet);

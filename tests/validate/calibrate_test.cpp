@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <fstream>
 
+#include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/table.hpp"
@@ -26,7 +27,7 @@ TEST(Calibrate, BicycleKeepsItsTorqueWithoutANamedLoad) {
   CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
   EXPECT_EQ(opt.cadence_hz, 1.0);  // from its validation.calibrate block
   EXPECT_EQ(opt.power_w, 125.0);
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   Progress quiet(false);
   const auto r = calibrate(scene, opt, quiet);
   EXPECT_NEAR(r.torque_Nm, 64.68568861256895, 1e-6);
@@ -41,7 +42,6 @@ TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   CalibrationOptions opt;
   opt.cadence_hz = 1.0;
   opt.power_w = 125.0;
-  opt.full_check_s = 3.0;
   Progress quiet(false);
   const auto r = calibrate(scene, opt, quiet);
   EXPECT_NEAR(r.mean_cadence_hz_reduced, 1.0, 1e-8);
@@ -52,6 +52,50 @@ TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   // Two thighs, each descending through a realistic swing (40°–70°).
   EXPECT_GT(r.work_per_rev_per_unit / 2, 40 * M_PI / 180);
   EXPECT_LT(r.work_per_rev_per_unit / 2, 70 * M_PI / 180);
+}
+
+// Mean cadence over whole turns of a full-model run [rev/s], counted independently of
+// validate/confirm_full: the rows' first and last crossings of q(0) + 2πk, linear between rows.
+double whole_turn_cadence(const models::TimeSeries& ts) {
+  const double q0 = ts.q.front();
+  const long turns = static_cast<long>(std::floor((ts.q.back() - q0) / (2 * M_PI)));
+  auto crossing = [&](long k) {
+    const double level = q0 + 2 * M_PI * k;
+    size_t i = 0;
+    while (ts.q[i + 1] < level) ++i;
+    return ts.t[i] + (level - ts.q[i]) / (ts.q[i + 1] - ts.q[i]) * (ts.t[i + 1] - ts.t[i]);
+  };
+  return turns >= 1 ? turns / crossing(turns) : NAN;
+}
+
+// A new user's Watt six-bar leg press (issue #23; tests/validate/scenes/legpress-norail.yaml, as
+// given): its speed swings widely within a turn at 0.5 Hz, so the old confirmation — the mean
+// rate over 1–6 s, 2.5 turns — read 0.556562 Hz and refused a calibration that holds. Whole
+// revolutions from the reduced steady point confirm it; the written scene, simulated on its own
+// for 10.5 s (5 turns; `rdyn simulate --model full --duration 30` of it: 0.50000 Hz over 15), holds
+// 0.5 Hz over whole turns.
+TEST(Calibrate, LegPressIsConfirmedOverWholeRevolutionsAndItsWrittenSceneHoldsTheCadence) {
+  const std::string file = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-norail.yaml";
+  const std::string text = models::read_scene_text(file);
+  const auto scene = models::parse_scene(text, file);
+  const CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+  ASSERT_EQ(opt.cadence_hz, 0.5);
+  ASSERT_EQ(opt.power_w, 30.0);
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_NEAR(r.mean_cadence_hz_reduced, 0.5, 0.5e-6);
+  EXPECT_NEAR(r.mean_cadence_hz_full, 0.5, 0.01 * 0.5);
+  EXPECT_GE(r.full_revolutions, 6);
+  EXPECT_GT(r.speed_fluctuation, 0.2);  // what defeated the fixed window
+  const auto written = models::parse_scene(calibrated_scene_yaml(file, text, {}, scene, opt, r), "written.yaml");
+  EXPECT_EQ(written.initial.q, r.steady_q);
+  EXPECT_EQ(written.initial.qdot, r.steady_qdot);
+  engine::ForwardOptions fo;
+  fo.duration_s = 10.5;
+  fo.output_interval_s = 0.001;
+  const double f = whole_turn_cadence(engine::simulate_full(engine::FullModel(written), fo));
+  EXPECT_NEAR(f, 0.5, 0.01 * 0.5);
+  EXPECT_NEAR(f, r.mean_cadence_hz_full, 1e-3 * 0.5);  // both steady: far inside the 1 %
 }
 
 TEST(Calibrate, WrittenSceneScalesProfiledLoadsWhereTheSceneListsThem) {
@@ -102,7 +146,6 @@ TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {
   // revolution is T·Δθ, so T ∝ P (up to the tiny speed fluctuation).
   const auto scene = models::load_scene("bicycle");
   CalibrationOptions opt;
-  opt.full_check_s = 1.5;
   Progress quiet(false);
   opt.power_w = 100;
   const double t100 = calibrate(scene, opt, quiet).torque_Nm;
@@ -128,11 +171,11 @@ std::string flywheel_yaml(const std::string& loads, bool rim = false) {
 }
 
 // calibrate() of `load` at `cadence_hz` (power_w > 0: with the resistance dissipating it, else
-// mean-speed mode), confirmed on the full model over full_check_s (0: not).
+// mean-speed mode), confirmed on the full model until steady when `confirm`.
 CalibrationResult calibrate_load(const models::Scene& scene, double cadence_hz, const std::string& load,
-                                 double full_check_s, double power_w = 0.0) {
+                                 bool confirm, double power_w = 0.0) {
   CalibrationOptions opt = calibration_options_of(scene, cadence_hz, power_w, load);
-  opt.full_check_s = full_check_s;
+  if (!confirm) opt.full_max_s = 0;
   Progress quiet(false);
   return calibrate(scene, opt, quiet);
 }
@@ -141,7 +184,7 @@ CalibrationResult calibrate_load(const models::Scene& scene, double cadence_hz, 
 // when it calibrates.
 template <typename Error>
 std::string error_of(const models::Scene& scene, CalibrationOptions opt) {
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   Progress quiet(false);
   try {
     calibrate(scene, opt, quiet);
@@ -162,7 +205,7 @@ std::string failure_of(const models::Scene& scene, const CalibrationOptions& opt
 TEST(Calibrate, FlywheelTorqueEqualsDampingTimesSpeed) {
   const auto scene = models::parse_scene(
       flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
-  const auto r = calibrate_load(scene, 2.0, "drive", 1.5);
+  const auto r = calibrate_load(scene, 2.0, "drive", true);
   const double omega = 2 * M_PI * 2.0;
   EXPECT_NEAR(r.load_value, 0.02 * omega, 1e-9 * 0.02 * omega);
   EXPECT_EQ(r.load, "drive");
@@ -173,17 +216,34 @@ TEST(Calibrate, FlywheelTorqueEqualsDampingTimesSpeed) {
   EXPECT_TRUE(std::isnan(r.resistance_coefficient));     // mean-speed mode: unchanged
 
   // With a power: c = P/ω², T = P/ω.
-  const auto p = calibrate_load(scene, 2.0, "drive", 1.5, 40.0);
+  const auto p = calibrate_load(scene, 2.0, "drive", true, 40.0);
   EXPECT_NEAR(p.resistance_coefficient, 40.0 / (omega * omega), 1e-12);
   EXPECT_NEAR(p.load_value, 40.0 / omega, 1e-8);
   EXPECT_NEAR(p.mean_power_w, 40.0, 1e-6);
+}
+
+// The confirmation starts from the reduced steady point alone: a scene whose own initial speed
+// (given as cadence_Hz: 7 Hz, against a target of 2 Hz and a time constant J/c of 2.5 s) is far
+// off is confirmed in one run of 7 revolutions, as with the speed given as qdot at the target.
+TEST(Calibrate, TheSceneInitialSpeedIsReplacedNotCombined) {
+  auto text = flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n");
+  const std::string given = "initial: {q_deg: 0, qdot: 5.0}";
+  for (const std::string initial : {"initial: {q_deg: 0, cadence_Hz: 7.0}", "initial: {q_deg: 30, qdot: 12.566}"}) {
+    auto t = text;
+    t.replace(t.find(given), given.size(), initial);
+    const auto r = calibrate_load(models::parse_scene(t, "flywheel.yaml"), 2.0, "drive", true);
+    EXPECT_NEAR(r.mean_cadence_hz_full, 2.0, 1e-6) << initial;
+    EXPECT_EQ(r.full_revolutions, 7) << initial;
+    EXPECT_NEAR(r.full_duration_s, 1.02 * 7 / 2.0, 1e-9) << initial;  // the first run: steady at once
+    EXPECT_NEAR(r.steady_qdot, 4 * M_PI, 1e-9) << initial;
+  }
 }
 
 TEST(Calibrate, FlywheelMotorStallTorqueKeepsItsNoLoadSpeed) {
   const auto scene = models::parse_scene(
       flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"),
       "flywheel.yaml");
-  const auto r = calibrate_load(scene, 2.0, "motor", 1.5);
+  const auto r = calibrate_load(scene, 2.0, "motor", true);
   const double omega = 2 * M_PI * 2.0, s = 0.02 * omega / (1 - omega / 30.0);
   EXPECT_NEAR(r.load_value, s, 1e-9 * s);
   EXPECT_EQ(r.load_kind, "motor_stall_torque");
@@ -222,7 +282,7 @@ TEST(Calibrate, CylinderForceDoesForceTimesStrokePerRevolution) {
       "initial: {q_deg: 30, qdot: 6.0}\n"
       "simulation: {duration_s: 2, output_interval_s: 0.01, tolerance: 1.0e-9}\n";
   const auto scene = models::parse_scene(yaml, "cylinder.yaml");
-  const auto r = calibrate_load(scene, 1.0, "cylinder", 2.0);
+  const auto r = calibrate_load(scene, 1.0, "cylinder", true);
   EXPECT_EQ(r.load_kind, "joint_force");
   EXPECT_EQ(r.load_unit, "N");
   EXPECT_LT(r.load_value, 0);  // the sign the scene gives it
@@ -251,7 +311,7 @@ TEST(Calibrate, PointForceDoesItsClosedFormWorkPerRevolution) {
     const double q = (i + 0.5) * 2 * M_PI / n, L = std::sqrt(0.26 - 0.1 * std::cos(q));
     W += 0.04 * std::sin(q) * std::sin(q) / L * (2 * M_PI / n);
   }
-  const auto r = calibrate_load(scene, 1.0, "m", 2.0);
+  const auto r = calibrate_load(scene, 1.0, "m", true);
   EXPECT_EQ(r.load, "m");
   EXPECT_EQ(r.load_kind, "point_force");
   EXPECT_EQ(r.load_unit, "N");
@@ -269,7 +329,7 @@ TEST(Calibrate, PointForceDoesItsClosedFormWorkPerRevolution) {
                           "  - {type: point_force, name: b, body_a: ground, point_a: G, body_b: wheel, point_b: B, "
                           "force_N: 3, profile: {of: wheel, fourier: {a0: 1, b: [-0.8]}}}\n";
   const auto scene2 = models::parse_scene(pulled_flywheel_yaml(two), "pulled2.yaml");
-  const auto r2 = calibrate_load(scene2, 1.0, "a+b", 0);
+  const auto r2 = calibrate_load(scene2, 1.0, "a+b", false);
   EXPECT_EQ(r2.load, "a+b");
   EXPECT_EQ(r2.load_kind, "point_forces");
   EXPECT_NEAR(r2.load_value, r.load_value / 2, 1e-6 * r.load_value);
@@ -305,7 +365,6 @@ TEST(Calibrate, PowerModeDissipatesThePowerOnTheFluctuatingCycle) {
   drag.name = "drag", drag.body = "crank", drag.law = models::ResistanceLaw::Viscous, drag.coefficient = 1e-3;
   scene.resistances.push_back(drag);
   CalibrationOptions opt = calibration_options_of(scene, 5.0, 20.0, "motor");
-  opt.full_check_s = 3.0;
   Progress quiet(false);
   const auto r = calibrate(scene, opt, quiet);
   EXPECT_GT(r.speed_fluctuation, 2.0);  // the case that broke the constant-speed rule
@@ -321,6 +380,41 @@ TEST(Calibrate, PowerModeDissipatesThePowerOnTheFluctuatingCycle) {
   EXPECT_LT(r.resistance_coefficient, 0.9 * 20.0 / (omega * omega));
 }
 
+// A confirmation that cannot become steady within its cap is a numerical failure whose message
+// gives the reduced operating point and what the full model reached (here a cap of 1 s holds 2
+// of the 6 whole revolutions the steady test compares).
+TEST(Calibrate, AnUnsteadyConfirmationNamesTheReducedPointAndWhatTheFullModelReached) {
+  const auto scene = models::parse_scene(
+      flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 2.0, 0.0, "drive");
+  opt.full_max_s = 1.0;
+  Progress quiet(false);
+  std::string what;
+  try {
+    calibrate(scene, opt, quiet);
+  } catch (const models::NumericalError& e) {
+    what = e.what();
+  }
+  for (const char* part :
+       {"calibration not confirmed: the full model is not steady within 1 s of simulated time",
+        "it reached 2 whole revolutions in 1 s of simulated time, fewer than the 6 the steady test compares",
+        "the reduced operating point: drive = 0.251327 N·m, steady cycle through q = 0 rad at q̇ = 12.5664 rad/s, "
+        "mean cadence 2 Hz"})
+    EXPECT_NE(what.find(part), std::string::npos) << part << "\n" << what;
+  // Kept (`--write-scene FILE --force`): the result carries the message and the written scene
+  // says, in a comment, that it is not confirmed; it still loads.
+  opt.keep_unconfirmed = true;
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_EQ(r.unconfirmed, what);
+  const std::string text = flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n");
+  const std::string out = calibrated_scene_yaml("flywheel.yaml", text, {}, scene, opt, r);
+  EXPECT_NE(out.find("/ no measure (full)"), std::string::npos) << out;  // 2 of the 3 revolutions measured
+  EXPECT_NE(out.find("\n# NOT CONFIRMED on the full model (written with --force): calibration not confirmed"),
+            std::string::npos)
+      << out;
+  EXPECT_NEAR(models::parse_scene(out, "written.yaml").joint_torques[0].value, 0.02 * 4 * M_PI, 1e-9);
+}
+
 // A calibrated value the scene format would refuse (|torque| above 1e6 N·m) is a numerical
 // failure naming the value and the limit, not a result.
 TEST(Calibrate, AValueBeyondTheSceneLimitIsAFailure) {
@@ -332,7 +426,7 @@ TEST(Calibrate, AValueBeyondTheSceneLimitIsAFailure) {
   heavy.bodies[0].inertia_kgm2 = 50.0;
   heavy.resistances[0].coefficient = 1e4;
   CalibrationOptions opt = calibration_options_of(heavy, 20.0, 0.0, "drive");
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   Progress quiet(false);
   const std::string m = failure_of(heavy, opt);
   EXPECT_NE(m.find("needs drive = 1.25664e+06 N·m"), std::string::npos) << m;
@@ -349,7 +443,7 @@ TEST(Calibrate, ALoadWithNothingLeftToDoNamesTheOtherDrives) {
   auto scene = models::load_scene("bicycle-muscle");
   scene.joint_torques.push_back({"extra", "hip_r", 1.0, std::nullopt, std::nullopt});
   CalibrationOptions opt = calibration_options_of(scene, 1.0, 125.0, "extra");
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   Progress quiet(false);
   try {
     calibrate(scene, opt, quiet);
@@ -418,7 +512,7 @@ TEST(Calibrate, ConstantMagnitudeResistanceCannotSetTheCadence) {
 TEST(Calibrate, AnUnbalancedReducedCycleIsAFailure) {
   const auto scene = models::load_scene("bicycle");
   CalibrationOptions opt = calibration_options_of(scene, 1.0, 1e-3, "");
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   const std::string m = failure_of(scene, opt);
   EXPECT_NE(m.find("the resistances dissipate 0.001 W"), std::string::npos) << m;
   EXPECT_NE(m.find("--grid-deg"), std::string::npos) << m;
@@ -473,7 +567,7 @@ TEST(Calibrate, WrittenSceneCarriesTheLoadValue) {
       flywheel_yaml("  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n");
   const auto scene = models::parse_scene(text, "flywheel.yaml");
   CalibrationOptions opt = calibration_options_of(scene, 2.0, 0.0, "motor");
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   Progress quiet(false);
   const auto r = calibrate(scene, opt, quiet);
   const std::string out = calibrated_scene_yaml("flywheel.yaml", text, {}, scene, opt, r);

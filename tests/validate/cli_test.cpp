@@ -249,6 +249,9 @@ TEST_F(Cli, CalibrateNamedLoad) {
   EXPECT_NE(r.output.find("\"load_value\": 0.43248724"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("drive_torque_Nm"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("\"target_power_w\": null"), std::string::npos) << r.output;
+  // The confirming run: 7 reduced periods (2 % more), 7 whole revolutions, steady at once.
+  EXPECT_NE(r.output.find("\"full_revolutions\": 7,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"full_duration_s\": 3.5"), std::string::npos) << r.output;  // 3.57 s
   r = rdyn("calibrate " + scene + " --load nope");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("field '--load': no joint_torque, point_force or motor named 'nope'"), std::string::npos) << r.output;

@@ -17,7 +17,7 @@ namespace rdyn::validate {
 namespace {
 
 CalibrationResult run(const models::Scene& scene, CalibrationOptions opt, bool direct) {
-  opt.full_check_s = 0;
+  opt.full_max_s = 0;
   opt.direct = direct;
   Progress quiet(false);
   return calibrate(scene, opt, quiet);

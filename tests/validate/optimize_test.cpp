@@ -53,7 +53,7 @@ TEST(Optimize, ConstantTorqueIsOptimalForACentripetalForce) {
   // The constant strategy: closed forms, and calibrate() on the unprofiled scene.
   EXPECT_NEAR(r.constant.amplitude, 40.0 / omega, 1e-8);
   CalibrationOptions copt = calibration_options_of(scene, 2.0, 40.0, "");
-  copt.full_check_s = 0;
+  copt.full_max_s = 0;
   const auto cal = calibrate(scene, copt, quiet);
   EXPECT_NEAR(r.constant.amplitude, cal.load_value, 1e-6 * cal.load_value);
   EXPECT_NEAR(r.constant.peak_reduced_N, 2.0 * 0.1 * omega * omega, 1e-6 * 2.0 * 0.1 * omega * omega);

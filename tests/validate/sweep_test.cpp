@@ -233,7 +233,7 @@ TEST(Sweep, ReusedTableGivesTheCaseItsOwnCalibration) {
           "bicycle", {{"bicycle_leg.subject.height_m", fmt::format("{:.17g}", h)},
                       {"bicycle_leg.resistance.power_W", fmt::format("{:.17g}", p)}});
       CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
-      opt.full_check_s = 0.0;
+      opt.full_max_s = 0.0;
       Progress quiet(false);
       const auto own = calibrate(scene, opt, quiet);
       EXPECT_NE(line.find(fmt::format(",ok,{:.10g},", own.load_value)), std::string::npos)
