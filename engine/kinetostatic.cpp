@@ -68,7 +68,8 @@ void project(const FullModel::Impl& m, State& s, double q_for_message) {
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
-                                  m.scene.source_file, m.scene.independent, q_for_message, describe_simbody_exception(e)));
+                                  m.scene.source_file, m.scene.independent, q_for_message,
+                                  describe_simbody_exception(e)));
   }
 }
 

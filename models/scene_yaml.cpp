@@ -835,8 +835,9 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
                {"type", "name", "joint", "stall_torque_Nm", "stall_force_N", "no_load_speed_rad_s",
                 "no_load_speed_m_s"});
       Motor m{name, f.str("joint"), 0.0, 0.0};
-      for (const auto& [torque_key, force_key] : {std::pair<std::string, std::string>{"stall_torque_Nm", "stall_force_N"},
-                                                  {"no_load_speed_rad_s", "no_load_speed_m_s"}}) {
+      using Keys = std::pair<std::string, std::string>;  // revolute's key, prismatic's key
+      for (const auto& [torque_key, force_key] :
+           {Keys{"stall_torque_Nm", "stall_force_N"}, Keys{"no_load_speed_rad_s", "no_load_speed_m_s"}}) {
         if (f.has(torque_key) && f.has(force_key))
           f.fail(torque_key, fmt::format("give {} (revolute) or {} (prismatic), not both", torque_key, force_key));
         check_unit_key(f, s, m.joint, torque_key, force_key);

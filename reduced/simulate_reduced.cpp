@@ -349,7 +349,8 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
   const int st = d.evolve_apply(&t, t_end, &d.h, d.y);
   if (st != GSL_SUCCESS)
-    throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s (q = {:.9g}, q̇ = {:.6g}): {}",
+    throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s (q = {:.9g}, q̇ = {:.6g}): "
+                                             "{}",
                                              t_prev, y_prev[0], y_prev[1], describe_gsl_failure(st, d.h)));
   ++d.steps;
   d.end = d.end_point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)

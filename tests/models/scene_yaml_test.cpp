@@ -406,7 +406,8 @@ TEST(SceneYaml, AValueKeyInTheOtherJointsUnitIsRefusedNamingTheRightKey) {
   const std::string revolute_force = fb + "  - {type: joint_torque, name: d, joint: crank, force_N: 2}\n";
   expect_refused(revolute_force, "loads[1].force_N", "joint 'crank' is revolute (torques in N·m, speeds in rad/s): "
                  "give torque_Nm instead of force_N", "name: d");
-  const std::string slider_motor = with(sc, "joint: crank, stall_torque_Nm: 6.0", "joint: slider, stall_torque_Nm: 6.0");
+  const std::string slider_motor =
+      with(sc, "joint: crank, stall_torque_Nm: 6.0", "joint: slider, stall_torque_Nm: 6.0");
   const SceneError e = refusal(slider_motor);
   EXPECT_EQ(e.field(), "loads[0].stall_torque_Nm") << e.what();
   EXPECT_NE(e.message().find("joint 'slider' is prismatic (forces in N, speeds in m/s): give stall_force_N instead "

@@ -750,15 +750,19 @@ void issue23(std::vector<Case>& cs) {
   const int fb_lines = static_cast<int>(std::count(fb.begin(), fb.end(), '\n'));
   for (const std::string cmd : {"simulate", "inspect"})
     cs.push_back({"second_yaml_document_" + cmd,
-                  cmd == "inspect" ? std::vector<std::string>{cmd, "s.yaml"} : std::vector<std::string>{cmd, "s.yaml", "--out", "o"},
+                  cmd == "inspect" ? std::vector<std::string>{cmd, "s.yaml"}
+                                   : std::vector<std::string>{cmd, "s.yaml", "--out", "o"},
                   2,
                   fmt::format("s.yaml:{}: a second YAML document (after '---')", fb_lines + 1),
                   {{"s.yaml", fb + "---\ngravity: {enabled: false}\n"}}, nullptr, "o"});
   // A value key in the other joint type's unit was read in the joint's own unit.
   const std::string sc = scene_text("slider-crank");
-  const int load_line = 1 + static_cast<int>(std::count(sc.begin(), sc.begin() + static_cast<long>(sc.find("joint: slider, force_N")), '\n'));
-  const int motor_line = 1 + static_cast<int>(std::count(sc.begin(), sc.begin() + static_cast<long>(sc.find("stall_torque_Nm")), '\n'));
-  for (const auto& [tag, from, to, message] : std::vector<std::tuple<std::string, std::string, std::string, std::string>>{
+  auto line_of = [](const std::string& text, const std::string& what) {
+    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find(what)), '\n'));
+  };
+  const int load_line = line_of(sc, "joint: slider, force_N"), motor_line = line_of(sc, "stall_torque_Nm");
+  using Edit = std::tuple<std::string, std::string, std::string, std::string>;  // tag, from, to, message
+  for (const auto& [tag, from, to, message] : std::vector<Edit>{
            {"torque_on_prismatic", "joint: slider, force_N:", "joint: slider, torque_Nm:",
             fmt::format("s.yaml:{}: field 'loads[1].torque_Nm': joint 'slider' is prismatic (forces in N, speeds in "
                         "m/s): give force_N instead of torque_Nm", load_line)},
@@ -782,8 +786,9 @@ void issue23(std::vector<Case>& cs) {
                 nullptr, "s.csv"});
   cs.push_back({"sweep_threads_hex", with(sweep, {"--threads", "0x10", "--out", "s.csv"}), 2,
                 "--threads: expected a whole decimal number, got '0x10'", {}, nullptr, "s.csv"});
-  cs.push_back({"sweep_vary_hex", {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=0x3c:70:2", "--out", "s.csv"},
-                2, "a of a:b:n: expected a decimal number, got '0x3c'", {}, nullptr, "s.csv"});
+  cs.push_back({"sweep_vary_hex",
+                {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=0x3c:70:2", "--out", "s.csv"}, 2,
+                "a of a:b:n: expected a decimal number, got '0x3c'", {}, nullptr, "s.csv"});
   cs.push_back({"simulate_duration_hex", {"simulate", "fourbar", "--duration", "0x10", "--out", "o"}, 2,
                 "--duration: expected a decimal number, got '0x10' (digits 0-9 only", {}, nullptr, "o"});
   cs.push_back({"simulate_duration_underflows", {"simulate", "fourbar", "--duration", "1e-400", "--out", "o"}, 2,
@@ -813,8 +818,7 @@ void issue23(std::vector<Case>& cs) {
     fb2 = edit(fb2, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
                "    - {name: rocker_axial, joint: rocker, direction: C}\n    - {name: x, joint: rocker, direction: C}\n"
                "    - {name: x_b, joint: rocker, direction: C}\n");
-    const int x_b_line =
-        1 + static_cast<int>(std::count(fb2.begin(), fb2.begin() + static_cast<long>(fb2.find("name: x_b")), '\n'));
+    const int x_b_line = line_of(fb2, "name: x_b");
     for (const std::string cmd : {"simulate", "extract"})
       cs.push_back({"column_collision_" + cmd, {cmd, "s.yaml", "--out", "o"}, 2,
                     fmt::format("s.yaml:{}: field 'outputs.constraint_forces[2].name': constraint force 'x' with joint "
@@ -825,8 +829,7 @@ void issue23(std::vector<Case>& cs) {
     const std::string reserved = edit(fb, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
                                       "    - {name: rocker_axial, joint: rocker, direction: C}\n"
                                       "    - {name: R_crank_cx, joint: crank, direction: [1, 0]}\n");
-    const int reserved_line =
-        1 + static_cast<int>(std::count(reserved.begin(), reserved.begin() + static_cast<long>(reserved.find("R_crank_cx")), '\n'));
+    const int reserved_line = line_of(reserved, "R_crank_cx");
     cs.push_back({"reserved_reaction_line_name", {"simulate", "s.yaml", "--model", "reduced", "--out", "o"}, 2,
                   fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_cx' is reserved",
                               reserved_line),
