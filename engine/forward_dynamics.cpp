@@ -176,7 +176,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   try {
     stepper.initialize(s);
   } catch (const std::exception& e) {
-    throw models::NumericalError(std::string("cannot start the full model: ") + e.what());
+    throw models::NumericalError(std::string("cannot start the full model: ") + describe_simbody_exception(e));
   }
 
   m.events_handled = 0;
@@ -185,7 +185,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   ts.forces.resize(ts.force_names.size());
   ts.column_names = reduced::joint_output_names(m.scene);
   ts.columns.resize(ts.column_names.size());
-  const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
+  const long n = models::calc_output_rows(opt.duration_s, opt.output_interval_s);  // the last at t = duration
   record(m, integ->getState(), ts);
   check_finite_row(ts);
   // Largest kinetic energy and |W| seen [J]: with max|E| the scale of the energy-balance test.
@@ -205,7 +205,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   m.system.realize(integ->getState(), Stage::Position);
   check_point_force_lines(m, integ->getState(), line_dir);
   for (long i = 1; i <= n; ++i) {
-    const double t = std::min(opt.duration_s, i * opt.output_interval_s);
+    const double t = models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s);
     try {
       while (integ->getTime() < t - 1e-14) {
         const double t_before = integ->getTime(), q_before = m.joint_q(integ->getState(), m.independent);
@@ -260,7 +260,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
       }
       throw models::NumericalError(
           fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}", integ->getTime(),
-                      integ->getPreviousStepSizeTaken(), e.what()));
+                      integ->getPreviousStepSizeTaken(), describe_simbody_exception(e)));
     }
     record(m, integ->getState(), ts);
     check_finite_row(ts);

@@ -4,7 +4,9 @@
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
 
+#include <cctype>
 #include <cmath>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -406,7 +408,7 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     default_state = system.realizeTopology();
     system.realizeModel(default_state);
   } catch (const std::exception& e) {
-    throw EngineError(std::string("Simbody could not build the system: ") + e.what());
+    throw EngineError(std::string("Simbody could not build the system: ") + describe_simbody_exception(e));
   }
 }
 
@@ -524,5 +526,41 @@ FullWorkspace::FullWorkspace(const FullModel& model)
 
 FullWorkspace::~FullWorkspace() = default;
 FullWorkspace::FullWorkspace(FullWorkspace&&) noexcept = default;
+
+std::string describe_simbody_error(const std::string& what) {
+  std::string text = what;
+  const std::string thrown = "SimTK Exception thrown at ";  // then "<file>:<line>:\n  "
+  if (text.rfind(thrown, 0) == 0) {
+    const auto nl = text.find('\n');
+    text.erase(0, nl == std::string::npos ? text.size() : nl + 1);
+  }
+  // The condition Simbody checked, then its words without the "(Required condition …)" line.
+  std::string condition;
+  for (const char* tag : {"(Required condition '", "(Assertion '"}) {
+    const auto at = text.find(tag);
+    if (at == std::string::npos) continue;
+    const auto start = at + std::strlen(tag), end = text.find('\'', start);
+    condition = text.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    text.erase(at);
+  }
+  std::string line;  // whitespace (newlines included) collapsed
+  for (char c : text) {
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      if (!line.empty() && line.back() != ' ') line += ' ';
+    } else {
+      line += c;
+    }
+  }
+  const std::string prefix = "Error detected by Simbody method ";
+  if (line.rfind(prefix, 0) == 0) line.erase(0, prefix.size());
+  while (!line.empty() && (line.back() == ' ' || line.back() == ':' || line.back() == '.')) line.pop_back();
+  // Conditions a run on valid input meets, in words.
+  if (condition == "t1 > t0")
+    return "the integrator's step shrank to zero length while it located a load switch (switches closer together "
+           "than the time can resolve at this t: a gate that switches back at once, or a run too long for its "
+           "tolerance; Simbody found an event interval of zero length)";
+  if (condition.empty()) return line;
+  return line + " [Simbody's condition: " + condition + "]";
+}
 
 }  // namespace rdyn::engine

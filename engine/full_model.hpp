@@ -70,4 +70,12 @@ class FullWorkspace {
   std::unique_ptr<Impl> impl_;
 };
 
+// An exception's text for a user, for the engine's messages: Simbody's texts lose their source
+// file, line and boilerplate ("SimTK Exception thrown at Integrator.cpp:…:", "Required
+// condition 't1 > t0' was not met") and come on one line, what failed in words, the checked
+// condition as a hint; the integrator's zero-length event interval (t1 > t0) is said as what
+// happened. Other texts pass through on one line.
+std::string describe_simbody_error(const std::string& what);
+inline std::string describe_simbody_exception(const std::exception& e) { return describe_simbody_error(e.what()); }
+
 }  // namespace rdyn::engine

@@ -68,7 +68,8 @@ void project(const FullModel::Impl& m, State& s, double q_for_message) {
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
-                                  m.scene.source_file, m.scene.independent, q_for_message, e.what()));
+                                  m.scene.source_file, m.scene.independent, q_for_message,
+                                  describe_simbody_exception(e)));
   }
 }
 
@@ -166,7 +167,7 @@ void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
-                                  m.scene.source_file, m.scene.independent, q, e.what()));
+                                  m.scene.source_file, m.scene.independent, q, describe_simbody_exception(e)));
   }
 }
 
@@ -402,7 +403,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
-                                  m.scene.source_file, m.scene.independent, q, e.what()));
+                                  m.scene.source_file, m.scene.independent, q, describe_simbody_exception(e)));
   }
   m.system.realize(s, Stage::Position);
   const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());

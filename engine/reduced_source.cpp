@@ -57,7 +57,7 @@ auto FullKinetostaticSource::at(double q, F&& call, bool from_anchor) {
             "{}: the independent coordinate '{}' cannot move from {:.6g} to {:.6g} {}: a dead point of the mechanism "
             "lies in between (the loops cannot close beyond it). A reduced table's range must lie between the "
             "mechanism's dead points: declare independent_range inside them, or leave it out and rdyn finds them. ({})",
-            sc.source_file, sc.independent, q_start * k, q * k, rev ? "degrees" : "m", e.what()));
+            sc.source_file, sc.independent, q_start * k, q * k, rev ? "degrees" : "m", describe_simbody_exception(e)));
       }
       ws_.impl().state.updQ() = q_backup;  // back to the last good configuration
       q_now_ = q_start;

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
+#include <utility>
+#include <vector>
 
 namespace rdyn::models {
 
@@ -192,6 +195,49 @@ void check_profile(const Checker& c, const std::string& f, const LoadProfile& p,
     c.fail(f + "." + value_key,
            fmt::format("the profiled load can reach {:g} {} (|amplitude {:g}| × profile bound {:g}); at most {:g}",
                        bound, unit, value, calc_profile_bound(p), limits::kMaxForce));
+}
+
+// Names that become reduced-table columns (reduced/extract.cpp) must give each column one
+// meaning; found here so the refusal names the scene's field and line, not a bare "duplicate
+// column" from the extraction (issue #23).
+// - The reduced model's own reaction lines are constraint forces named R_<joint>_cx and
+//   R_<joint>_cy (reduced/joint_outputs.hpp, internal_request_name): a scene's force may not
+//   take such a name.
+// - Columns named from two names, rx_<force>_<joint>, wx_<force>_<body> and
+//   Qxpf_<force>_<point force>, meet when underscores shift between the two: force 'a_b' with
+//   joint 'c' and force 'a' with joint 'b_c' both make rx_a_b_c.
+void check_table_column_names(const Checker& c, const Scene& s) {
+  const auto& cf = s.outputs.constraint_forces;
+  std::vector<std::pair<std::string, std::string>> forces;  // name, field that gives it
+  for (size_t i = 0; i < cf.size(); ++i) {
+    const std::string field = fmt::format("outputs.constraint_forces[{}].name", i);
+    for (const auto& j : s.joints)
+      for (const char* axis : {"_cx", "_cy"})
+        if (cf[i].name == "R_" + j.name + axis)
+          c.fail(field, fmt::format("'{}' is reserved: the reduced model names its own reaction lines R_<joint>_cx "
+                                    "and R_<joint>_cy; choose another name",
+                                    printable(cf[i].name)));
+    forces.push_back({cf[i].name, field});
+  }
+  if (!s.outputs.reactions.empty())  // the reaction lines the reduced model adds (a superset)
+    for (const auto& j : s.joints)
+      for (const char* axis : {"_cx", "_cy"}) forces.push_back({"R_" + j.name + axis, "outputs.reactions"});
+  std::map<std::string, std::string> made;  // column → what makes it
+  auto add = [&](const std::string& prefix, const std::pair<std::string, std::string>& force, const char* kind,
+                 const std::string& other) {
+    const std::string column = prefix + force.first + "_" + other;
+    const std::string what = fmt::format("constraint force '{}' with {} '{}'", force.first, kind, other);
+    const auto [it, inserted] = made.emplace(column, what);
+    if (!inserted && it->second != what)
+      c.fail(force.second, fmt::format("{} and {} both make the reduced table's column '{}'; rename one of them so "
+                                       "each column has one meaning",
+                                       it->second, what, printable(column)));
+  };
+  for (const auto& f : forces) {
+    for (const auto& j : s.joints) add("rx_", f, "joint", j.name);
+    for (const auto& r : s.resistances) add("wx_", f, "body", r.body);
+    for (const auto& pf : s.point_forces) add("Qxpf_", f, "point force", pf.name);
+  }
 }
 
 }  // namespace
@@ -412,6 +458,7 @@ void check_scene(const Scene& s) {
     // constraint actuator's sliders follow it (engine/full_model.cpp).
     c.direction(f + ".direction", cf.direction);
   }
+  check_table_column_names(c, s);
   {
     std::set<std::string> seen;
     for (size_t i = 0; i < s.outputs.bodies.size(); ++i) {

@@ -33,6 +33,19 @@ struct TimeSeries {
   RunStats stats;
 };
 
+// The output grid of a run: rows at t = i·interval for i = 0…n−1 and a last row at t =
+// duration, also when the interval does not divide it (1 s at 0.3 s: 0, 0.3, 0.6, 0.9, 1), so
+// the final state is always written. calc_output_rows is n + 1 without the t = 0 row, i.e. the
+// rows after the start; a quotient within 1e-9 of a whole number counts as whole (1 s / 0.1 s
+// is 10.000000000000002), so no sliver row appears next to the last one.
+inline long calc_output_rows(double duration_s, double interval_s) {
+  return static_cast<long>(std::ceil(duration_s / interval_s - 1e-9));
+}
+// Time of row i (1…rows) of that grid; the last is exactly the duration.
+inline double calc_output_time(long i, long rows, double duration_s, double interval_s) {
+  return i >= rows ? duration_s : std::min(duration_s, static_cast<double>(i) * interval_s);
+}
+
 // Energy balance of a simulated motion: E(t) − E(0) = W(t), the work of the non-conservative
 // loads integrated next to the motion, so the residual max|E − E0 − W| measures what the
 // integration lost or invented [J]; the largest |E| seen is its natural scale [J].

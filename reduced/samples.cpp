@@ -25,8 +25,14 @@ int Samples::column(const std::string& name) const {
 
 int Samples::require(const std::string& name) const {
   const int c = column(name);
-  if (c < 0) throw TableError("reduced table has no column '" + name + "'");
-  return c;
+  if (c >= 0) return c;
+  // A table read from a file names the file and its header line: that is where the column is missing.
+  const std::string shown = name.substr(0, 80);
+  if (file.empty()) throw TableError("the reduced table has no column '" + shown + "', which the scene needs");
+  throw TableError(fmt::format("{}:{}: the column header has no column '{}', which the scene needs (its constraint "
+                               "forces, loads and outputs): extract the table again from this scene with `rdyn "
+                               "extract`",
+                               file, header_line, shown));
 }
 
 const std::vector<double>* Samples::roots_of(const std::string& column) const {
@@ -232,6 +238,7 @@ Samples parse_samples_csv(const std::string& text, const std::string& name) {
   if (header.empty() || (header[0] != "q_deg" && header[0] != "q_m")) fail(ln, "first column must be q_deg or q_m");
   s.revolute = header[0] == "q_deg";
   const long header_line = ln;
+  s.header_line = ln;
   for (size_t c = 1; c < header.size(); ++c) {
     if (!known_column(header[c]))
       fail(ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*, p_*, k_*, tau_*, Qpf_*, Qxpf_*)",
@@ -262,6 +269,15 @@ Samples parse_samples_csv(const std::string& text, const std::string& name) {
     if (c + 1 != header.size()) fail(ln, fmt::format("{} values, the header has {}", c + 1, header.size()));
   }
   if (s.q.size() < 4) fail(ln, "a reduced table needs at least 4 grid points");
+  // The reduced inertia is positive wherever the mechanism moves (Eksergian divides by it):
+  // refused here with its line, not later as a model that cannot be built.
+  if (const int c = s.column("m1"); c >= 0)
+    for (size_t i = 0; i < s.q.size(); ++i)
+      if (!(s.columns[c][i] > 0))
+        fail(header_line + 1 + static_cast<long>(i),
+             fmt::format("column 'm1' (the reduced inertia, kg·m² or kg) must be positive, got {:g}; extract the "
+                         "table again with `rdyn extract`",
+                         s.columns[c][i]));
   // The grid: increasing, equally spaced by step, starting at q0; a periodic one covers one turn.
   const double tol = 1e-9 * std::max(1.0, std::abs(s.q0) + s.step * static_cast<double>(s.q.size()));
   if (std::abs(s.q[0] - s.q0) > tol) fail(header_line + 1, "the first grid point differs from field 'q0'");

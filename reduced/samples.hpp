@@ -34,6 +34,7 @@ struct Samples {
   // scene with another hash. Empty only for samples assembled by hand.
   std::optional<std::uint64_t> scene_hash;
   std::string file;          // the file it was read from (for messages); empty when extracted
+  long header_line = 0;      // line of the column header in `file` (for messages); 0 when extracted
   std::string method;        // extraction method
   bool periodic = true;      // one period 2π of a revolute coordinate
   bool revolute = true;      // q in radians (q_deg column) or metres (q_m)
@@ -54,7 +55,7 @@ struct Samples {
   const std::vector<double>* roots_of(const std::string& column) const;  // null when absent
 
   int column(const std::string& name) const;  // −1 when absent
-  int require(const std::string& name) const;  // throws TableError when absent
+  int require(const std::string& name) const;  // throws TableError (file and header line) when absent
   void add(const std::string& name, std::vector<double> values);
 };
 
@@ -76,7 +77,7 @@ void write_samples_csv(const std::string& path, const Samples& s);
 // Parses the text of a table; `name` is used in messages. Throws TableError naming the file,
 // line and field on malformed content: a missing or older header (re-extract), values that are
 // not finite, a grid that is not increasing and uniform, duplicate or unknown column names,
-// ragged rows, or a table over the limits above.
+// ragged rows, an m1 that is not positive, or a table over the limits above.
 Samples parse_samples_csv(const std::string& text, const std::string& name);
 // Reads a file (refusing one over kMaxTableBytes before reading it) and parses it.
 Samples read_samples_csv(const std::string& path);

@@ -57,6 +57,19 @@ void hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point
   work = h00 * a.work + h10 * H * a.power + h01 * b.work + h11 * H * b.power;
 }
 
+// What a GSL status means here, in plain words: GSL's own texts ("problem with user-supplied
+// function") name its API, not the run (issue #23).
+std::string describe_gsl_failure(int status, double h) {
+  if (status == GSL_EBADFUNC)
+    return "the reduced model's acceleration q̈ is not finite there (m1 reaches 0 or a table value is not finite "
+           "near this q: a finer grid, or a start farther from a dead point)";
+  if (status == GSL_FAILURE)
+    return fmt::format("the error control cannot shrink the step below {:.3g} s and still meet the tolerance (the "
+                       "motion is too stiff for it: loosen --reduced-tolerance or use a finer grid)",
+                       h);
+  return fmt::format("the integrator stopped with GSL status {} ({})", status, gsl_strerror(status));
+}
+
 // The edge of a range table's validity domain that q has crossed.
 double domain_edge(const ReducedModel& m, double q) {
   return q < m.table.q0 ? m.table.q0 : m.table.q0 + m.table.intervals * m.table.step;
@@ -336,7 +349,9 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
   const int st = d.evolve_apply(&t, t_end, &d.h, d.y);
   if (st != GSL_SUCCESS)
-    throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s: {}", t, gsl_strerror(st)));
+    throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s (q = {:.9g}, q̇ = {:.6g}): "
+                                             "{}",
+                                             t_prev, y_prev[0], y_prev[1], describe_gsl_failure(st, d.h)));
   ++d.steps;
   d.end = d.end_point(t, d.y);  // the raw step's end (Hermite needs it for event estimates)
   // What changed sign in this step: a gate's switching function (index ≥ 0) or q − q_stop (−2).
@@ -443,7 +458,7 @@ void check_reduced_options(const ReducedOptions& opt) {
   if (!(std::isfinite(opt.output_interval_s) && opt.output_interval_s > 0))
     throw TableError(
         fmt::format("reduced simulation output interval {:g} s must be finite and positive", opt.output_interval_s));
-  const double rows = std::floor(opt.duration_s / opt.output_interval_s) + 1;
+  const double rows = static_cast<double>(models::calc_output_rows(opt.duration_s, opt.output_interval_s)) + 1;
   if (!(rows <= static_cast<double>(kMaxOutputRows)))
     throw TableError(fmt::format(
         "reduced simulation: duration {:g} s / output interval {:g} s gives {:.3g} output rows, more than the limit of {}",
@@ -481,8 +496,8 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
   ts.force_names = m.force_names;
   ts.forces.resize(m.force_names.size());
   std::vector<double> f(m.force_names.size());
-  const long n = std::lround(std::floor(opt.duration_s / opt.output_interval_s + 1e-9));
-  auto t_out = [&](long i) { return std::min(opt.duration_s, i * opt.output_interval_s); };
+  const long n = models::calc_output_rows(opt.duration_s, opt.output_interval_s);  // the last at t = duration
+  auto t_out = [&](long i) { return models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s); };
   for (auto* v : {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work}) v->reserve(n + 1);
   for (auto& v : ts.forces) v.reserve(n + 1);
   ts.gates.reserve(n + 1);

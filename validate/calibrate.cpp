@@ -774,7 +774,9 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
         generated = true;
         continue;
       }
-      const std::string key = models::scene_yaml_has(text, "loads." + t.name + ".force_N") ? "force_N" : "torque_Nm";
+      // The joint's unit decides the key (scene_yaml refuses the other one).
+      const models::Joint* j = scene.find_joint(t.joint);
+      const std::string key = j && j->type == models::JointType::Prismatic ? "force_N" : "torque_Nm";
       o.push_back({"loads." + t.name + "." + key, num((t.value < 0 ? -1 : 1) * T)});
     }
     if (generated) o.push_back({"bicycle_leg.hip_torque_Nm", num(T)});

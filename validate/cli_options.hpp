@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "validate/decimal_number.hpp"
+
 namespace rdyn::validate {
 
 inline constexpr const char* kForceHelpDir =
@@ -46,6 +48,20 @@ inline void add_scene_overrides(CLI::App& cmd, std::vector<std::string>& sets) {
 inline void add_output_folder(CLI::App& cmd, std::string& out, bool& force) {
   cmd.add_option("--out", out, "Output folder (written atomically)")->required();
   cmd.add_flag("--force", force, kForceHelpDir);
+}
+
+// Every number option of `app` and its subcommands (and their option groups) reads its text as
+// a scene number: decimal only, nothing a double cannot hold (validate/decimal_number.hpp). Called
+// once after every option is declared, so no option is forgotten; the check sees the text as
+// typed, before CLI11 converts it, and its refusal names the option (exit 2).
+inline void require_decimal_numbers(CLI::App& app) {
+  for (CLI::Option* o : app.get_options()) {
+    const std::string type = o->get_type_name();
+    const bool whole = type == "INT" || type == "UINT";
+    if (!whole && type != "FLOAT") continue;
+    o->check(CLI::Validator([whole](std::string& text) { return check_decimal_number(text, whole); }, ""));
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) require_decimal_numbers(*sub);
 }
 
 }  // namespace rdyn::validate

@@ -340,15 +340,16 @@ int run_sweep_command(const SweepArgs& a) {
   SweepOptions o;
   o.scene = a.scene;
   o.sets = a.sets;
-  o.cadence_hz = a.cadence_hz;
-  o.power_w = a.power_w;
+  o.cadence_hz = a.cadence_hz.value_or(0.0);  // SweepOptions: 0 is the scene's
+  o.power_w = a.power_w.value_or(0.0);
   o.load = a.load;
-  o.threads = a.threads;
+  o.threads = a.threads.value_or(0);  // 0: the hardware's threads
   o.grid_deg = a.grid_deg;
   require_grid("--grid-deg", a.grid_deg);
-  if (a.threads != 0) require_in("--threads", a.threads, 1, kMaxThreads, "");
-  if (a.cadence_hz != 0) require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
-  if (a.power_w != 0) require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
+  // A typed value is checked even when it is 0: `--threads 0` meant no default (issue #23).
+  if (a.threads) require_in("--threads", *a.threads, 1, kMaxThreads, "");
+  if (a.cadence_hz) require_positive_up_to("--cadence-hz", *a.cadence_hz, kMaxCadence_Hz, " Hz");
+  if (a.power_w) require_positive_up_to("--power-w", *a.power_w, kMaxPower_W, " W");
   {
     int used = 0;
     if (std::sscanf(a.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 ||

@@ -91,8 +91,8 @@ struct SweepArgs {
   std::vector<std::string> sets;
   std::string out;
   std::string shard = "0/1";
-  int threads = 0;
-  double cadence_hz = 0.0, power_w = 0.0;
+  std::optional<int> threads;                  // none: the hardware's threads
+  std::optional<double> cadence_hz, power_w;   // none: the scene's validation.calibrate
   std::string load;  // --load, as for calibrate
   double grid_deg = 10.0;
   bool force = false;

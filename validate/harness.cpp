@@ -139,6 +139,11 @@ ValidationResult describe(const models::Scene& scene) {
   v.machine = machine_description();
   v.duration_s = scene.validation.duration_s > 0 ? scene.validation.duration_s : scene.simulation.duration_s;
   v.output_interval_s = scene.simulation.output_interval_s;
+  // Runs are compared row by row, and the MuJoCo peer fills every output interval with whole
+  // steps: validation spans whole output intervals (the rows up to the duration, as every run
+  // ended before `simulate` wrote a last row at the duration itself).
+  const double whole = std::floor(v.duration_s / v.output_interval_s + 1e-9);
+  if (whole >= 1) v.duration_s = std::min(v.duration_s, whole * v.output_interval_s);
   v.headline_quantity = scene.outputs.constraint_forces.empty() ? "qdot" : scene.outputs.constraint_forces[0].name;
   v.quantities = {"qdot"};
   for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);

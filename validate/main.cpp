@@ -154,11 +154,14 @@ int main(int argc, char** argv) {
   sweep->add_option("--out", sw.out, "Output CSV file")->required();
   sweep->add_flag("--force", sw.force, kForceHelpFile);
   sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
-  sweep->add_option("--threads", sw.threads, "Worker threads (default: hardware threads)");
-  sweep->add_option("--cadence-hz", sw.cadence_hz, "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
-  sweep->add_option("--power-w", sw.power_w,
-                    "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as "
-                    "given)");
+  // Typed values are kept apart from the defaults, so a typed 0 is refused instead of meaning "default".
+  sweep->add_option_function<int>("--threads", [&sw](const int& v) { sw.threads = v; },
+                                  "Worker threads, 1..256 (default: hardware threads)");
+  sweep->add_option_function<double>("--cadence-hz", [&sw](const double& v) { sw.cadence_hz = v; },
+                                     "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
+  sweep->add_option_function<double>(
+      "--power-w", [&sw](const double& v) { sw.power_w = v; },
+      "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as given)");
   sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load);
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
 
@@ -246,6 +249,7 @@ int main(int argc, char** argv) {
   expand->add_option("--out", exp.out, "Output YAML file (default: standard output)");
   expand->add_flag("--force", exp.force, kForceHelpFile);
 
+  require_decimal_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

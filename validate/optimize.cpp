@@ -113,10 +113,15 @@ Design resolve_design(const models::Scene& s, const models::OptimizeSpec& spec, 
   d.H = opt.harmonics > 0 ? opt.harmonics : spec.harmonics;
   d.of = spec.of.empty() ? s.independent : spec.of;
   const double max_load = opt.max_load > 0 ? opt.max_load : spec.max_load;
-  auto index_of = [&](const std::string& name) {
+  // `key`: the design entry's own key (its line, or its --set), when the name comes from the block.
+  auto index_of = [&](const std::string& name, const std::string& key) {
     for (size_t i = 0; i < s.joint_torques.size(); ++i)
       if (s.joint_torques[i].name == name) return i;
-    fail("optimize.loads", "no joint_torque named '" + name + "'");
+    const std::string msg = "no joint_torque named '" + name + "' to design (design loads are the scene's joint "
+                            "torques as loaded, --set overrides applied)";
+    if (!key.empty() && (s.line_of(key) > 0 || s.field_of(key) != key))
+      throw models::SceneError(s.source_file, s.line_of(key), s.field_of(key), msg);
+    fail("optimize.loads", msg);
     return size_t(0);
   };
   std::vector<models::OptimizeLoad> listed = spec.loads;
@@ -126,9 +131,10 @@ Design resolve_design(const models::Scene& s, const models::OptimizeSpec& spec, 
           t.name != "torque_" + t.joint)
         listed.push_back({t.name, "", 0.0});
   std::vector<std::string> group_of_name;
-  for (const auto& l : listed) {
+  for (size_t k = 0; k < listed.size(); ++k) {
+    const auto& l = listed[k];
     DesignLoad dl;
-    dl.torque = index_of(l.load);
+    dl.torque = index_of(l.load, spec.loads.empty() ? "" : fmt::format("optimize.loads[{}].load", k));
     if (l.same_as.empty()) {
       dl.group = static_cast<int>(d.groups.size());
       Group g;
@@ -148,7 +154,7 @@ Design resolve_design(const models::Scene& s, const models::OptimizeSpec& spec, 
   }
   for (const auto& j : opt.add_torques) {  // signed shapes of their own, starting from zero
     DesignLoad dl;
-    dl.torque = index_of("torque_" + j);
+    dl.torque = index_of("torque_" + j, "");
     dl.group = static_cast<int>(d.groups.size());
     Group g;
     g.fixed_a0 = d.groups.empty();

@@ -82,7 +82,8 @@ std::vector<std::string> entries_below(const fs::path& root) {
   std::error_code ec;
   for (auto it = fs::recursive_directory_iterator(root, fs::directory_options::none, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    std::string rel = fs::relative(it->path(), root, ec).string();
+    // Lexically: fs::relative resolves links and gave '' for every entry of /proc/self (issue #23).
+    std::string rel = it->path().lexically_relative(root).string();
     if (it->is_directory(ec) && !it->is_symlink(ec)) rel += "/";
     out.push_back(rel);
   }
@@ -166,6 +167,12 @@ OutputDir::OutputDir(std::string final_path, bool force) {
   const fs::path target = resolve_links(final_path);
   if (target == target.root_path() || target.filename() == "." || target.filename() == "..")
     throw OutputError(final_path + ": not a folder rdyn can write its results to");
+  // The kernel's file systems hold processes and devices, never results (a folder under /dev,
+  // such as /dev/shm, is an ordinary one and goes through the checks below).
+  for (const std::string sys : {"/proc", "/sys"})
+    if (target == fs::path(sys) || target.string().rfind(sys + "/", 0) == 0)
+      throw OutputError(final_path + ": lies in " + sys + ", the kernel's own file system, not a folder rdyn can " +
+                        "write its results to; choose another --out");
   final_ = target.string();
   created_ = make_parents(final_path, target);
   std::error_code ec;
@@ -221,15 +228,30 @@ void OutputDir::commit() {
     for (const auto& f : kept)
       if (fs::is_regular_file(target / f, ec)) still_there.insert(f);
     write_manifest(tmp_, still_there);
-    for (const auto& e : entries_below(tmp_)) {
+    const auto entries = entries_below(tmp_);
+    // Every destination is checked before the first move: a refusal half-way had already
+    // replaced the user's run.json and left a manifest behind (issue #23). Nothing is changed
+    // when one of them cannot take rdyn's entry.
+    for (const auto& e : entries) {
+      // Without the folder's trailing '/': "figures/" of a file called figures does not exist.
+      const fs::path to = target / (e.back() == '/' ? e.substr(0, e.size() - 1) : e);
+      const auto st = fs::symlink_status(to, ec);
+      if (!fs::exists(st)) continue;
+      if (e.back() == '/' && !fs::is_directory(fs::status(to, ec)))
+        throw OutputError(final_ + "/" + e.substr(0, e.size() - 1) +
+                          ": exists and is not a folder; rdyn would write its folder of that name there. Nothing "
+                          "was written; move it away or choose another --out");
+      if (e.back() != '/' && fs::is_directory(st))
+        throw OutputError(final_ + "/" + e + ": is a folder; rdyn would write a file of that name there. Nothing "
+                          "was written; move it away or choose another --out");
+    }
+    for (const auto& e : entries) {
       const fs::path from = fs::path(tmp_) / e, to = target / e;
       if (e.back() == '/') {
         if (mkdir(to.c_str(), 0755) != 0 && errno != EEXIST)
           throw OutputError(final_ + "/" + e + ": cannot create: " + sys_error());
         continue;
       }
-      if (fs::is_directory(to, ec))
-        throw OutputError(final_ + "/" + e + ": is a folder; rdyn would write a file of that name");
       if (std::rename(from.c_str(), to.c_str()) != 0)
         throw OutputError(final_ + "/" + e + ": cannot move into place: " + sys_error());
     }

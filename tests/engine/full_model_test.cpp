@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -286,6 +287,28 @@ TEST(FullModelPointForce, CoincidentPointsAtAssemblyAreASceneErrorWithItsLine) {
   yaml.replace(yaml.find("q_deg: 0"), 8, "q_deg: 180");
   const FullModel ok(models::parse_scene(yaml, "ok.yaml"));
   EXPECT_NO_THROW(FullWorkspace{ok});
+}
+
+// Simbody's exception texts reach users as words: no source file and line, no boilerplate, one
+// line; the condition it checked as a hint; the integrator's zero-length event interval
+// (Required condition 't1 > t0', issue #23) said as what happened.
+TEST(SimbodyMessages, ExceptionTextsAreSaidInWords) {
+  // The texts as Simbody 3.7 formats them (SimTKcommon/internal/Exception.h: ErrorCheck,
+  // APIArgcheckFailed).
+  const std::string z = describe_simbody_error(
+      "SimTK Exception thrown at Integrator.cpp:412:\n  Error detected by Simbody method Integrator::stepTo(): Event "
+      "interval [2, 2] has no length.\n  (Required condition 't1 > t0' was not met.)\n");
+  EXPECT_EQ(z.rfind("the integrator's step shrank to zero length while it located a load switch", 0), 0u) << z;
+  const std::string bad = describe_simbody_error(
+      "SimTK Exception thrown at State.cpp:7:\n  Bad call to Simbody API method State::setN(): n=-1\nnot positive\n"
+      "  (Required condition 'n > 0' was not met.)");
+  EXPECT_EQ(bad, "Bad call to Simbody API method State::setN(): n=-1 not positive [Simbody's condition: n > 0]");
+  for (const std::string& m : {z, bad}) {
+    EXPECT_EQ(m.find("SimTK Exception thrown"), std::string::npos) << m;
+    EXPECT_EQ(m.find(".cpp"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+  EXPECT_EQ(describe_simbody_exception(std::runtime_error("plain\ntext")), "plain text");
 }
 
 }  // namespace

@@ -164,6 +164,20 @@ TEST(SceneYaml, MalformedEmptyAndBinaryInputsAreRefused) {
   EXPECT_NE(error_of(std::string(kFourbar).substr(0, 200)).find("test.yaml"), std::string::npos);
 }
 
+TEST(SceneYaml, ASecondDocumentIsRefusedAtItsMarker) {
+  // yaml-cpp's Load reads the first document only: what follows `---` was silently dropped.
+  const std::string fb = kFourbar;
+  const int marker_line = static_cast<int>(std::count(fb.begin(), fb.end(), '\n')) + 1;
+  for (const std::string second : {"---\nname: other\n", "---\n", "...\n---\ngravity: {enabled: false}\n"}) {
+    const SceneError e = refusal(fb + second);
+    EXPECT_EQ(e.file(), "test.yaml");
+    EXPECT_EQ(e.line(), marker_line + (second.rfind("...", 0) == 0 ? 1 : 0)) << second;
+    EXPECT_NE(e.message().find("second YAML document"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(parse_scene("---\n" + fb, "test.yaml"));  // one document with its marker
+  EXPECT_NO_THROW(parse_scene(fb + "...\n", "test.yaml"));   // one document with its end
+}
+
 TEST(SceneYaml, MissingSceneFileIsNamed) {
   try {
     load_scene("/nonexistent/scene.yaml");
@@ -364,6 +378,47 @@ loads:
   - {type: resistance, name: brake, body: wheel, law: viscous, dissipates: {power_W: 10, cadence_Hz: 1}}
 )";
   EXPECT_EQ(refusal(y).field(), "loads.brake.dissipates");
+}
+
+TEST(SceneYaml, AValueKeyInTheOtherJointsUnitIsRefusedNamingTheRightKey) {
+  // torque_Nm and force_N (stall_torque_Nm and stall_force_N, …) fill the same value: the
+  // wrong one was read in the joint's own unit without a word (issue #23).
+  const std::string sc = read_scene_text("slider-crank");
+  struct Case {
+    std::string from, to, field, right;
+  };
+  const Case cases[] = {
+      {"joint: slider, force_N: -40.0", "joint: slider, torque_Nm: -40.0", "loads[1].torque_Nm", "give force_N"},
+      {"stall_torque_Nm: 6.0, no_load_speed_rad_s: 60.0", "stall_force_N: 6.0, no_load_speed_rad_s: 60.0",
+       "loads[0].stall_force_N", "give stall_torque_Nm"},
+      {"stall_torque_Nm: 6.0, no_load_speed_rad_s: 60.0", "stall_torque_Nm: 6.0, no_load_speed_m_s: 60.0",
+       "loads[0].no_load_speed_m_s", "give no_load_speed_rad_s"},
+  };
+  for (const auto& c : cases) {
+    const std::string y = with(sc, c.from, c.to);
+    const SceneError e = refusal(y);
+    EXPECT_EQ(e.field(), c.field) << e.what();
+    EXPECT_EQ(e.line(), line_in(y, c.to)) << e.what();
+    EXPECT_NE(e.message().find(c.right), std::string::npos) << e.what();
+  }
+  // A force on a revolute joint's torque load; a motor on the slider with torque keys.
+  const std::string fb = kFourbar;
+  const std::string revolute_force = fb + "  - {type: joint_torque, name: d, joint: crank, force_N: 2}\n";
+  expect_refused(revolute_force, "loads[1].force_N", "joint 'crank' is revolute (torques in N·m, speeds in rad/s): "
+                 "give torque_Nm instead of force_N", "name: d");
+  const std::string slider_motor =
+      with(sc, "joint: crank, stall_torque_Nm: 6.0", "joint: slider, stall_torque_Nm: 6.0");
+  const SceneError e = refusal(slider_motor);
+  EXPECT_EQ(e.field(), "loads[0].stall_torque_Nm") << e.what();
+  EXPECT_NE(e.message().find("joint 'slider' is prismatic (forces in N, speeds in m/s): give stall_force_N instead "
+                             "of stall_torque_Nm"),
+            std::string::npos)
+      << e.what();
+  // The right keys load; so does the slider's motor in its own units.
+  EXPECT_NO_THROW(parse_scene(sc, "t.yaml"));
+  EXPECT_NO_THROW(parse_scene(with(slider_motor, "stall_torque_Nm: 6.0, no_load_speed_rad_s: 60.0",
+                                   "stall_force_N: 6.0, no_load_speed_m_s: 0.5"),
+                              "t.yaml"));
 }
 
 TEST(SceneYaml, AMotorRunningAwayIsRefused) {
@@ -705,7 +760,6 @@ TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
     std::string from, to, field, says;
   };
   const std::vector<Case> cases{
-      {"{load: hip_torque_r}", "{load: hip_torque_x}", "optimize.loads[0].load", "no joint_torque named"},
       {"same_as: hip_torque_r,", "same_as: hip_torque_l,", "optimize.loads[1].same_as", "its own shape"},
       {"{load: hip_torque_r}", "{load: hip_torque_r, same_as: hip_torque_l}", "optimize.loads[0].same_as",
        "takes its shape from"},
@@ -730,6 +784,13 @@ TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
     const std::string bad = with(y, c.from, c.to);
     EXPECT_GT(expect_refused(bad, c.field, c.says).line(), line_in(bad, "optimize:") - 1) << c.to;
   }
+  // A design load the scene does not make is `rdyn optimize`'s refusal (validate/optimize.cpp),
+  // not the reader's: with the drive off ("no drive") the generator makes no hip torques.
+  const Scene off = parse_scene(y, "b.yaml", {parse_override("bicycle_leg.hip_torque_Nm=0")});
+  EXPECT_TRUE(std::none_of(off.joint_torques.begin(), off.joint_torques.end(),
+                          [](const JointTorque& t) { return t.name == "hip_torque_r"; }));
+  EXPECT_EQ(off.line_of("optimize.loads[0].load"), line_in(y, "{load: hip_torque_r}"));
+  EXPECT_NO_THROW(parse_scene(with(y, "{load: hip_torque_l,", "{load: hip_torque_x,"), "b.yaml"));
   // pnorm with its exponent parses.
   const Scene p = parse_scene(with(y, "objective: peak", "objective: pnorm\n  p: 12"), "b.yaml");
   EXPECT_EQ(p.optimize->objective, "pnorm");

@@ -123,8 +123,9 @@ TEST(Samples, MalformedTablesNameFileLineAndField) {
     std::string text;
     const char* expected;  // substring of the message
   };
-  std::string uneven, decreasing, nan_value, inf_value, more_values;
+  std::string uneven, decreasing, nan_value, inf_value, more_values, negative_m1;
   for (int i = 0; i < 8; ++i) {
+    negative_m1 += fmt::format("{},{},0,1\n", 45 * i, i == 3 ? "-2" : "1");
     uneven += fmt::format("{},1,0,1\n", i == 5 ? 226 : 45 * i);
     decreasing += fmt::format("{},1,0,1\n", i == 3 ? 90 : 45 * i);
     nan_value += fmt::format("{},{},0,1\n", 45 * i, i == 2 ? "nan" : "1");
@@ -151,6 +152,8 @@ TEST(Samples, MalformedTablesNameFileLineAndField) {
       {"trailing garbage", table_text("", "q_deg,m1,m2,r_crank", "0,1x,0,1\n"), "not a finite number: '1x'"},
       {"uneven grid", table_text("", "q_deg,m1,m2,r_crank", uneven), "t.csv:9: grid points must increase, equally"},
       {"decreasing grid", table_text("", "q_deg,m1,m2,r_crank", decreasing), "t.csv:7: grid points must increase"},
+      {"negative m1", table_text("", "q_deg,m1,m2,r_crank", negative_m1),
+       "t.csv:7: column 'm1' (the reduced inertia, kg·m² or kg) must be positive, got -2"},
       {"too few points", table_text("", "q_deg,m1,m2,r_crank", "0,1,0,1\n45,1,0,1\n"), "at least 4 grid points"},
       {"not a full turn", table_text("", "q_deg,m1,m2,r_crank", "0,1,0,1\n45,1,0,1\n90,1,0,1\n135,1,0,1\n"),
        "exactly one turn"},
@@ -162,6 +165,22 @@ TEST(Samples, MalformedTablesNameFileLineAndField) {
   for (const auto& c : cases) {
     const std::string e = error_of(c.text);
     EXPECT_NE(e.find(c.expected), std::string::npos) << c.what << ": got '" << e << "'";
+  }
+}
+
+TEST(Samples, AMissingColumnNamesTheFileAndItsHeaderLine) {
+  std::string rows;
+  for (int i = 0; i < 8; ++i) rows += fmt::format("{},1,0,1\n", 45 * i);
+  const Samples s = parse_samples_csv(table_text("", "q_deg,m1,m2,r_crank", rows), "t.csv");
+  EXPECT_EQ(s.header_line, 3);
+  try {
+    s.require("me1_knee");
+    ADD_FAILURE() << "found";
+  } catch (const TableError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("t.csv:3: the column header has no column 'me1_knee', which the scene needs",
+                                          0),
+              0u)
+        << e.what();
   }
 }
 

@@ -197,6 +197,26 @@ TEST(SimulateReduced, NonFiniteOutputFailsTheRun) {
   }
 }
 
+TEST(SimulateReduced, AStepThatMeetsANonFiniteAccelerationSaysSoInPlainWords) {
+  // Finite at the start, −∞ from 90° on (m2 = 1e300 at q̇ = 1e10 overflows): GSL reports
+  // GSL_EBADFUNC, whose own text ("problem with user-supplied function") must not reach users.
+  test::AnalyticSource src;
+  ExtractOptions eo;
+  eo.step_rad = 10 * M_PI / 180;
+  const auto scene = test::analytic_scene();
+  auto s = extract_samples(src, scene, eo);
+  auto& m2 = s.columns[s.require("m2")];
+  for (size_t i = 0; i < s.q.size(); ++i)
+    if (s.q[i] >= M_PI / 2) m2[i] = 1e300;
+  const auto m = make_reduced_model(s, scene, Interpolation::Linear);
+  AdaptiveIntegrator integ(m, 1e-8);
+  integ.reset(0.0, 0.0, 1e10);
+  const std::string msg = message_of([&] { integ.advance(1.0); });
+  EXPECT_EQ(msg.rfind("reduced integration failed at t = ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("): the reduced model's acceleration q̈ is not finite there"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("user-supplied"), std::string::npos) << msg;
+}
+
 }  // namespace
 }  // namespace rdyn::reduced
 

@@ -5,10 +5,14 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include "tests/validate/run_rdyn.hpp"
@@ -724,8 +728,181 @@ void found_later(std::vector<Case>& cs) {
   }
 }
 
+// Leftovers of issue #23: each refused with file, line and field (or the option), or written
+// as documented.
+void issue23(std::vector<Case>& cs) {
+  // The final state is the last row, also when --dt-out does not divide --duration.
+  for (const std::string model : {"reduced", "full"})
+    cs.push_back({"simulate_last_row_at_duration_" + model,
+                  {"simulate", "fourbar", "--model", model, "--duration", "1", "--dt-out", "0.3", "--out", "o"}, 0, "",
+                  {}, nullptr, "", {}, [](const fs::path& d, const RdynRun&) {
+                    std::istringstream csv(slurp(d / "o/timeseries.csv"));
+                    std::string line;
+                    std::getline(csv, line);  // header
+                    std::vector<double> t;
+                    while (std::getline(csv, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
+                    ASSERT_EQ(t.size(), 5u);
+                    for (size_t i = 0; i + 1 < t.size(); ++i) EXPECT_NEAR(t[i], 0.3 * i, 1e-12) << i;
+                    EXPECT_EQ(t.back(), 1.0);
+                  }});
+  // A second YAML document was silently dropped.
+  const std::string fb = scene_text("fourbar");
+  const int fb_lines = static_cast<int>(std::count(fb.begin(), fb.end(), '\n'));
+  for (const std::string cmd : {"simulate", "inspect"})
+    cs.push_back({"second_yaml_document_" + cmd,
+                  cmd == "inspect" ? std::vector<std::string>{cmd, "s.yaml"}
+                                   : std::vector<std::string>{cmd, "s.yaml", "--out", "o"},
+                  2,
+                  fmt::format("s.yaml:{}: a second YAML document (after '---')", fb_lines + 1),
+                  {{"s.yaml", fb + "---\ngravity: {enabled: false}\n"}}, nullptr, "o"});
+  // A value key in the other joint type's unit was read in the joint's own unit.
+  const std::string sc = scene_text("slider-crank");
+  auto line_of = [](const std::string& text, const std::string& what) {
+    return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find(what)), '\n'));
+  };
+  const int load_line = line_of(sc, "joint: slider, force_N"), motor_line = line_of(sc, "stall_torque_Nm");
+  using Edit = std::tuple<std::string, std::string, std::string, std::string>;  // tag, from, to, message
+  for (const auto& [tag, from, to, message] : std::vector<Edit>{
+           {"torque_on_prismatic", "joint: slider, force_N:", "joint: slider, torque_Nm:",
+            fmt::format("s.yaml:{}: field 'loads[1].torque_Nm': joint 'slider' is prismatic (forces in N, speeds in "
+                        "m/s): give force_N instead of torque_Nm", load_line)},
+           {"force_on_revolute", "joint: slider, force_N:", "joint: crank, force_N:",
+            fmt::format("s.yaml:{}: field 'loads[1].force_N': joint 'crank' is revolute (torques in N·m, speeds in "
+                        "rad/s): give torque_Nm instead of force_N", load_line)},
+           {"stall_torque_on_slider", "joint: crank, stall_torque_Nm", "joint: slider, stall_torque_Nm",
+            fmt::format("s.yaml:{}: field 'loads[0].stall_torque_Nm': joint 'slider' is prismatic (forces in N, speeds "
+                        "in m/s): give stall_force_N instead of stall_torque_Nm", motor_line)}})
+    cs.push_back({"unit_key_" + tag, {"simulate", "s.yaml", "--out", "o"}, 2, message, {{"s.yaml", edit(sc, from, to)}},
+                  nullptr, "o"});
+  // Numbers on the command line: decimal only, in range, said as typed.
+  const std::vector<std::string> sweep{"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=60:70:2"};
+  auto with = [](std::vector<std::string> a, std::vector<std::string> more) {
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  cs.push_back({"sweep_threads_zero", with(sweep, {"--threads", "0", "--out", "s.csv"}), 2,
+                "--threads: must be a finite number in [1, 256] (got 0)", {}, nullptr, "s.csv"});
+  cs.push_back({"sweep_cadence_zero", with(sweep, {"--cadence-hz", "0", "--out", "s.csv"}), 2, "--cadence-hz", {},
+                nullptr, "s.csv"});
+  cs.push_back({"sweep_threads_hex", with(sweep, {"--threads", "0x10", "--out", "s.csv"}), 2,
+                "--threads: expected a whole decimal number, got '0x10'", {}, nullptr, "s.csv"});
+  cs.push_back({"sweep_vary_hex",
+                {"sweep", "bicycle", "--vary", "bicycle_leg.hip_torque_Nm=0x3c:70:2", "--out", "s.csv"}, 2,
+                "a of a:b:n: expected a decimal number, got '0x3c'", {}, nullptr, "s.csv"});
+  cs.push_back({"simulate_duration_hex", {"simulate", "fourbar", "--duration", "0x10", "--out", "o"}, 2,
+                "--duration: expected a decimal number, got '0x10' (digits 0-9 only", {}, nullptr, "o"});
+  cs.push_back({"simulate_duration_underflows", {"simulate", "fourbar", "--duration", "1e-400", "--out", "o"}, 2,
+                "--duration: '1e-400' is out of range: it underflows", {}, nullptr, "o"});
+  cs.push_back({"simulate_duration_overflows", {"simulate", "fourbar", "--duration", "1e400", "--out", "o"}, 2,
+                "--duration: '1e400' is out of range", {}, nullptr, "o"});
+  // --force into a folder where timeseries.csv is a folder: refused with nothing changed.
+  cs.push_back({"simulate_force_into_folder_named_like_a_result",
+                {"simulate", "fourbar", "--duration", "0.1", "--out", "proj", "--force"}, 2,
+                "proj/timeseries.csv: is a folder; rdyn would write a file of that name there. Nothing was written",
+                {{"proj/run.json", "{\"mine\": true}\n"}, {"proj/timeseries.csv/keep.txt", "kept\n"}}, nullptr, "",
+                {}, [](const fs::path& d, const RdynRun&) {
+                  EXPECT_FALSE(fs::exists(d / "proj/.rdyn-output"));
+                  EXPECT_EQ(std::distance(fs::directory_iterator(d / "proj"), fs::directory_iterator()), 2);
+                }});
+  // "0: no drive" (models/README.md) holds with the bicycle's optimize block in place; only
+  // `rdyn optimize` needs the design loads, and says so when there are none.
+  cs.push_back({"simulate_bicycle_without_drive",
+                {"simulate", "bicycle", "--set", "bicycle_leg.hip_torque_Nm=0", "--duration", "0.2", "--out", "o"}, 0,
+                ""});
+  cs.push_back({"optimize_bicycle_without_drive",
+                {"optimize", "bicycle", "--set", "bicycle_leg.hip_torque_Nm=0", "--out", "o"}, 2,
+                "bicycle.yaml: field 'loads': optimize shapes joint torques and the scene has none", {}, nullptr, "o"});
+  // Messages with file, line and field in plain words.
+  {
+    std::string fb2 = edit(fb, "{name: coupler, type: revolute", "{name: b_crank, type: revolute");
+    fb2 = edit(fb2, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
+               "    - {name: rocker_axial, joint: rocker, direction: C}\n    - {name: x, joint: rocker, direction: C}\n"
+               "    - {name: x_b, joint: rocker, direction: C}\n");
+    const int x_b_line = line_of(fb2, "name: x_b");
+    for (const std::string cmd : {"simulate", "extract"})
+      cs.push_back({"column_collision_" + cmd, {cmd, "s.yaml", "--out", "o"}, 2,
+                    fmt::format("s.yaml:{}: field 'outputs.constraint_forces[2].name': constraint force 'x' with joint "
+                                "'b_crank' and constraint force 'x_b' with joint 'crank' both make the reduced table's "
+                                "column 'rx_x_b_crank'",
+                                x_b_line),
+                    {{"s.yaml", fb2}}, nullptr, "o"});
+    const std::string reserved = edit(fb, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
+                                      "    - {name: rocker_axial, joint: rocker, direction: C}\n"
+                                      "    - {name: R_crank_cx, joint: crank, direction: [1, 0]}\n");
+    const int reserved_line = line_of(reserved, "R_crank_cx");
+    cs.push_back({"reserved_reaction_line_name", {"simulate", "s.yaml", "--model", "reduced", "--out", "o"}, 2,
+                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_cx' is reserved",
+                              reserved_line),
+                  {{"s.yaml", reserved}}, nullptr, "o"});
+  }
+  // A table file edited by hand: a negative m1, a missing column. Each names the table's line.
+  auto edited_table = [](std::function<std::string(std::vector<std::vector<std::string>>&)> change) {
+    return [change](const fs::path& d) {
+      const RdynRun r = run_rdyn({"extract", "fourbar", "--out", "t.csv"}, d);
+      ASSERT_EQ(r.status, 0) << r.err;
+      std::istringstream in(slurp(d / "t.csv"));
+      std::vector<std::vector<std::string>> cells;  // comment lines as one cell
+      for (std::string line; std::getline(in, line);) {
+        cells.emplace_back();
+        if (line.rfind("#", 0) == 0) {
+          cells.back().push_back(line);
+          continue;
+        }
+        std::istringstream l(line);
+        for (std::string cell; std::getline(l, cell, ',');) cells.back().push_back(cell);
+      }
+      std::ofstream(d / "t.csv") << change(cells);
+    };
+  };
+  auto join = [](const std::vector<std::vector<std::string>>& cells) {
+    std::string out;
+    for (const auto& row : cells) {
+      for (size_t k = 0; k < row.size(); ++k) out += (k ? "," : "") + row[k];
+      out += "\n";
+    }
+    return out;
+  };
+  // The header is the first line that is not a comment; the table's line numbers are 1-based.
+  auto header_index = [](const std::vector<std::vector<std::string>>& cells) {
+    size_t h = 0;
+    while (cells[h][0].rfind("#", 0) == 0) ++h;
+    return h;
+  };
+  cs.push_back({"table_negative_m1", {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--out", "o"}, 2,
+                "column 'm1' (the reduced inertia, kg·m² or kg) must be positive, got -0.5", {},
+                edited_table([=](std::vector<std::vector<std::string>>& cells) {
+                  cells[header_index(cells) + 3][1] = "-0.5";
+                  return join(cells);
+                }),
+                "o", {}, [](const fs::path&, const RdynRun& r) {
+                  EXPECT_TRUE(std::regex_search(r.err, std::regex("t\\.csv:[0-9]+: column 'm1'"))) << r.err;
+                }});
+  cs.push_back({"table_missing_column",
+                {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--out", "o"}, 2,
+                "the column header has no column 'me1_rocker_axial', which the scene needs", {},
+                edited_table([=](std::vector<std::vector<std::string>>& cells) {
+                  const size_t h = header_index(cells);
+                  const auto& header = cells[h];
+                  const size_t c = static_cast<size_t>(
+                      std::find(header.begin(), header.end(), "me1_rocker_axial") - header.begin());
+                  for (size_t i = h; i < cells.size(); ++i)
+                    if (c < cells[i].size()) cells[i].erase(cells[i].begin() + static_cast<long>(c));
+                  return join(cells);
+                }),
+                "o", {}, [](const fs::path&, const RdynRun& r) {
+                  EXPECT_TRUE(std::regex_search(r.err, std::regex("t\\.csv:[0-9]+: the column header"))) << r.err;
+                }});
+  // A kernel folder as an output folder: refused in words, no '' names.
+  cs.push_back({"simulate_out_proc_self", {"simulate", "fourbar", "--duration", "0.1", "--out", "/proc/self"}, 2,
+                "/proc/self: lies in /proc, the kernel's own file system", {}, nullptr, "", {},
+                [](const fs::path&, const RdynRun& r) { EXPECT_EQ(r.err.find("''"), std::string::npos) << r.err; }});
+  cs.push_back({"optimize_harmonics_hex", {"optimize", "bicycle", "--harmonics", "0x3", "--out", "o"}, 2,
+                "--harmonics: expected a whole decimal number, got '0x3'", {}, nullptr, "o"});
+}
+
 std::vector<Case> all_cases() {
   std::vector<Case> cs;
+  issue23(cs);
   found_later(cs);
   ground_truth(cs);
   bad_numbers(cs);

@@ -91,6 +91,41 @@ TEST_F(Outputs, ForeignFolderIsRefusedUntouchedAndForceMergesIntoIt) {
   EXPECT_THROW(OutputDir((dir_ / "proj").string()), OutputError);  // scene.yaml is still not rdyn's
 }
 
+TEST_F(Outputs, ForcedMergeChecksEveryDestinationBeforeMovingAnything) {
+  // A user folder where rdyn writes a file (or a file where it writes a folder) is refused at
+  // commit before the first move: run.json stays the user's and no manifest appears (issue #23).
+  for (const bool folder_for_file : {true, false}) {
+    fs::remove_all(dir_ / "proj");
+    fs::create_directories(dir_ / "proj");
+    std::ofstream(dir_ / "proj/run.json") << "the user's";
+    if (folder_for_file) {
+      fs::create_directories(dir_ / "proj/timeseries.csv");
+    } else {
+      std::ofstream(dir_ / "proj/figures") << "a file";
+    }
+    {
+      OutputDir out((dir_ / "proj").string(), /*force=*/true);
+      write_text_file(out.file("run.json"), "rdyn's");
+      write_text_file(out.file("timeseries.csv"), "t\n");
+      out.make_subfolder("figures");
+      write_text_file(out.file("figures/a.svg"), "<svg/>");
+      try {
+        out.commit();
+        ADD_FAILURE() << "committed";
+      } catch (const OutputError& e) {
+        EXPECT_NE(std::string(e.what()).find(folder_for_file ? "proj/timeseries.csv: is a folder"
+                                                             : "proj/figures: exists and is not a folder"),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("Nothing was written"), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_EQ(read(dir_ / "proj/run.json"), "the user's");
+    EXPECT_FALSE(fs::exists(dir_ / "proj/.rdyn-output"));
+    EXPECT_EQ(temporaries(), 0);
+  }
+}
+
 TEST_F(Outputs, AFileAddedDuringTheRunStopsTheReplacement) {
   {
     OutputDir first((dir_ / "res").string());

@@ -162,6 +162,21 @@ TEST_F(ExportMjcfCli, PeersOptionNeedsMujocoAtBuildTime) {
   EXPECT_FALSE(fs::exists(dir_ / "v"));
 }
 
+// A validation duration that the output interval does not divide: `simulate` ends on a last row
+// at the duration, but the MuJoCo peer fills each output interval with whole steps and runs are
+// compared row by row, so validation spans the whole intervals (1.0005 s at 2 ms: 1 s).
+TEST_F(ExportMjcfCli, ValidateWithPeersSpansWholeOutputIntervals) {
+  if (!engine::mujoco_available()) GTEST_SKIP() << "rdyn was built without MuJoCo";
+  const auto r = rdyn({"validate", "fourbar", "--quick", "--peers", "mujoco", "--set", "validation.duration_s=1.0005",
+                       "--out", "v"});
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
+  EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  const auto s = nlohmann::json::parse(test::slurp(dir_ / "v" / "summary.json"));
+  EXPECT_NEAR(s.at("duration_s").get<double>(), 1.0, 1e-12);
+  for (const auto& p : s.at("peers"))
+    for (const auto& run : p.at("runs")) EXPECT_FALSE(run.contains("failure")) << run.dump();
+}
+
 // End to end: MuJoCo's two ladders in summary.json and the figure's data; the full model timed
 // without the output grid (fewer steps than on the grid), and the report says how.
 TEST_F(ExportMjcfCli, ValidateWithMujocoPeersWritesLaddersAndFairBaselines) {
