@@ -1,6 +1,7 @@
 #include "engine/kinetostatic.hpp"
 #include "engine/independent_range.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <optional>
@@ -302,9 +303,127 @@ bool newton_project(const FullModel::Impl& m, State& s) {
 
 }  // namespace
 
-double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+namespace {
+
+// The branch's derivatives at a configuration realized to Position (kinetostatic mode, loads
+// irrelevant): q' = N r and q'' = N b per unit of the independent coordinate, r from G r = 0 with
+// ṙ_independent = 1 and b from G b = −bias(r) (calc_kinetostatic_sample's r and b); `singular`
+// when the loop Jacobian's conditioning is below kSingularConditioning (r, b are then
+// least-squares values of no particular branch). Leaves u = r in the state.
+struct BranchTangent {
+  Vector dq, ddq;
+  bool singular = false;
+};
+
+BranchTangent calc_branch_tangent(const FullModel::Impl& m, State& s, double x) {
+  m.set_law(s, 0, poly_law(x, 1.0, 0.0));
+  m.system.realize(s, Stage::Position);
+  const auto J = calc_split_jacobian(m, s);
+  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
+  Vector u(nu, 0.0), b(nu, 0.0);
+  u[ind] = 1.0;
+  BranchTangent t;
+  if (J.G.nrow() > 0 && J.G_free.ncol() > 0) {
+    FactorSVD svd(J.G_free);
+    t.singular = conditioning_of(svd, J.G_free) < kSingularConditioning;
+    Vector rhs(J.G.nrow()), x_free;
+    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, ind);
+    svd.solve(rhs, x_free);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) u[J.free_cols[c]] = x_free[static_cast<int>(c)];
+    s.updU() = u;
+    m.system.realize(s, Stage::Velocity);
+    Vector bias;
+    m.matter.calcBiasForAccelerationConstraints(s, bias);
+    bias *= -1.0;
+    svd.solve(bias, x_free);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) b[J.free_cols[c]] = x_free[static_cast<int>(c)];
+  }
+  m.matter.multiplyByN(s, false, u, t.dq);
+  m.matter.multiplyByN(s, false, b, t.ddq);
+  return t;
+}
+
+}  // namespace
+
+void follow_branch(const FullModel& model, FullWorkspace& ws, double q, double max_step, double max_correction) {
   const auto& m = model.impl();
-  State& s = ws.impl().state;
+  check_finite_input(m, {q, max_step, max_correction});
+  auto& w = ws.impl();
+  State& s = w.state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.system.realize(s, Stage::Position);
+  double x = m.joint_q(s, m.independent);
+  if (w.hist_n == 0) remember(w, x);
+  // The smallest move before a correction larger than max_correction is accepted anyway (a
+  // configuration where the branch turns within 1e-6 of a move: no better prediction exists).
+  const double min_step = 1e-6 * max_step;
+  constexpr long kMaxMoves = 100000;
+  double step = max_step;
+  for (long moves = 0; x != q; ++moves) {
+    if (moves > kMaxMoves)
+      throw EngineError(fmt::format("{}: the branch continuation to {} = {:.6g} needed more than {} moves",
+                                    m.scene.source_file, m.scene.independent, q, kMaxMoves));
+    // Second-order predictor along the branch; at a singular configuration the chord of the
+    // last move instead (the branch the continuation came along; calc_kinetostatic_sample's rule).
+    BranchTangent t = calc_branch_tangent(m, s, x);
+    if (t.singular && w.hist_n == 2 && std::abs(w.hist_x[1] - w.hist_x[0]) > 1e-12 &&
+        w.hist_q[0].size() == s.getNQ()) {
+      t.dq = (w.hist_q[1] - w.hist_q[0]) / (w.hist_x[1] - w.hist_x[0]);
+      t.ddq = 0.0 * t.dq;
+    }
+    const Vector q_here = s.getQ();
+    double d = std::clamp(q - x, -step, step);
+    for (;;) {
+      const double x_new = std::abs(q - x) <= std::abs(d) ? q : x + d;
+      d = x_new - x;
+      const Vector pred = q_here + t.dq * d + t.ddq * (0.5 * d * d);
+      s.updQ() = pred;
+      m.set_law(s, 0, poly_law(x_new, 0.0, 0.0));
+      bool converged = true;
+      try {
+        m.system.realize(s, Stage::Time);
+        m.system.prescribeQ(s);
+        if (!newton_project(m, s)) {
+          try {
+            m.system.projectQ(s, 1e-12);
+          } catch (const std::exception&) {
+            m.system.projectQ(s, 1e-9);  // singular configuration: as project()
+            ++m.near_singular_projections;
+          }
+        }
+      } catch (const std::exception&) {
+        converged = false;
+      }
+      // Newton's correction of the prediction: O(d³) on this branch; a move that lands on
+      // another branch nearby (where two branches pass close, the one followed turning sharply)
+      // is corrected by the prediction's distance to it, larger than this for a long enough move.
+      double correction = 0.0;
+      if (converged)
+        for (int i = 0; i < s.getNQ(); ++i) correction = std::max(correction, std::abs(s.getQ()[i] - pred[i]));
+      const bool accept = converged && std::isfinite(correction) && correction <= max_correction;
+      if (accept || std::abs(d) <= min_step) {
+        if (!converged)
+          throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                        "(dead point or a loop that cannot close)",
+                                        m.scene.source_file, m.scene.independent, x_new));
+        x = x_new;
+        remember(w, x);
+        step = std::min(max_step, 2 * std::abs(d));  // grow back after a turn
+        break;
+      }
+      d *= 0.5;
+    }
+  }
+  m.system.realize(s, Stage::Position);
+}
+
+double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+  return calc_loop_conditioning(model.impl(), ws.impl().state);
+}
+
+double calc_loop_conditioning(const FullModel::Impl& m, const State& s) {
   m.system.realize(s, Stage::Position);
   const auto J = calc_split_jacobian(m, s);
   if (J.G.nrow() == 0) return 1.0;
@@ -470,12 +589,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       // failed move to retry.
       if (!(std::abs(dx) > 1e-9)) {
         w.anchor_set = false;
-        throw models::SceneError(
-            m.scene.source_file, m.scene.line_of("initial"), "initial",
-            fmt::format("the mechanism starts at a singular configuration of '{}' ({}: the loop Jacobian loses rank "
-                        "and assembly branches cross there), so the branch to follow is not determined; start it a "
-                        "little away from there",
-                        m.scene.independent, format_coordinate(q, revolute)));
+        throw_singular_start(m, s);
       }
     }
     if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {
