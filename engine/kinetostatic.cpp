@@ -305,11 +305,53 @@ bool newton_project(const FullModel::Impl& m, State& s) {
 
 namespace {
 
-// The branch's derivatives at a configuration realized to Position (kinetostatic mode, loads
-// irrelevant): q' = N r and q'' = N b per unit of the independent coordinate, r from G r = 0 with
-// ṙ_independent = 1 and b from G b = −bias(r) (calc_kinetostatic_sample's r and b); `singular`
-// when the loop Jacobian's conditioning is below kSingularConditioning (r, b are then
-// least-squares values of no particular branch). Leaves u = r in the state.
+// The branch's rates at a configuration realized to Position whose independent law gives q̇ = 1
+// (kinetostatic mode): r (q̇ = 1, ẋ = 0) from G_free r_free = −G e_independent, and b = dr/dq (the
+// accelerations at q̈ = ẍ = 0) from G_free b_free = −bias (Simbody: acceleration constraint errors
+// G u̇ + bias, bias = −Ġu at this velocity); least squares: G may carry redundant rows, the system
+// is consistent. Leaves u = r in the state, realized to Velocity; J and its SVD stay for further
+// solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
+struct BranchRates {
+  SplitJacobian J;
+  std::optional<FactorSVD> svd;  // of J.G_free, when there are rows and free columns
+  Vector r, b;                   // [mobilities]
+  // v: prescribed entries set; the free ones solved from G_free v_free = rhs.
+  void complete(Vector& v, const Vector& rhs) {
+    if (!svd) return;
+    Vector x;
+    svd->solve(rhs, x);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
+  }
+  // −(column col of G): the right-hand side for a unit rate of prescribed mobility col.
+  Vector column(int col) const {
+    Vector rhs(J.G.nrow());
+    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
+    return rhs;
+  }
+};
+
+void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
+  m.system.realize(s, Stage::Position);
+  out.J = calc_split_jacobian(m, s);
+  if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) out.svd.emplace(out.J.G_free);
+  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
+  out.r = Vector(nu, 0.0);
+  out.r[ind] = 1.0;
+  out.complete(out.r, out.column(ind));
+  s.updU() = out.r;
+  m.system.realize(s, Stage::Velocity);
+  out.b = Vector(nu, 0.0);
+  if (out.J.G.nrow() > 0) {
+    Vector bias;
+    m.matter.calcBiasForAccelerationConstraints(s, bias);
+    out.complete(out.b, -bias);
+  }
+}
+
+// The branch's derivatives at a configuration: q' = N r and q'' = N b per unit of the
+// independent coordinate (Ṅ = 0 for the pins and sliders rdyn builds); `singular` when the loop
+// Jacobian's conditioning is below kSingularConditioning (r, b are then least-squares values of
+// no particular branch).
 struct BranchTangent {
   Vector dq, ddq;
   bool singular = false;
@@ -317,29 +359,12 @@ struct BranchTangent {
 
 BranchTangent calc_branch_tangent(const FullModel::Impl& m, State& s, double x) {
   m.set_law(s, 0, poly_law(x, 1.0, 0.0));
-  m.system.realize(s, Stage::Position);
-  const auto J = calc_split_jacobian(m, s);
-  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
-  Vector u(nu, 0.0), b(nu, 0.0);
-  u[ind] = 1.0;
+  BranchRates rates;
+  calc_branch_rates(m, s, rates);
   BranchTangent t;
-  if (J.G.nrow() > 0 && J.G_free.ncol() > 0) {
-    FactorSVD svd(J.G_free);
-    t.singular = conditioning_of(svd, J.G_free) < kSingularConditioning;
-    Vector rhs(J.G.nrow()), x_free;
-    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, ind);
-    svd.solve(rhs, x_free);
-    for (size_t c = 0; c < J.free_cols.size(); ++c) u[J.free_cols[c]] = x_free[static_cast<int>(c)];
-    s.updU() = u;
-    m.system.realize(s, Stage::Velocity);
-    Vector bias;
-    m.matter.calcBiasForAccelerationConstraints(s, bias);
-    bias *= -1.0;
-    svd.solve(bias, x_free);
-    for (size_t c = 0; c < J.free_cols.size(); ++c) b[J.free_cols[c]] = x_free[static_cast<int>(c)];
-  }
-  m.matter.multiplyByN(s, false, u, t.dq);
-  m.matter.multiplyByN(s, false, b, t.ddq);
+  t.singular = rates.svd && conditioning_of(*rates.svd, rates.J.G_free) < kSingularConditioning;
+  m.matter.multiplyByN(s, false, rates.r, t.dq);
+  m.matter.multiplyByN(s, false, rates.b, t.ddq);
   return t;
 }
 
@@ -478,41 +503,18 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   }
   m.system.realize(s, Stage::Position);
   const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
-  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
+  const int nu = s.getNU();
   KinetostaticSample out;
   out.near_singular = m.near_singular_projections > singular_before;
-  // G_free u_free = −(G u)_prescribed: the free mobilities from the prescribed ones (least
-  // squares: G may carry redundant rows; the system is consistent).
-  const auto J = calc_split_jacobian(m, s);
-  std::optional<FactorSVD> svd;
-  if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
-  if (parts == SampleParts::All) out.conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
-  auto complete = [&](Vector& v, const Vector& rhs) {  // v: prescribed entries set, free ones solved
-    if (!svd) return;
-    Vector x;
-    svd->solve(rhs, x);
-    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
-  };
-  auto column = [&](int col) {
-    Vector rhs(J.G.nrow());
-    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
-    return rhs;
-  };
-  // r: q̇ = 1, ẋ = 0 (the velocity projection of call (i)).
-  Vector u(nu, 0.0);
-  u[ind] = 1.0;
-  complete(u, column(ind));
-  s.updU() = u;
-  m.system.realize(s, Stage::Velocity);
+  // r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its accelerations),
+  // from the Jacobian of this configuration (calc_branch_rates); the state is left at u = r.
+  BranchRates rates;
+  calc_branch_rates(m, s, rates);
+  const auto& J = rates.J;
+  const Vector &u = rates.r, &b = rates.b;
+  if (parts == SampleParts::All)
+    out.conditioning = J.G.nrow() == 0 ? 1.0 : rates.svd ? conditioning_of(*rates.svd, J.G_free) : 0.0;
   if (parts == SampleParts::All) out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1
-  // b = dr/dq: the accelerations of call (i) (q̇ = 1, q̈ = 0, ẍ = 0), from G b = −bias
-  // (Simbody: acceleration constraint errors G u̇ + bias, bias = −Ġu at this velocity).
-  Vector b(nu, 0.0);
-  if (J.G.nrow() > 0) {
-    Vector bias;
-    m.matter.calcBiasForAccelerationConstraints(s, bias);
-    complete(b, -bias);
-  }
   out.joint_q.resize(nj);
   out.ratio_q.resize(nj);
   out.ratio_slope.resize(nj);
@@ -540,7 +542,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       const int col = m.actuator_slider[k].getFirstUIndex(s);
       Vector rx(nu, 0.0);
       rx[col] = 1.0;
-      complete(rx, column(col));
+      rates.complete(rx, rates.column(col));
       std::vector<double> rates(nj);
       for (int j = 0; j < nj; ++j) finite &= std::isfinite(rates[j] = joint_part(m, s, rx, j));
       out.ratio_x.push_back(std::move(rates));
