@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "engine/branch_guard.hpp"
 #include "engine/full_model_impl.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/kinetostatic.hpp"
@@ -134,6 +135,24 @@ void check_point_force_lines(const FullModel::Impl& m, const State& s, std::vect
     for (const auto& f : pf) e_prev.push_back(calc_point_force_line(m, s, f, false).e_G);
 }
 
+// The branch guard at one output sample (engine/branch_guard.hpp): every joint of the integrated
+// state on the branch the run started on, or NumericalError naming the time, the joint and both
+// values. The guard failing to follow its own branch is a numerical failure too.
+void check_branch(const FullModel& model, BranchGuard& guard, const State& s, double t_prev) {
+  const auto& m = model.impl();
+  std::vector<double> q(m.scene.joints.size());
+  for (size_t j = 0; j < q.size(); ++j) q[j] = m.joint_q(s, static_cast<int>(j));
+  BranchCheck c;
+  try {
+    c = calc_branch_check(model, guard, q[m.independent], q);
+  } catch (const EngineError& e) {
+    throw models::NumericalError(fmt::format("full model's branch guard could not follow the starting branch to "
+                                             "t = {:.6g} s: {}",
+                                             s.getTime(), e.what()));
+  }
+  if (!c.on_branch) throw models::NumericalError(describe_branch_switch(model, c, s.getTime(), t_prev));
+}
+
 }  // namespace
 
 TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
@@ -148,9 +167,10 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
 
   // Consistent initial state: a kinetostatic projection at (q0, q̇0), then the independent
   // coordinate is released.
-  FullWorkspace ws(model);
-  calc_kinetostatic(model, ws, m.scene.initial.q, m.scene.initial.qdot, 0.0, Loads::Off);
-  State s = ws.impl().state;
+  // The workspace then stays with the branch guard, which continues it along the starting branch.
+  BranchGuard guard(model);
+  calc_kinetostatic(model, guard.ws, m.scene.initial.q, m.scene.initial.qdot, 0.0, Loads::Off);
+  State s = guard.ws.impl().state;
   m.independent_motion.disable(s);
   m.system.realizeModel(s);
   s.setTime(0.0);
@@ -264,6 +284,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     }
     record(m, integ->getState(), ts);
     check_finite_row(ts);
+    check_branch(model, guard, integ->getState(), ts.t[ts.t.size() - 2]);
     motion_scale_J = std::max(
         {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
   }

@@ -49,7 +49,9 @@ using models::TimeSeries;
 // Starts at the scene's initial q, q̇ (the rest of the state from the constraints).
 // Throws EngineError for options out of range or a scene the engine refuses, and
 // models::NumericalError when the integration fails on valid input: integrator error, step
-// or wall-time budget exhausted, a non-finite value, or an energy balance that does not close.
+// or wall-time budget exhausted, a non-finite value, an energy balance that does not close, or a
+// switch of assembly branch (engine/branch_guard.hpp: checked at every output sample, ~0.2 ms
+// each on the bicycle). A start at a singular configuration is a models::SceneError (`initial`).
 TimeSeries simulate_full(const FullModel& model, const ForwardOptions& options);
 
 }  // namespace rdyn::engine

@@ -3,6 +3,8 @@
 // coordinate couplers or folded onto their driver, constraint actuators as prescribed
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
+#include "engine/independent_range.hpp"
+#include "engine/kinetostatic.hpp"
 
 #include <cctype>
 #include <cmath>
@@ -82,14 +84,14 @@ constexpr double kRankTolerance = 1e-9;
 // is skipped and only the counts are reported.
 constexpr int kMaxRowsToName = 400;
 
-int numerical_rank(const Matrix& A) {
+int numerical_rank(const Matrix& A, double tolerance = kRankTolerance) {
   if (A.nrow() == 0 || A.ncol() == 0) return 0;
   FactorSVD svd(A);
   Vector sv;
   svd.getSingularValues(sv);
   if (sv.size() == 0 || !std::isfinite(sv[0])) return 0;
   int r = 0;
-  for (int i = 0; i < sv.size(); ++i) r += sv[i] > kRankTolerance * sv[0] ? 1 : 0;
+  for (int i = 0; i < sv.size(); ++i) r += sv[i] > tolerance * sv[0] ? 1 : 0;
   return r;
 }
 
@@ -104,7 +106,8 @@ struct Mobility {
   std::vector<std::string> redundant;  // constraints owning a redundant row, "loop 'C' (1 row)"
 };
 
-Mobility calc_mobility(const FullModel::Impl& m, const State& s) {
+// rank_tolerance: relative, as numerical_rank.
+Mobility calc_mobility(const FullModel::Impl& m, const State& s, double rank_tolerance = kRankTolerance) {
   m.system.realize(s, Stage::Position);
   std::vector<bool> keep(s.getNU(), true);
   for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
@@ -132,7 +135,7 @@ Mobility calc_mobility(const FullModel::Impl& m, const State& s) {
         if (c != drop_col) A(static_cast<int>(i), o++) = rows[r](0, c);
       ++i;
     }
-    return numerical_rank(A);
+    return numerical_rank(A, rank_tolerance);
   };
   Mobility out;
   out.mobilities = static_cast<int>(cols.size());
@@ -198,7 +201,8 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
   for (double dq : {step, -step}) {
     if (const auto near = nearby_configuration(m, s, dq)) {
       const Mobility other = calc_mobility(m, *near);
-      if (one_dof(other)) return;
+      // One degree of freedom beside the start but not at it: the start itself is singular.
+      if (one_dof(other)) throw_singular_start(m, s);
       if (other.rank > mob.rank) mob = other;
     }
   }
@@ -227,6 +231,27 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
                                 where, m.scene.independent));
 }
 
+}  // namespace
+
+void throw_singular_start(const FullModel::Impl& m, const State& s) {
+  // The local count at the singular threshold the extraction uses (kSingularConditioning): an
+  // assembly lands ~1e-6 rad from an aligned position (its closure error is quadratic there),
+  // where the rank at kRankTolerance is still full.
+  const Mobility here = calc_mobility(m, s, kSingularConditioning);
+  const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
+  throw models::SceneError(
+      m.scene.source_file, m.scene.line_of("initial"), "initial",
+      fmt::format("the mechanism starts at a singular configuration of '{}' ({}): the loop Jacobian loses rank there "
+                  "(rank {} of {} loop and gear rows over {} joint coordinates, singular values below {:g} of the "
+                  "largest dropped: locally {} degrees of freedom, 1 beside it) and assembly branches cross there, "
+                  "so neither the branch to follow nor the velocities and constraint forces are determined; start "
+                  "it a little away from there",
+                  m.scene.independent, format_coordinate(m.joint_q(s, m.independent), rev), here.rank, here.rows,
+                  here.mobilities, kSingularConditioning, here.mobilities - here.rank));
+}
+
+namespace {
+
 // Each loop that names its branch must have closed on it: the named joint's coordinate (a
 // revolute angle wrapped to (−180°, 180°]) has the sign asked for. Zero (the boundary between
 // the branches, a singular position) is neither.
@@ -251,7 +276,7 @@ void check_branches(const FullModel::Impl& m, const State& s) {
   }
 }
 
-// Every point force has a direction where the mechanism assembles: its points are apart.
+// Every point force and spring has a direction where the mechanism assembles: its points are apart.
 void check_point_forces(const FullModel::Impl& m, const State& s) {
   for (const auto& f : m.scene.point_forces) {
     const double L = calc_point_force_line(m, s, f, false).length;
@@ -262,6 +287,21 @@ void check_point_forces(const FullModel::Impl& m, const State& s) {
         fmt::format("point force '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled "
                     "configuration (at {} = {:.6g}), closer than {:g} m: the line of action has no direction",
                     f.name, f.body_b, L, f.body_a, m.scene.independent, m.scene.initial.q,
+                    models::limits::kMinPointForceLength_m));
+  }
+  // A spring too: its force k (L − L0) acts along a line that has no direction at L = 0 (the full
+  // model skipped it there, the reduced model's potential did not: the two then disagree).
+  for (const auto& sp : m.scene.springs) {
+    const Vec3 p_GA = m.mobod_of(sp.body_a).findStationLocationInGround(s, v3(sp.point_a));
+    const Vec3 p_GB = m.mobod_of(sp.body_b).findStationLocationInGround(s, v3(sp.point_b));
+    const double L = (p_GB - p_GA).norm();
+    if (L >= models::limits::kMinPointForceLength_m) continue;
+    const std::string field = "loads." + sp.name + ".point_b";
+    throw models::SceneError(
+        m.scene.source_file, m.scene.line_of(field), field,
+        fmt::format("spring '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled configuration "
+                    "(at {} = {:.6g}), closer than {:g} m: the spring's line of action has no direction",
+                    sp.name, sp.body_b, L, sp.body_a, m.scene.independent, m.scene.initial.q,
                     models::limits::kMinPointForceLength_m));
   }
 }
@@ -520,6 +560,9 @@ FullWorkspace::FullWorkspace(const FullModel& model)
                                   m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
   }
   check_one_dof(m, s);
+  // A start where the loops' Jacobian (less the prescribed columns) is singular by the measure
+  // the extraction marks singular grid points with: refused (issue #22 item 5).
+  if (calc_loop_conditioning(m, s) < kSingularConditioning) throw_singular_start(m, s);
   check_branches(m, s);
   check_point_forces(m, s);
 }

@@ -106,6 +106,15 @@ struct FullWorkspace::Impl {
 // (full_model.cpp; the same count check_one_dof uses).
 void calc_mobility_count(const FullModel::Impl& m, const SimTK::State& s, int& mobilities, int& rows, int& rank);
 
+// calc_loop_conditioning (kinetostatic.hpp) at a state.
+double calc_loop_conditioning(const FullModel::Impl& m, const SimTK::State& s);
+
+// Refuses a start at a singular configuration (the loop Jacobian loses rank there, one degree of
+// freedom beside it): models::SceneError naming `initial` and the local degrees of freedom at
+// the state (realized to Position or less). The one refusal of the assembly (check_one_dof, so
+// every run, inspect included) and of the extraction's first grid point (kinetostatic.cpp).
+[[noreturn]] void throw_singular_start(const FullModel::Impl& m, const SimTK::State& s);
+
 // The columns of reduced::joint_output_names (joint motions, reactions, shaking) at a state
 // realized to Acceleration (engine/joint_outputs.cpp).
 void calc_joint_outputs(const FullModel::Impl& m, const SimTK::State& s, std::vector<double>& out);

@@ -1,6 +1,7 @@
 #include "engine/kinetostatic.hpp"
 #include "engine/independent_range.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <optional>
@@ -349,9 +350,152 @@ void polish_projection(const FullModel::Impl& m, State& s) {
 
 }  // namespace
 
-double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+namespace {
+
+// The branch's rates at a configuration realized to Position whose independent law gives q̇ = 1
+// (kinetostatic mode): r (q̇ = 1, ẋ = 0) from G_free r_free = −G e_independent, and b = dr/dq (the
+// accelerations at q̈ = ẍ = 0) from G_free b_free = −bias (Simbody: acceleration constraint errors
+// G u̇ + bias, bias = −Ġu at this velocity); least squares: G may carry redundant rows, the system
+// is consistent. Leaves u = r in the state, realized to Velocity; J and its SVD stay for further
+// solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
+struct BranchRates {
+  SplitJacobian J;
+  std::optional<FactorSVD> svd;  // of J.G_free, when there are rows and free columns
+  Vector r, b;                   // [mobilities]
+  // v: prescribed entries set; the free ones solved from G_free v_free = rhs.
+  void complete(Vector& v, const Vector& rhs) {
+    if (!svd) return;
+    Vector x;
+    svd->solve(rhs, x);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
+  }
+  // −(column col of G): the right-hand side for a unit rate of prescribed mobility col.
+  Vector column(int col) const {
+    Vector rhs(J.G.nrow());
+    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
+    return rhs;
+  }
+};
+
+void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
+  m.system.realize(s, Stage::Position);
+  out.J = calc_split_jacobian(m, s);
+  if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) out.svd.emplace(out.J.G_free);
+  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
+  out.r = Vector(nu, 0.0);
+  out.r[ind] = 1.0;
+  out.complete(out.r, out.column(ind));
+  s.updU() = out.r;
+  m.system.realize(s, Stage::Velocity);
+  out.b = Vector(nu, 0.0);
+  if (out.J.G.nrow() > 0) {
+    Vector bias;
+    m.matter.calcBiasForAccelerationConstraints(s, bias);
+    out.complete(out.b, -bias);
+  }
+}
+
+// The branch's derivatives at a configuration: q' = N r and q'' = N b per unit of the
+// independent coordinate (Ṅ = 0 for the pins and sliders rdyn builds); `singular` when the loop
+// Jacobian's conditioning is below kSingularConditioning (r, b are then least-squares values of
+// no particular branch).
+struct BranchTangent {
+  Vector dq, ddq;
+  bool singular = false;
+};
+
+BranchTangent calc_branch_tangent(const FullModel::Impl& m, State& s, double x) {
+  m.set_law(s, 0, poly_law(x, 1.0, 0.0));
+  BranchRates rates;
+  calc_branch_rates(m, s, rates);
+  BranchTangent t;
+  t.singular = rates.svd && conditioning_of(*rates.svd, rates.J.G_free) < kSingularConditioning;
+  m.matter.multiplyByN(s, false, rates.r, t.dq);
+  m.matter.multiplyByN(s, false, rates.b, t.ddq);
+  return t;
+}
+
+}  // namespace
+
+void follow_branch(const FullModel& model, FullWorkspace& ws, double q, double max_step, double max_correction) {
   const auto& m = model.impl();
-  State& s = ws.impl().state;
+  check_finite_input(m, {q, max_step, max_correction});
+  auto& w = ws.impl();
+  State& s = w.state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.system.realize(s, Stage::Position);
+  double x = m.joint_q(s, m.independent);
+  if (w.hist_n == 0) remember(w, x);
+  // The smallest move before a correction larger than max_correction is accepted anyway (a
+  // configuration where the branch turns within 1e-6 of a move: no better prediction exists).
+  const double min_step = 1e-6 * max_step;
+  constexpr long kMaxMoves = 100000;
+  double step = max_step;
+  for (long moves = 0; x != q; ++moves) {
+    if (moves > kMaxMoves)
+      throw EngineError(fmt::format("{}: the branch continuation to {} = {:.6g} needed more than {} moves",
+                                    m.scene.source_file, m.scene.independent, q, kMaxMoves));
+    // Second-order predictor along the branch; at a singular configuration the chord of the
+    // last move instead (the branch the continuation came along; calc_kinetostatic_sample's rule).
+    BranchTangent t = calc_branch_tangent(m, s, x);
+    if (t.singular && w.hist_n == 2 && std::abs(w.hist_x[1] - w.hist_x[0]) > 1e-12 &&
+        w.hist_q[0].size() == s.getNQ()) {
+      t.dq = (w.hist_q[1] - w.hist_q[0]) / (w.hist_x[1] - w.hist_x[0]);
+      t.ddq = 0.0 * t.dq;
+    }
+    const Vector q_here = s.getQ();
+    double d = std::clamp(q - x, -step, step);
+    for (;;) {
+      const double x_new = std::abs(q - x) <= std::abs(d) ? q : x + d;
+      d = x_new - x;
+      const Vector pred = q_here + t.dq * d + t.ddq * (0.5 * d * d);
+      s.updQ() = pred;
+      m.set_law(s, 0, poly_law(x_new, 0.0, 0.0));
+      bool converged = true;
+      try {
+        m.system.realize(s, Stage::Time);
+        m.system.prescribeQ(s);
+        if (!newton_project(m, s)) {
+          try {
+            m.system.projectQ(s, 1e-12);
+          } catch (const std::exception&) {
+            m.system.projectQ(s, 1e-9);  // singular configuration: as project()
+            ++m.near_singular_projections;
+          }
+        }
+      } catch (const std::exception&) {
+        converged = false;
+      }
+      // Newton's correction of the prediction: O(d³) on this branch; a move that lands on
+      // another branch nearby (where two branches pass close, the one followed turning sharply)
+      // is corrected by the prediction's distance to it, larger than this for a long enough move.
+      double correction = 0.0;
+      if (converged)
+        for (int i = 0; i < s.getNQ(); ++i) correction = std::max(correction, std::abs(s.getQ()[i] - pred[i]));
+      const bool accept = converged && std::isfinite(correction) && correction <= max_correction;
+      if (accept || std::abs(d) <= min_step) {
+        if (!converged)
+          throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                        "(dead point or a loop that cannot close)",
+                                        m.scene.source_file, m.scene.independent, x_new));
+        x = x_new;
+        remember(w, x);
+        step = std::min(max_step, 2 * std::abs(d));  // grow back after a turn
+        break;
+      }
+      d *= 0.5;
+    }
+  }
+  m.system.realize(s, Stage::Position);
+}
+
+double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws) {
+  return calc_loop_conditioning(model.impl(), ws.impl().state);
+}
+
+double calc_loop_conditioning(const FullModel::Impl& m, const State& s) {
   m.system.realize(s, Stage::Position);
   const auto J = calc_split_jacobian(m, s);
   if (J.G.nrow() == 0) return 1.0;
@@ -407,49 +551,30 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   }
   m.system.realize(s, Stage::Position);
   const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
-  const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
+  const int nu = s.getNU();
   KinetostaticSample out;
   out.near_singular = m.near_singular_projections > singular_before;
-  // G_free u_free = −(G u)_prescribed: the free mobilities from the prescribed ones (least
-  // squares: G may carry redundant rows; the system is consistent).
-  auto J = calc_split_jacobian(m, s);
-  std::optional<FactorSVD> svd;
-  if (J.G.nrow() > 0 && J.G_free.ncol() > 0) svd.emplace(J.G_free);
-  double conditioning = J.G.nrow() == 0 ? 1.0 : svd ? conditioning_of(*svd, J.G_free) : 0.0;
-  // Near a singular configuration, not on it (there the rates are repaired, not computed).
+  // r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its accelerations),
+  // from the Jacobian of this configuration (calc_branch_rates); the state is left at u = r.
+  BranchRates first, polished;
+  calc_branch_rates(m, s, first);
+  auto conditioning_of_rates = [](BranchRates& r) {
+    return r.J.G.nrow() == 0 ? 1.0 : r.svd ? conditioning_of(*r.svd, r.J.G_free) : 0.0;
+  };
+  double conditioning = conditioning_of_rates(first);
+  BranchRates* rates = &first;
+  // Near a singular configuration, not on it (there the rates are repaired, not computed): the
+  // projection polished to rounding, then the rates again (polish_projection).
   if (conditioning >= kSingularConditioning && conditioning < kPolishConditioning) {
     polish_projection(m, s);
-    J = calc_split_jacobian(m, s);
-    svd.emplace(J.G_free);
-    conditioning = conditioning_of(*svd, J.G_free);
+    calc_branch_rates(m, s, polished);
+    rates = &polished;
+    conditioning = conditioning_of_rates(polished);
   }
+  const auto& J = rates->J;
+  const Vector &u = rates->r, &b = rates->b;
   if (parts == SampleParts::All) out.conditioning = conditioning;
-  auto complete = [&](Vector& v, const Vector& rhs) {  // v: prescribed entries set, free ones solved
-    if (!svd) return;
-    Vector x;
-    svd->solve(rhs, x);
-    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
-  };
-  auto column = [&](int col) {
-    Vector rhs(J.G.nrow());
-    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
-    return rhs;
-  };
-  // r: q̇ = 1, ẋ = 0 (the velocity projection of call (i)).
-  Vector u(nu, 0.0);
-  u[ind] = 1.0;
-  complete(u, column(ind));
-  s.updU() = u;
-  m.system.realize(s, Stage::Velocity);
   if (parts == SampleParts::All) out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1
-  // b = dr/dq: the accelerations of call (i) (q̇ = 1, q̈ = 0, ẍ = 0), from G b = −bias
-  // (Simbody: acceleration constraint errors G u̇ + bias, bias = −Ġu at this velocity).
-  Vector b(nu, 0.0);
-  if (J.G.nrow() > 0) {
-    Vector bias;
-    m.matter.calcBiasForAccelerationConstraints(s, bias);
-    complete(b, -bias);
-  }
   out.joint_q.resize(nj);
   out.ratio_q.resize(nj);
   out.ratio_slope.resize(nj);
@@ -477,7 +602,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       const int col = m.actuator_slider[k].getFirstUIndex(s);
       Vector rx(nu, 0.0);
       rx[col] = 1.0;
-      complete(rx, column(col));
+      rates->complete(rx, rates->column(col));
       std::vector<double> rates(nj);
       for (int j = 0; j < nj; ++j) finite &= std::isfinite(rates[j] = joint_part(m, s, rx, j));
       out.ratio_x.push_back(std::move(rates));
@@ -526,12 +651,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
       // failed move to retry.
       if (!(std::abs(dx) > 1e-9)) {
         w.anchor_set = false;
-        throw models::SceneError(
-            m.scene.source_file, m.scene.line_of("initial"), "initial",
-            fmt::format("the mechanism starts at a singular configuration of '{}' ({}: the loop Jacobian loses rank "
-                        "and assembly branches cross there), so the branch to follow is not determined; start it a "
-                        "little away from there",
-                        m.scene.independent, format_coordinate(q, revolute)));
+        throw_singular_start(m, s);
       }
     }
     if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {

@@ -35,6 +35,18 @@ KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, 
 // continuation sweeps.
 void move_configuration(const FullModel& model, FullWorkspace& ws, double q);
 
+// Moves the workspace's configuration to q along the branch it is on (continuation): each move
+// starts from the second-order prediction q + q' d + ½ q'' d² (q', q'' from linear solves with the
+// loop Jacobian; at a singular configuration, e.g. a parallelogram's aligned position, the chord
+// of the last move, as calc_kinetostatic_sample) and projects by Newton's method (projectQ at
+// 1e-12, 1e-9 at a singular configuration, when Newton does not contract). A move is at most
+// max_step [rad or m] and is halved while Newton corrects the prediction by more than
+// max_correction [rad or m] in any coordinate: where two branches pass close and the one followed
+// turns sharply, a long move would land on the other. Cost per move: two SVDs of the loop
+// Jacobian and 2–4 position realizations. The branch guard of forward dynamics
+// (engine/branch_guard.hpp). Throws EngineError when a configuration cannot be reached.
+void follow_branch(const FullModel& model, FullWorkspace& ws, double q, double max_step, double max_correction);
+
 // Velocity ratios at q: every joint rate per unit q̇ with every x fixed (wrt_q), and per
 // unit ẋ_k with q̇ = 0 and the other x fixed (wrt_x[k]); folded joints through their gear.
 struct VelocityRatios {

@@ -809,6 +809,7 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
       sp.body_b = f.str("body_b");
       sp.point_a = read_point(f, "point_a", sp.body_a, s);
       sp.point_b = read_point(f, "point_b", sp.body_b, s);
+      note_key(s, top.ctx(), "loads." + sp.name + ".point_b", f.raw("point_b"));  // checked at assembly
       sp.stiffness_N_per_m = f.num("stiffness_N_per_m");
       sp.rest_length_m = f.num("rest_length_m");
       s.springs.push_back(sp);

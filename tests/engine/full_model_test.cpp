@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -125,13 +126,36 @@ initial: {q_deg: 90, qdot: 0}
   EXPECT_TRUE(has(m, "independent coordinate 'a' cannot move")) << m;
 }
 
-TEST(FullModelDof, SingularInitialConfigurationIsNotMistakenForRedundancy) {
+TEST(FullModelDof, SingularInitialConfigurationIsRefusedNamingInitialAndItsLocalDof) {
   // At q = 0 the parallelogram is aligned: C's velocity from every joint is vertical and the
-  // loop Jacobian has rank 1 there only; 0.01 rad away it has rank 2.
+  // loop Jacobian has rank 1 there only; 0.01 rad away it has rank 2. Not redundancy, not two
+  // degrees of freedom: a singular start (issue #22 item 5), bad input naming `initial`, the one
+  // refusal every run and inspect share (extraction's first grid point reuses it).
   std::string y = test::parallelogram_yaml(0.0, false);
-  y.replace(y.find("initial: {q_deg: 40"), 19, "initial: {q_deg: 0");
-  const auto scene = models::parse_scene(y, "aligned.yaml");
-  EXPECT_EQ(refusal(scene), "");
+  const std::string path = ::testing::TempDir() + "aligned_start.yaml";
+  // At 0° and 0.001° (1.7e-5 rad: conditioning ~5e-6, below the extraction's 1e-5) refused.
+  for (const char* start : {"initial: {q_deg: 0,", "initial: {q_deg: 0.001,"}) {
+    std::string a = y;
+    a.replace(a.find("initial: {q_deg: 40,"), 20, start);
+    {
+      std::ofstream out(path);
+      out << a;
+    }
+    const FullModel model(models::load_scene(path));
+    try {
+      FullWorkspace ws(model);
+      ADD_FAILURE() << "a start at the aligned position was accepted: " << start;
+    } catch (const models::SceneError& e) {
+      EXPECT_EQ(e.field(), "initial");
+      EXPECT_EQ(e.line(), 1 + std::count(a.begin(), a.begin() + static_cast<long>(a.find("initial:")), '\n'));
+      EXPECT_TRUE(has(e.message(), "singular configuration of 'crank'")) << e.what();
+      EXPECT_TRUE(has(e.message(), "rank 1 of 2 loop and gear rows over 3 joint coordinates")) << e.what();
+      EXPECT_TRUE(has(e.message(), "locally 2 degrees of freedom")) << e.what();
+    }
+  }
+  // 0.01° away (conditioning ~5e-5) it assembles.
+  y.replace(y.find("initial: {q_deg: 40,"), 20, "initial: {q_deg: 0.01,");
+  EXPECT_EQ(refusal(models::parse_scene(y, "near.yaml")), "");
 }
 
 TEST(FullModelDof, EveryShippedSceneIsAccepted) {
@@ -309,6 +333,35 @@ TEST(SimbodyMessages, ExceptionTextsAreSaidInWords) {
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
   }
   EXPECT_EQ(describe_simbody_exception(std::runtime_error("plain\ntext")), "plain text");
+}
+
+// A spring whose ends coincide where the mechanism assembles has no line of action: refused as
+// the point force above (issue #22 item 6), naming its point_b's line.
+TEST(FullModelSpring, CoincidentEndsAtAssemblyAreASceneErrorWithItsLine) {
+  const std::string load = "  - {type: spring, name: k, body_a: ground, point_a: [0.1, 0], body_b: crank, "
+                           "point_b: B, stiffness_N_per_m: 100, rest_length_m: 0.05}\n";
+  std::string yaml = test::pulled_crank_yaml(5);
+  yaml.replace(yaml.find("  - {type: point_force"), yaml.find("gravity:") - yaml.find("  - {type: point_force"), load);
+  yaml.replace(yaml.find("q_deg: 150"), 10, "q_deg: 0");  // B = (0.1, 0) = point_a
+  const std::string path = ::testing::TempDir() + "coincident_spring.yaml";
+  {
+    std::ofstream out(path);
+    out << yaml;
+  }
+  const FullModel model(models::load_scene(path));
+  try {
+    FullWorkspace ws(model);
+    FAIL() << "assembled";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "loads.k.point_b");
+    const auto at = yaml.find(load);
+    EXPECT_EQ(e.line(), 1 + std::count(yaml.begin(), yaml.begin() + static_cast<long>(at), '\n')) << e.what();
+    EXPECT_TRUE(has(e.message(), "spring 'k'")) << e.what();
+    EXPECT_TRUE(has(e.message(), "no direction")) << e.what();
+  }
+  yaml.replace(yaml.find("q_deg: 0"), 8, "q_deg: 180");
+  const FullModel ok(models::parse_scene(yaml, "ok.yaml"));
+  EXPECT_NO_THROW(FullWorkspace{ok});
 }
 
 }  // namespace

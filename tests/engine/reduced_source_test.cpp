@@ -157,7 +157,7 @@ TEST(ReducedSource, ParallelogramSweepKeepsItsBranchThroughTheAlignedPositions) 
                                {"joints.coupler.guess_deg", minus}});
   };
   for (const auto& [deg, start] : {std::pair{10.0, 30.0}, {5.0, 30.0}, {15.0, 30.0}, {10.0, 2.0}, {10.0, -3.0},
-                                   {10.0, 175.0}, {5.0, 0.001}, {7.5, 181.0}}) {
+                                   {10.0, 175.0}, {5.0, 0.01}, {7.5, 181.0}}) {
     const auto scene = started_at(start);
     const auto s = extract(scene, deg, reduced::Method::Kinetostatic);
     ASSERT_EQ(s.q.size(), static_cast<size_t>(std::lround(360 / deg)));

@@ -102,3 +102,32 @@ inline double pulled_crank_dL_dq(double q) {
 }
 
 }  // namespace rdyn::test
+
+namespace rdyn::test {
+
+// The published branch-switching case (issue #22 item 2), one loop of it: a parallelogram of
+// uniform 1 m, 1 kg rods (I = m L²/12 about the centre) on ground pivots A (0, 0) and D (1, 0),
+// under gravity, both cranks vertical at the start and the crank turning at 1 rad/s. It falls
+// through its aligned (flat, singular) positions at q = 0 and 180°, where the antiparallelogram
+// branch crosses.
+inline std::string rod_parallelogram_yaml(const std::string& simulation = "{duration_s: 6, output_interval_s: 0.01}") {
+  return R"(
+name: rod-parallelogram
+ground_points: {A: [0, 0], D: [1, 0]}
+bodies:
+  - {name: crank, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.0833333333333333, points: {B: [1, 0]}}
+  - {name: coupler, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.0833333333333333, points: {C: [1, 0]}}
+  - {name: rocker, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.0833333333333333, points: {C: [1, 0]}}
+joints:
+  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank, guess_deg: 90}
+  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler, guess_deg: -90}
+  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 90}
+loops:
+  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
+independent: crank
+gravity: {enabled: true}
+initial: {q_deg: 90, qdot: 1.0}
+simulation: )" + simulation + "\n";
+}
+
+}  // namespace rdyn::test
