@@ -284,7 +284,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     }
     record(m, integ->getState(), ts);
     check_finite_row(ts);
-    check_branch(model, guard, integ->getState(), ts.t[ts.t.size() - 2]);
+    if (opt.branch_guard) check_branch(model, guard, integ->getState(), ts.t[ts.t.size() - 2]);
     motion_scale_J = std::max(
         {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
   }

@@ -35,6 +35,11 @@ struct ForwardOptions {
   // Empty: simulate_full computes it (calc_independent_domain: a continuation walk of ~10 ms on
   // the bicycle), so callers that time repeated runs pass it in.
   std::optional<IndependentDomain> domain = std::nullopt;
+  // The branch guard at every output sample (engine/branch_guard.hpp). Off only for timed
+  // repeats of a run whose outputs were already checked with it on (validate's full-model
+  // ladder): with one output at the end it walks the whole run's range of q once, ~0.1 s on the
+  // bicycle's 5 s, which would be charged to Simbody's cost and inflate every speedup.
+  bool branch_guard = true;
 };
 
 // Output rows (duration / interval + 1) a run may produce: 1e7 rows of ~8 doubles is ~0.6 GB.

@@ -571,7 +571,6 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
     rates = &polished;
     conditioning = conditioning_of_rates(polished);
   }
-  const auto& J = rates->J;
   const Vector &u = rates->r, &b = rates->b;
   if (parts == SampleParts::All) out.conditioning = conditioning;
   if (parts == SampleParts::All) out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1

@@ -50,7 +50,7 @@ TEST_F(BranchCli, ABranchSwitchIsExitOneNamingTheTimeAndTheJoint) {
 TEST_F(BranchCli, ASingularStartIsExitTwoNamingInitialInSimulateAndInspect) {
   // Aligned at 0°: the loop Jacobian loses rank (locally 2 degrees of freedom); the full model
   // ran from here with forces of ~1e6 N before, while extraction refused it.
-  for (const std::vector<std::string> args :
+  for (const std::vector<std::string>& args :
        {std::vector<std::string>{"simulate", kParallelogram, "--model", "full", "--set", "initial.q_deg=0", "--out",
                                  "o"},
         std::vector<std::string>{"simulate", kParallelogram, "--model", "reduced", "--set", "initial.q_deg=0", "--out",
