@@ -297,7 +297,7 @@ DivergenceGuard start_divergence_guard(double energy0, double potential_min, dou
   DivergenceGuard g;
   g.energy0 = energy0;
   g.scale0 = std::max(0.0, energy0 - potential_min);
-  g.work_last = work0;
+  g.work_max = std::abs(work0);
   return g;
 }
 

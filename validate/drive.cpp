@@ -14,6 +14,7 @@
 
 #include "engine/full_model.hpp"
 #include "engine/kinetostatic.hpp"
+#include "models/scene_yaml.hpp"
 #include "reduced/samples.hpp"
 
 namespace rdyn::validate {
@@ -46,6 +47,12 @@ void check_finite(double v, const char* what, double t) {
 
 }  // namespace
 
+double calc_drive_moves(const PrescribedMotion& m) {
+  double path = 0.0;
+  for (size_t i = 1; i < m.q.size(); ++i) path += std::abs(m.q[i] - m.q[i - 1]);
+  return path / kDriveMove + static_cast<double>(m.q.size());
+}
+
 PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s, double dt_s) {
   PrescribedMotion m;
   m.t = output_times(duration_s, dt_s);
@@ -59,8 +66,13 @@ PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s,
 
 PrescribedMotion profile_motion(const std::string& path, bool revolute, std::optional<double> duration_opt, double dt_s,
                                 double max_rows) {
+  // Checked before opening: a FIFO without a writer would block, a device never ends.
+  if (const std::string kind = models::non_regular_file_kind(path); !kind.empty())
+    throw models::SceneError(path, 0, "--profile", "not a regular file (" + kind + "): give a CSV file t,q_deg or t,q_m");
   std::ifstream in(path);
   if (!in) throw models::SceneError(path, 0, "--profile", "cannot be read");
+  bool header_seen = false;
+  auto quoted = [](const std::string& l) { return l.size() > 60 ? l.substr(0, 60) + "…" : l; };
   std::string line;
   int line_no = 0;
   std::vector<double> t, q;
@@ -69,11 +81,12 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty() || line[0] == '#') continue;
-    if (t.empty() && q.empty() && line.find_first_not_of("0123456789+-.eE, ") != std::string::npos) {
+    if (!header_seen) {  // the first line that is not a comment
       if (line != want)
         throw models::SceneError(path, line_no, "header",
                                  fmt::format("the header must be '{}' (the independent coordinate is {}), got '{}'",
-                                             want, revolute ? "revolute: degrees" : "prismatic: metres", line));
+                                             want, revolute ? "revolute: degrees" : "prismatic: metres", quoted(line)));
+      header_seen = true;
       continue;
     }
     std::istringstream row(line);
@@ -87,7 +100,7 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
       if (a.find_first_not_of(' ', ea) != std::string::npos || b.find_first_not_of(' ', eb) != std::string::npos)
         throw std::invalid_argument("trailing text");
     } catch (const std::exception&) {
-      throw models::SceneError(path, line_no, "row", fmt::format("'{}' is not two decimal numbers", line));
+      throw models::SceneError(path, line_no, "row", fmt::format("'{}' is not two decimal numbers", quoted(line)));
     }
     if (!std::isfinite(tv) || !std::isfinite(qv) || std::abs(qv) > 1e7)
       throw models::SceneError(path, line_no, "row", "t and q must be finite (|q| ≤ 1e7)");
@@ -135,17 +148,44 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
   // predictor, the chord through singular configurations), in moves of at most kMove: a plain
   // projection from the previous row switched a parallelogram to its antiparallelogram at 3.6°
   // rows through the aligned position.
-  constexpr double kMove = 5.0 * M_PI / 180;
   double q_prev = motion.q.empty() ? 0.0 : motion.q[0];
-  for (size_t i = 0; i < motion.t.size(); ++i) {
-    const int moves = std::max(1, static_cast<int>(std::ceil(std::abs(motion.q[i] - q_prev) / kMove)));
+  auto follow = [&](double q_to) {
+    const int moves = std::max(1, static_cast<int>(std::ceil(std::abs(q_to - q_prev) / kDriveMove)));
     for (int k = 1; k <= moves; ++k)
-      engine::calc_kinetostatic_sample(model, ws, q_prev + (motion.q[i] - q_prev) * k / moves, 2 * kMove,
+      engine::calc_kinetostatic_sample(model, ws, q_prev + (q_to - q_prev) * k / moves, 2 * kDriveMove,
                                        engine::SampleParts::All);
-    q_prev = motion.q[i];
-    // Inverse dynamics there: the driver's generalized force T_act with every load applied.
-    const auto k = engine::calc_kinetostatic(model, ws, motion.q[i], motion.qdot[i], motion.qddot[i],
-                                             engine::Loads::All);
+    q_prev = q_to;
+  };
+  // Inverse dynamics at q: the driver's generalized force T_act with every load applied.
+  auto inverse = [&](double q, size_t i) {
+    return engine::calc_kinetostatic(model, ws, q, motion.qdot[i], motion.qddot[i], engine::Loads::All);
+  };
+  const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    if (std::chrono::duration<double>(Clock::now() - start).count() > kDriveMaxWall_s)
+      throw models::NumericalError(fmt::format("the full model's drive stopped at t = {:.6g} s: it used its wall-time "
+                                               "budget of {:g} s",
+                                               motion.t[i], kDriveMaxWall_s));
+    follow(motion.q[i]);
+    auto k = inverse(motion.q[i], i);
+    if (engine::calc_loop_conditioning(model, ws) < engine::kSingularConditioning) {
+      // At a singular configuration the constraint forces (and with them T_act) are a
+      // least-squares split of no branch (a parallelogram's drive came out 0.31 k for k): the
+      // limit along the branch from both sides, as the extraction's singular samples
+      // (Richardson on q ± δ/2, q ± δ; reduced/extract.cpp).
+      const double d = revolute ? 1e-2 : 1e-3;
+      std::vector<engine::KinetostaticResult> side;
+      for (double off : {-d, -d / 2, d / 2, d}) {
+        follow(motion.q[i] + off);
+        side.push_back(inverse(motion.q[i] + off, i));
+      }
+      auto limit = [](double m1, double m2, double p2, double p1) { return (2 * (m2 + p2) - 0.5 * (m1 + p1)) / 3; };
+      k.driving_force = limit(side[0].driving_force, side[1].driving_force, side[2].driving_force,
+                              side[3].driving_force);
+      for (size_t c = 0; c < names.size(); ++c)
+        k.constraint_forces[c] = limit(side[0].constraint_forces[c], side[1].constraint_forces[c],
+                                       side[2].constraint_forces[c], side[3].constraint_forces[c]);
+    }
     check_finite(k.driving_force, "generalized force", motion.t[i]);
     r.drive.push_back(k.driving_force);
     r.power.push_back(k.driving_force * motion.qdot[i]);

@@ -33,6 +33,15 @@ PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s,
 PrescribedMotion profile_motion(const std::string& path, bool revolute, std::optional<double> duration_s, double dt_s,
                                 double max_rows = 1e7);
 
+// The full model follows the branch in moves of at most kDriveMove between rows (one
+// kinetostatic sample each, ~0.1–0.3 ms); calc_drive_moves counts them for a motion, so the
+// command can refuse one that would take hours before any work (kMaxDriveMoves), and a run
+// stops after kDriveMaxWall_s all the same.
+constexpr double kDriveMove = 5.0 * 3.14159265358979323846 / 180;
+constexpr double kMaxDriveMoves = 2e5;
+constexpr double kDriveMaxWall_s = 600.0;
+double calc_drive_moves(const PrescribedMotion& motion);
+
 struct DriveRecord {
   std::vector<double> t, q, qdot, qddot;
   std::vector<double> drive;  // generalized force the drive adds on q [N·m or N]

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -49,6 +50,27 @@ TEST(Drive, ParallelogramAtConstantRateHoldsGravityOnly) {
   EXPECT_NEAR(st.mean_power_W, 0.0, 1e-6 * k * motion.qdot[0]);
   EXPECT_NEAR(st.rms, k / std::sqrt(2.0), 1e-4 * k);
   EXPECT_NEAR(st.peak, k, 1e-3 * k);  // rows 3.6° apart: the sampled peak is within 1 − cos 1.8°
+}
+
+// A row exactly at an aligned (singular) position: the constraint split there is least squares,
+// so the full model takes the drive's limit along the branch from both sides (it gave 0.31 k).
+// The chain of 3 parallelograms the same at its flat rows: k = g [(N+1)/2 + N].
+TEST(Drive, FullModelAtASingularRowTakesTheBranchLimit) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  const double k = 9.81 * (0.5 * 0.05 + 0.7 * 0.05 + 1.2 * 0.1);
+  const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI, 0.5, 1.0 / 24);  // 15° rows through 180°
+  const auto full = calc_drive_full(scene, motion);
+  bool singular_row = false;
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    singular_row |= std::abs(std::remainder(motion.q[i], M_PI)) < 1e-12;
+    EXPECT_NEAR(full.drive[i], k * std::cos(motion.q[i]), 1e-6 * k) << motion.t[i];
+  }
+  EXPECT_TRUE(singular_row);
+  const auto chain = models::load_scene(RDYN_SCENES "/chains/chain-3.yaml");
+  const double kc = 9.81 * (4 / 2.0 + 3);
+  const auto cm = constant_rate_motion(chain.initial.q, 2 * M_PI, 1.0, 0.25);  // 90°, 180°, 270°, 360°, 450°
+  const auto cf = calc_drive_full(chain, cm);
+  for (size_t i = 0; i < cm.t.size(); ++i) EXPECT_NEAR(cf.drive[i], kc * std::cos(cm.q[i]), 1e-6 * kc) << cm.t[i];
 }
 
 // The bicycle with its hip torque gate, brake and knee force: full inverse dynamics against the
@@ -110,7 +132,17 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   auto run = [&](std::vector<std::string> args) { return test::run_rdyn(args, dir); };
-  auto r = run({"drive", "fourbar", "--cadence-hz", "2", "--out", "out"});
+  // Statistics come from rows at most 1° apart whatever --dt-out: 0.5 s rows of a 1 rev/s run.
+  auto r = run({"drive", RDYN_SCENES "/hard/parallelogram.yaml", "--cadence-hz", "1", "--duration", "2", "--dt-out",
+                "0.5", "--model", "reduced", "--out", "coarse"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto c = nlohmann::json::parse(test::slurp(dir / "coarse" / "run.json"));
+  const double kp = 9.81 * 0.18;
+  EXPECT_NEAR(c["drive_peak"].get<double>(), kp, 1e-4 * kp);
+  EXPECT_NEAR(c["drive_rms"].get<double>(), kp / std::sqrt(2.0), 1e-4 * kp);
+  const std::string coarse = test::slurp(dir / "coarse" / "timeseries.csv");
+  EXPECT_EQ(std::count(coarse.begin(), coarse.end(), '\n'), 6);  // header + 0, 0.5, 1, 1.5, 2
+  r = run({"drive", "fourbar", "--cadence-hz", "2", "--out", "out"});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(test::slurp(dir / "out" / "run.json"));
   EXPECT_EQ(j["drive_unit"], "N·m");
@@ -126,7 +158,10 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
            {"drive", "fourbar", "--cadence-hz", "0", "--out", "o2"},
            {"drive", "fourbar", "--cadence-hz", "inf", "--out", "o2"},
            {"drive", "slider-crank-slider", "--cadence-hz", "1", "--out", "o2"},
-           {"drive", "fourbar", "--profile", "missing.csv", "--out", "o2"}}) {
+           {"drive", "fourbar", "--profile", "missing.csv", "--out", "o2"},
+           {"drive", "fourbar", "--profile", "/dev/zero", "--out", "o2"},  // never ends: refused unread
+           {"drive", "fourbar", "--cadence-hz", "1", "--duration", "0.5", "--dt-out", "1", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "1000", "--duration", "10", "--out", "o2"}}) {  // hours of moves
     r = run(args);
     EXPECT_EQ(r.status, 2) << args[2] << " " << r.err;
     EXPECT_FALSE(fs::exists(dir / "o2")) << args[2];
