@@ -302,6 +302,21 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   return false;
 }
 
+// Position projection with the independent coordinate prescribed: the chord Newton iteration,
+// else Simbody's projectQ at 1e-12, else at 1e-9 (a singular configuration, counted). Throws
+// what projectQ throws when none succeeds (the callers name the coordinate).
+void project_prescribed(const FullModel::Impl& m, State& s) {
+  m.system.realize(s, Stage::Time);
+  m.system.prescribeQ(s);
+  if (newton_project(m, s)) return;
+  try {
+    m.system.projectQ(s, 1e-12);
+  } catch (const std::exception&) {
+    m.system.projectQ(s, 1e-9);  // singular configuration: as project()
+    ++m.near_singular_projections;
+  }
+}
+
 // Near a singular configuration the rates carry the loop residual magnified by the
 // conditioning κ: positions by 1/κ, velocity ratios by 1/κ², m2 (second-order terms) by 1/κ³;
 // a residual of 1e-13 put m2 off by 1e-6 at 4e-3 rad from a parallelogram chain's flat
@@ -455,16 +470,7 @@ void follow_branch(const FullModel& model, FullWorkspace& ws, double q, double m
       m.set_law(s, 0, poly_law(x_new, 0.0, 0.0));
       bool converged = true;
       try {
-        m.system.realize(s, Stage::Time);
-        m.system.prescribeQ(s);
-        if (!newton_project(m, s)) {
-          try {
-            m.system.projectQ(s, 1e-12);
-          } catch (const std::exception&) {
-            m.system.projectQ(s, 1e-9);  // singular configuration: as project()
-            ++m.near_singular_projections;
-          }
-        }
+        project_prescribed(m, s);
       } catch (const std::exception&) {
         converged = false;
       }
@@ -534,16 +540,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   // Position: the Newton projection of the loops, the only iterative step. Velocities and
   // accelerations follow from linear solves with the Jacobian at the converged configuration.
   try {
-    m.system.realize(s, Stage::Time);
-    m.system.prescribeQ(s);
-    if (!newton_project(m, s)) {
-      try {
-        m.system.projectQ(s, 1e-12);
-      } catch (const std::exception&) {
-        m.system.projectQ(s, 1e-9);  // singular configuration: as project()
-        ++m.near_singular_projections;
-      }
-    }
+    project_prescribed(m, s);
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
