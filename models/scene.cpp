@@ -211,6 +211,13 @@ void check_table_column_names(const Checker& c, const Scene& s) {
   std::vector<std::pair<std::string, std::string>> forces;  // name, field that gives it
   for (size_t i = 0; i < cf.size(); ++i) {
     const std::string field = fmt::format("outputs.constraint_forces[{}].name", i);
+    // validate judges quantities by name: a force named like the speed would take its verdict
+    // (a wrong knee force named 'qdot' was judged on the speed's error).
+    for (const char* q : {"qdot", "mean_qdot", "q", "qddot", "energy", "work"})
+      if (cf[i].name == q)
+        c.fail(field, fmt::format("'{}' is reserved: validate and the time series use it for the motion itself; "
+                                  "choose another name",
+                                  q));
     for (const auto& j : s.joints)
       for (const char* axis : {"_cx", "_cy"})
         if (cf[i].name == "R_" + j.name + axis)

@@ -839,6 +839,13 @@ void issue23(std::vector<Case>& cs) {
                   fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_cx' is reserved",
                               reserved_line),
                   {{"s.yaml", reserved}}, nullptr, "o"});
+    // A force named like the speed took the speed's verdict in validate.
+    const std::string as_speed = edit(fb, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
+                                      "    - {name: qdot, joint: rocker, direction: C}\n");
+    cs.push_back({"force_named_like_the_speed", {"validate", "s.yaml", "--quick", "--out", "o"}, 2,
+                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[0].name': 'qdot' is reserved",
+                              line_of(as_speed, "name: qdot")),
+                  {{"s.yaml", as_speed}}, nullptr, "o"});
   }
   // A table file edited by hand: a negative m1, a missing column. Each names the table's line.
   auto edited_table = [](std::function<std::string(std::vector<std::vector<std::string>>&)> change) {
