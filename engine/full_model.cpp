@@ -278,31 +278,26 @@ void check_branches(const FullModel::Impl& m, const State& s) {
 
 // Every point force and spring has a direction where the mechanism assembles: its points are apart.
 void check_point_forces(const FullModel::Impl& m, const State& s) {
-  for (const auto& f : m.scene.point_forces) {
-    const double L = calc_point_force_line(m, s, f, false).length;
-    if (L >= models::limits::kMinPointForceLength_m) continue;
-    const std::string field = "loads." + f.name + ".point_b";
+  // One refusal for both kinds: a load whose two points (nearly) coincide has no line of action.
+  auto refuse_if_close = [&](const char* kind, const std::string& name, const std::string& body_a,
+                             const std::string& body_b, double L) {
+    if (L >= models::limits::kMinPointForceLength_m) return;
+    const std::string field = "loads." + name + ".point_b";
     throw models::SceneError(
         m.scene.source_file, m.scene.line_of(field), field,
-        fmt::format("point force '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled "
-                    "configuration (at {} = {:.6g}), closer than {:g} m: the line of action has no direction",
-                    f.name, f.body_b, L, f.body_a, m.scene.independent, m.scene.initial.q,
+        fmt::format("{} '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled configuration "
+                    "(at {} = {:.6g}), closer than {:g} m: the line of action has no direction",
+                    kind, name, body_b, L, body_a, m.scene.independent, m.scene.initial.q,
                     models::limits::kMinPointForceLength_m));
-  }
+  };
+  for (const auto& f : m.scene.point_forces)
+    refuse_if_close("point force", f.name, f.body_a, f.body_b, calc_point_force_line(m, s, f, false).length);
   // A spring too: its force k (L − L0) acts along a line that has no direction at L = 0 (the full
   // model skipped it there, the reduced model's potential did not: the two then disagree).
   for (const auto& sp : m.scene.springs) {
     const Vec3 p_GA = m.mobod_of(sp.body_a).findStationLocationInGround(s, v3(sp.point_a));
     const Vec3 p_GB = m.mobod_of(sp.body_b).findStationLocationInGround(s, v3(sp.point_b));
-    const double L = (p_GB - p_GA).norm();
-    if (L >= models::limits::kMinPointForceLength_m) continue;
-    const std::string field = "loads." + sp.name + ".point_b";
-    throw models::SceneError(
-        m.scene.source_file, m.scene.line_of(field), field,
-        fmt::format("spring '{}': point_b on '{}' lies {:.3g} m from point_a on '{}' in the assembled configuration "
-                    "(at {} = {:.6g}), closer than {:g} m: the spring's line of action has no direction",
-                    sp.name, sp.body_b, L, sp.body_a, m.scene.independent, m.scene.initial.q,
-                    models::limits::kMinPointForceLength_m));
+    refuse_if_close("spring", sp.name, sp.body_a, sp.body_b, (p_GB - p_GA).norm());
   }
 }
 
