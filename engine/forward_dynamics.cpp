@@ -10,6 +10,7 @@
 #include "engine/full_model_impl.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/kinetostatic.hpp"
+#include "engine/singular_passage.hpp"
 #include "reduced/joint_outputs.hpp"
 
 namespace rdyn::engine {
@@ -71,6 +72,72 @@ void record(const FullModel::Impl& m, const State& s, TimeSeries& ts) {
     for (size_t k = 0; k < c.size(); ++k) ts.columns[k].push_back(c[k]);
   }
   ts.stats.max_constraint_error = std::max(ts.stats.max_constraint_error, m.worst_loop_gap(s).first);
+}
+
+// The Simbody state of free motion at p on the branch the guard follows (its workspace at p.q):
+// a kinetostatic projection at (q, q̇), then the independent coordinate released. The start of
+// a run, and the restart after a singular passage.
+State free_state(const FullModel& model, BranchGuard& guard, const PassagePoint& p) {
+  const auto& m = model.impl();
+  calc_kinetostatic(model, guard.ws, p.q, p.qdot, 0.0, Loads::Off);
+  State s = guard.ws.impl().state;
+  m.independent_motion.disable(s);
+  m.system.realizeModel(s);
+  s.setTime(p.t);
+  m.set_load_mode(s, kLoadsEvents);
+  m.forces.updZ(s)[m.work_index] = p.work;
+  initialize_gates(m, s);
+  return s;
+}
+
+// Replaces the last rows, one per node of the stencil, by their interpolation at its point
+// (singular_passage.hpp); gates from the node nearest below it.
+void combine_last_rows(TimeSeries& ts, const LimitStencil& st) {
+  const size_t k = st.w.size();
+  auto combine = [&](std::vector<double>& v) {
+    const size_t first = v.size() - k;
+    double r = 0.0;
+    for (size_t i = 0; i < k; ++i) r += st.w[i] * v[first + i];
+    v.resize(first + 1);
+    v.back() = r;
+  };
+  for (auto* v : {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work}) combine(*v);
+  for (auto& v : ts.forces) combine(v);
+  for (auto& v : ts.columns) combine(v);
+  const auto g = ts.gates[ts.gates.size() - k + k / 2 - 1];
+  ts.gates.resize(ts.gates.size() - k + 1);
+  ts.gates.back() = g;
+}
+
+// One output row of a singular passage at p: the full state on the branch with the free
+// acceleration prescribed (the drive it needs is then zero), recorded as the integrator's rows
+// are; near rank loss, where the multipliers are poorly determined, the interpolation of rows
+// taken outside the limit radius. Returns the kinetic
+// energy (of the row, or the largest of the four) [J].
+double record_passage(const FullModel& model, BranchGuard& guard, const IndependentDomain& domain,
+                      const PassagePoint& p, TimeSeries& ts) {
+  const auto& m = model.impl();
+  double kinetic_J = 0.0;
+  auto row_at = [&](double q) {
+    const auto fm = calc_free_motion(model, guard, q, p.qdot, LimitStencil{});
+    set_passage_state(model, guard, q, p.qdot, fm.qddot);
+    State& st = guard.ws.impl().state;  // its time stays 0: the prescribed law is q + q̇ t + ½ q̈ t²
+    m.forces.updZ(st)[m.work_index] = p.work;
+    initialize_gates(m, st);
+    record(m, st, ts);
+    ts.t.back() = p.t;
+    kinetic_J = std::max(kinetic_J, m.system.calcKineticEnergy(st));
+  };
+  const auto stencil = limit_stencil_at(domain.singular, domain.periodic, p.q);
+  if (stencil.x.empty()) {
+    row_at(p.q);
+    return kinetic_J;
+  }
+  for (const double x : stencil.x) row_at(x);
+  combine_last_rows(ts, stencil);
+  ts.t.back() = p.t, ts.q.back() = p.q, ts.qdot.back() = p.qdot, ts.work.back() = p.work;
+  follow_branch(model, guard.ws, p.q, guard.max_move, guard.max_correction);
+  return kinetic_J;
 }
 
 // Options in their documented ranges (EngineError: they are input, from the scene or the CLI).
@@ -169,14 +236,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   // coordinate is released.
   // The workspace then stays with the branch guard, which continues it along the starting branch.
   BranchGuard guard(model);
-  calc_kinetostatic(model, guard.ws, m.scene.initial.q, m.scene.initial.qdot, 0.0, Loads::Off);
-  State s = guard.ws.impl().state;
-  m.independent_motion.disable(s);
-  m.system.realizeModel(s);
-  s.setTime(0.0);
-  m.set_load_mode(s, kLoadsEvents);
-  m.forces.updZ(s)[m.work_index] = 0.0;
-  initialize_gates(m, s);
+  State s = free_state(model, guard, {0.0, m.scene.initial.q, m.scene.initial.qdot, 0.0});
 
   auto integ = make_integrator(m, opt.integrator);
   integ->setAccuracy(opt.tolerance);
@@ -224,12 +284,76 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   std::vector<Vec3> line_dir;  // point forces' directions after the last step
   m.system.realize(integ->getState(), Stage::Position);
   check_point_force_lines(m, integ->getState(), line_dir);
-  for (long i = 1; i <= n; ++i) {
+  // Singular passages (engine/singular_passage.hpp): a step that touches a window around a
+  // configuration of rank loss is taken back and the window is crossed in the partitioned
+  // formulation; Simbody restarts beyond it.
+  const bool periodic = domain.periodic;
+  static const std::vector<SingularPoint> kNone;
+  const auto& singular = opt.singular_passages ? domain.singular : kNone;
+  std::optional<PassagePoint> passage;  // set: start the partitioned formulation here
+  if (!singular.empty() && !outside_windows(singular, periodic, m.scene.initial.q))
+    passage = PassagePoint{0.0, m.scene.initial.q, m.scene.initial.qdot, 0.0};
+  long passage_steps = 0, passages = 0, steps_before_restarts = 0, attempts_before_restarts = 0;
+  for (long i = 1; i <= n;) {
+    if (passage) {
+      PassageOptions po;
+      po.tolerance = opt.tolerance;
+      po.t_end = opt.duration_s;
+      po.max_steps = std::max(1L, opt.max_steps - passage_steps - steps_before_restarts - integ->getNumStepsAttempted());
+      po.max_wall_s = std::max(0.0, opt.max_wall_s - wall());
+      long taken = 0;
+      PassagePoint end;
+      try {
+        end = integrate_passage(
+          model, guard, singular, periodic, *passage, po,
+          [&] { return i <= n ? models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s) : INFINITY; },
+          [&](const PassagePoint& p) {
+            const double kinetic_J = record_passage(model, guard, domain, p, ts);
+            check_finite_row(ts);
+            motion_scale_J = std::max({motion_scale_J, kinetic_J, std::abs(ts.work.back())});
+            ++i;
+          },
+          taken);
+      } catch (const EngineError& e) {  // the continuation failed: numerical, not the input
+        throw models::NumericalError(fmt::format("full model's singular passage from t = {:.6g} s failed: {}",
+                                                 passage->t, e.what()));
+      }
+      passage_steps += taken;
+      ++passages;
+      passage.reset();
+      if (i > n) break;
+      // Simbody again, from the end of the passage.
+      const long taken_before = integ->getNumStepsTaken(), attempted_before = integ->getNumStepsAttempted();
+      try {
+        stepper.initialize(free_state(model, guard, end));  // EngineError too: caught below
+        if (integ->getNumStepsAttempted() < attempted_before) {  // the statistics restarted too
+          steps_before_restarts += taken_before;
+          attempts_before_restarts += attempted_before;
+        }
+      } catch (const std::exception& e) {
+        throw models::NumericalError(fmt::format("full model could not restart after the singular passage at t = "
+                                                 "{:.6g} s: {}",
+                                                 end.t, describe_simbody_exception(e)));
+      }
+      line_dir.clear();
+      m.system.realize(integ->getState(), Stage::Position);
+      check_point_force_lines(m, integ->getState(), line_dir);
+      continue;
+    }
     const double t = models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s);
     try {
       while (integ->getTime() < t - 1e-14) {
         const double t_before = integ->getTime(), q_before = m.joint_q(integ->getState(), m.independent);
+        std::optional<State> before;
+        if (!singular.empty()) before = integ->getState();
         stepper.stepTo(t);
+        if (before) {
+          const double q_adv = m.joint_q(integ->getAdvancedState(), m.independent);
+          if (find_window(singular, periodic, q_before, q_adv) >= 0) {
+            passage = PassagePoint{t_before, q_before, m.joint_u(*before, m.independent), m.work(*before)};
+            break;
+          }
+        }
         const double h = integ->getPreviousStepSizeTaken();
         if (!line_dir.empty()) check_point_force_lines(m, integ->getState(), line_dir);
         if (!domain.periodic) {
@@ -245,7 +369,8 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
           }
         }
         if (h > 0) smallest = std::min(smallest, h);
-        const long steps = std::max<long>(++calls, integ->getNumStepsAttempted());
+        const long steps =
+            std::max<long>(++calls, attempts_before_restarts + integ->getNumStepsAttempted()) + passage_steps;
         const double w = wall();
         if (calls % kWindow == 0) {
           const double now = integ->getTime(), mean_h = (now - window_t0) / kWindow;
@@ -282,14 +407,17 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
           fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}", integ->getTime(),
                       integ->getPreviousStepSizeTaken(), describe_simbody_exception(e)));
     }
+    if (passage) continue;
     record(m, integ->getState(), ts);
     check_finite_row(ts);
     if (opt.branch_guard) check_branch(model, guard, integ->getState(), ts.t[ts.t.size() - 2]);
     motion_scale_J = std::max(
         {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
+    ++i;
   }
-  ts.stats.steps_taken = integ->getNumStepsTaken();
-  ts.stats.steps_attempted = integ->getNumStepsAttempted();
+  ts.stats.steps_taken = steps_before_restarts + integ->getNumStepsTaken() + passage_steps;
+  ts.stats.steps_attempted = attempts_before_restarts + integ->getNumStepsAttempted() + passage_steps;
+  ts.stats.singular_passages = passages;
   ts.stats.events = m.events_handled;
   ts.stats.smallest_step_s = std::isfinite(smallest) ? smallest : 0.0;
   ts.stats.wall_time_s = wall();

@@ -40,6 +40,11 @@ struct ForwardOptions {
   // ladder): with one output at the end it walks the whole run's range of q once, ~0.1 s on the
   // bicycle's 5 s, which would be charged to Simbody's cost and inflate every speedup.
   bool branch_guard = true;
+  // Configurations of rank loss crossed in the partitioned formulation (engine/
+  // singular_passage.hpp). Off: Simbody's integrator steps through them itself, and the branch
+  // guard stops a run that leaves its branch there — only to show what the passages are for
+  // (tests, measurements); no command turns it off.
+  bool singular_passages = true;
 };
 
 // Output rows (duration / interval + 1) a run may produce: 1e7 rows of ~8 doubles is ~0.6 GB.
@@ -57,6 +62,9 @@ using models::TimeSeries;
 // or wall-time budget exhausted, a non-finite value, an energy balance that does not close, or a
 // switch of assembly branch (engine/branch_guard.hpp: checked at every output sample, ~0.2 ms
 // each on the bicycle). A start at a singular configuration is a models::SceneError (`initial`).
+// Through configurations where the loop Jacobian loses rank (domain.singular) the motion is
+// integrated in the independent coordinate (engine/singular_passage.hpp); stats.singular_passages
+// counts those windows.
 TimeSeries simulate_full(const FullModel& model, const ForwardOptions& options);
 
 }  // namespace rdyn::engine

@@ -1,4 +1,5 @@
 #include "engine/independent_range.hpp"
+#include "engine/singular_passage.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -116,7 +117,9 @@ std::string format_coordinate(double q, bool revolute) {
   return revolute ? fmt::format("q = {:.9g}°", q * 180 / kPi) : fmt::format("q = {:.9g} m", q);
 }
 
-IndependentDomain calc_independent_domain(const FullModel& model) {
+namespace {
+
+IndependentDomain calc_domain_edges(const FullModel& model) {
   const auto& sc = model.scene();
   const auto* jt = sc.find_joint(sc.independent);
   if (!jt) throw EngineError(sc.source_file + ": unknown independent joint '" + sc.independent + "'");
@@ -176,6 +179,14 @@ IndependentDomain calc_independent_domain(const FullModel& model) {
         "independent_range",
         models::where(sc, "initial"), format_coordinate(sc.initial.q, d.revolute), 100 * kDeadPointMargin, sc.independent,
         *d.dead_min * k, unit, *d.dead_max * k, unit, 100 * kDeadPointMargin));
+  return d;
+}
+
+}  // namespace
+
+IndependentDomain calc_independent_domain(const FullModel& model) {
+  IndependentDomain d = calc_domain_edges(model);
+  d.singular = calc_singular_points(model, d);
   return d;
 }
 

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "engine/full_model.hpp"
 
@@ -17,6 +18,17 @@ namespace rdyn::engine {
 // value, 2–3× its minimum for fourbar-rocker (docs/theory.md, "Range tables").
 inline constexpr double kDeadPointMargin = 0.05;
 
+// A configuration inside the domain where the loop Jacobian loses rank (a parallelogram lying
+// flat): the full model passes it in the partitioned formulation (engine/singular_passage.hpp).
+struct SingularPoint {
+  double q = 0.0;           // the configuration of rank loss [rad or m]
+  double half_width = 0.0;  // the window is q ± half_width [rad or m]
+  // Within q ± limit_radius the rates are too poorly determined to be used (the conditioning is
+  // below kLimitConditioning there): values are limits from outside it [rad or m].
+  double limit_radius = 0.0;
+  double conditioning = 0.0;  // the loop Jacobian's at q (below kSingularConditioning)
+};
+
 struct IndependentDomain {
   bool periodic = false;  // a revolute turning fully, no range declared: no edges
   double min = 0.0, max = 0.0;  // edges of the domain [rad or m] (not set when periodic)
@@ -28,6 +40,8 @@ struct IndependentDomain {
   // only one): min = −∞, max = +∞ and this says why. The full model runs unbounded; a reduced
   // table needs a declared independent_range (extraction refuses with this message).
   std::string unbounded_reason;
+  // Configurations of rank loss inside the domain (calc_singular_points), in walking order.
+  std::vector<SingularPoint> singular;
 };
 
 // Declared range: returned as given after walking to both ends (EngineError when a dead point

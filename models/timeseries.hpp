@@ -17,6 +17,7 @@ struct RunStats {
   double smallest_step_s = 0.0;       // smallest step size used [s] (0 when unknown)
   double max_constraint_error = 0.0;  // largest loop-closure violation seen [m] (full model)
   double wall_time_s = 0.0;
+  long singular_passages = 0;  // windows of rank loss crossed in the partitioned formulation (full model)
 };
 
 struct TimeSeries {
