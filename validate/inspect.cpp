@@ -57,6 +57,11 @@ nlohmann::json inspection_json(const models::Scene& scene, const engine::Inspect
     range["dead_point_margin"] = engine::kDeadPointMargin;
   }
   range["dead_points"] = dead;
+  // Configurations of rank loss inside the domain (a parallelogram lying flat): passable, not
+  // edges; the full model crosses them in its partitioned formulation (docs/theory.md §7a).
+  nlohmann::json singular = nlohmann::json::array();
+  for (const auto& p : d.singular) singular.push_back(p.q * k);
+  range["singular_configurations"] = singular;
   return {{"scene", scene.name},
           {"scene_file", scene.source_file},
           {"independent", scene.independent},

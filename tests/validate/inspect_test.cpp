@@ -118,6 +118,22 @@ TEST(InspectCli, DeclaredAndUnboundedRanges) {
   fs::remove_all(dir);
 }
 
+TEST(InspectCli, AFlatParallelogramChainIsSingularNotADeadPoint) {
+  // It turns fully; twice a turn its loops' Jacobian loses rank (flat at 180° and 360° from the
+  // 90° start): passable configurations, listed apart from the dead points.
+  CliRun r = rdyn(std::string("inspect ") + RDYN_SCENES + "/chains/chain-3.yaml");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["range"]["full_turn"].get<bool>());
+  EXPECT_TRUE(j["range"]["dead_points"].empty());
+  ASSERT_EQ(j["range"]["singular_configurations"].size(), 2u);
+  EXPECT_NEAR(j["range"]["singular_configurations"][0].get<double>(), 180.0, 1e-6);
+  EXPECT_NEAR(j["range"]["singular_configurations"][1].get<double>(), 360.0, 1e-6);
+  r = rdyn("inspect fourbar");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(nlohmann::json::parse(r.out)["range"]["singular_configurations"].empty());
+}
+
 TEST(InspectCli, BadInputIsExitTwoNamingTheField) {
   CliRun r = rdyn("inspect fourbar --set bodies.crank.mass_kg=-1");
   EXPECT_EQ(r.status, 2) << r.err;
