@@ -4,17 +4,12 @@
 
 #include <cmath>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace rdyn::validate {
+#include "validate/argument_error.hpp"
 
-// A command-line value out of its documented range (exit status 2).
-class ArgumentError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+namespace rdyn::validate {
 
 struct SimulateArgs {
   std::string scene;

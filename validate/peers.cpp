@@ -7,7 +7,7 @@
 #include "engine/full_model.hpp"
 #include "engine/kinetostatic.hpp"
 #include "engine/mujoco_peer.hpp"
-#include "validate/commands.hpp"
+#include "validate/argument_error.hpp"
 #include "validate/pareto.hpp"
 #include "validate/timing.hpp"
 
