@@ -25,6 +25,7 @@
 #include "validate/report.hpp"
 #include "validate/summary.hpp"
 #include "validate/sweep.hpp"
+#include "validate/sweep_axis.hpp"
 #include "validate/progress.hpp"
 #include "validate/output_dir.hpp"
 #include "validate/peers.hpp"

@@ -9,13 +9,11 @@
 
 namespace rdyn::validate {
 
+// One axis of the sweep (read from `--vary` by validate/sweep_axis.hpp).
 struct SweepAxis {
   std::string key;  // a scene key path, as for --set
   std::vector<double> values;
 };
-
-// "key=a:b:n" → n values from a to b (n ≥ 1; n = 1 gives a). Throws models::SceneError.
-SweepAxis parse_sweep_axis(const std::string& text);
 
 struct SweepOptions {
   std::string scene;

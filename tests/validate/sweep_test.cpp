@@ -18,21 +18,10 @@
 #include "models/scene.hpp"
 #include "models/scene_yaml.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/sweep_axis.hpp"
 
 namespace rdyn::validate {
 namespace {
-
-TEST(Sweep, AxesParseAndRejectBadRanges) {
-  const auto a = parse_sweep_axis("bicycle_leg.subject.height_m=1.6:1.9:4");
-  EXPECT_EQ(a.key, "bicycle_leg.subject.height_m");
-  ASSERT_EQ(a.values.size(), 4u);
-  EXPECT_DOUBLE_EQ(a.values[0], 1.6);
-  EXPECT_DOUBLE_EQ(a.values[3], 1.9);
-  EXPECT_THROW(parse_sweep_axis("x=1:2"), models::SceneError);
-  EXPECT_THROW(parse_sweep_axis("x=1:2:0"), models::SceneError);
-  EXPECT_THROW(parse_sweep_axis("=1:2:3"), models::SceneError);
-  EXPECT_THROW(parse_sweep_axis("x=1:nan:3"), models::SceneError);
-}
 
 TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   SweepOptions o;
