@@ -19,6 +19,7 @@
 #include "reduced/simulate_reduced.hpp"
 #include "validate/build_reduced.hpp"
 #include "validate/calibrate.hpp"
+#include "validate/cli_limits.hpp"
 #include "validate/escape.hpp"
 #include "validate/harness.hpp"
 #include "validate/inspect.hpp"
@@ -46,18 +47,6 @@ models::Scene load(const std::string& scene, const std::vector<std::string>& set
   return models::load_scene(scene, overrides_of(sets));
 }
 
-// Ranges of the command-line numbers (README, "Limits"). Every number is checked before any
-// work starts, so nothing hangs or exhausts memory.
-constexpr double kMaxDuration_s = 1e5;
-constexpr double kMinOutputInterval_s = 1e-6;
-constexpr double kMaxOutputRows = 1e7;       // ~1.5 GB of CSV at most
-constexpr double kMinTolerance = 1e-14, kMaxTolerance = 1e-1;
-constexpr double kMinFixedStep_s = 1e-7, kMaxFixedStep_s = 1.0;
-constexpr double kMaxFixedSteps = 1e8;       // ~20 s of RK4 steps
-constexpr double kMinGrid_deg = 0.01, kMaxGrid_deg = 90.0;  // 36000 grid points at most
-constexpr int kMaxThreads = 256;
-constexpr double kMaxCadence_Hz = 1000.0, kMaxPower_W = 1e7;
-
 void require_in(const std::string& option, double v, double lo, double hi, const char* unit) {
   if (!(std::isfinite(v) && v >= lo && v <= hi))
     throw ArgumentError(fmt::format("{}: must be a finite number in [{:g}, {:g}]{} (got {})", option, lo, hi, unit, v));
@@ -69,7 +58,7 @@ void require_positive_up_to(const std::string& option, double v, double hi, cons
 }
 
 void require_grid(const std::string& option, double g) {
-  require_in(option, g, kMinGrid_deg, kMaxGrid_deg, " deg");
+  require_in(option, g, cli_limits::kMinGrid_deg, cli_limits::kMaxGrid_deg, " deg");
   const double n = 360.0 / g;
   if (std::abs(n - std::round(n)) > 1e-9 * n)
     throw ArgumentError(fmt::format("{}: {:g}° does not divide 360° into whole steps", option, g));
@@ -77,11 +66,11 @@ void require_grid(const std::string& option, double g) {
 
 // Duration, output interval and the number of rows they make.
 void require_timing(double duration, double dt_out) {
-  require_positive_up_to("--duration", duration, kMaxDuration_s, " s");
-  require_in("--dt-out", dt_out, kMinOutputInterval_s, duration, " s (and at most --duration)");
-  if (duration / dt_out > kMaxOutputRows)
+  require_positive_up_to("--duration", duration, cli_limits::kMaxDuration_s, " s");
+  require_in("--dt-out", dt_out, cli_limits::kMinOutputInterval_s, duration, " s (and at most --duration)");
+  if (duration / dt_out > cli_limits::kMaxOutputRows)
     throw ArgumentError(fmt::format("--dt-out: {:g} s over {:g} s makes {:.3g} rows; at most {:g}", dt_out, duration,
-                                    duration / dt_out, kMaxOutputRows));
+                                    duration / dt_out, cli_limits::kMaxOutputRows));
 }
 
 // Recognisers of rdyn's own single-file outputs, so a re-run may replace them.
@@ -107,13 +96,14 @@ int run_simulate(const SimulateArgs& a) {
   const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
   require_timing(duration, dt_out);
   // Every number given is checked, also those of the other model: a typo is never ignored.
-  require_in("--tolerance", tolerance, kMinTolerance, kMaxTolerance, "");
-  require_in("--reduced-tolerance", a.reduced_tolerance, kMinTolerance, kMaxTolerance, "");
+  require_in("--tolerance", tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
+  require_in("--reduced-tolerance", a.reduced_tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
   require_grid("--grid-deg", a.grid_deg);
-  require_in("--fixed-step", a.fixed_step, kMinFixedStep_s, kMaxFixedStep_s, " s");
-  if (a.model == "reduced" && a.reduced_integrator == "rk4-fixed" && duration / a.fixed_step > kMaxFixedSteps)
+  require_in("--fixed-step", a.fixed_step, cli_limits::kMinFixedStep_s, cli_limits::kMaxFixedStep_s, " s");
+  if (a.model == "reduced" && a.reduced_integrator == "rk4-fixed" &&
+      duration / a.fixed_step > cli_limits::kMaxFixedSteps)
     throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}", a.fixed_step,
-                                    duration, duration / a.fixed_step, kMaxFixedSteps));
+                                    duration, duration / a.fixed_step, cli_limits::kMaxFixedSteps));
   OutputDir out(a.out, a.force);  // fails early on an unusable folder
 
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
@@ -221,8 +211,8 @@ int run_extract(const ExtractArgs& a) {
 
 int run_calibrate(const CalibrateArgs& a) {
   const auto base = overrides_of(a.sets);
-  if (a.cadence_given) require_positive_up_to("--cadence-hz", a.cadence_hz, kMaxCadence_Hz, " Hz");
-  if (a.power_given) require_positive_up_to("--power-w", a.power_w, kMaxPower_W, " W");
+  if (a.cadence_given) require_positive_up_to("--cadence-hz", a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
+  if (a.power_given) require_positive_up_to("--power-w", a.power_w, cli_limits::kMaxPower_W, " W");
   require_grid("--grid-deg", a.grid_deg);
   const std::string text = models::read_scene_text(a.scene);  // once: the scene may be a stream
   const models::Scene scene = models::parse_scene(text, models::resolve_scene_path(a.scene), base);
@@ -348,9 +338,9 @@ int run_sweep_command(const SweepArgs& a) {
   o.grid_deg = a.grid_deg;
   require_grid("--grid-deg", a.grid_deg);
   // A typed value is checked even when it is 0: `--threads 0` meant no default (issue #23).
-  if (a.threads) require_in("--threads", *a.threads, 1, kMaxThreads, "");
-  if (a.cadence_hz) require_positive_up_to("--cadence-hz", *a.cadence_hz, kMaxCadence_Hz, " Hz");
-  if (a.power_w) require_positive_up_to("--power-w", *a.power_w, kMaxPower_W, " W");
+  if (a.threads) require_in("--threads", *a.threads, 1, cli_limits::kMaxThreads, "");
+  if (a.cadence_hz) require_positive_up_to("--cadence-hz", *a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
+  if (a.power_w) require_positive_up_to("--power-w", *a.power_w, cli_limits::kMaxPower_W, " W");
   {
     int used = 0;
     if (std::sscanf(a.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 ||
@@ -527,7 +517,7 @@ int run_validate(const ValidateArgs& a) {
 }
 
 int run_export_mjcf(const ExportMjcfArgs& a) {
-  require_in("--timestep", a.timestep_s, kMinFixedStep_s, kMaxFixedStep_s, " s");
+  require_in("--timestep", a.timestep_s, cli_limits::kMinFixedStep_s, cli_limits::kMaxFixedStep_s, " s");
   const models::Scene scene = load(a.scene, a.sets);
   OutputFile out(a.out, a.force, is_rdyn_mjcf);  // fails early on an unusable destination
   models::MjcfOptions opt;

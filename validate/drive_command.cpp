@@ -10,15 +10,13 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/samples.hpp"
 #include "validate/build_reduced.hpp"
+#include "validate/cli_limits.hpp"
 #include "validate/drive.hpp"
 #include "validate/output_dir.hpp"
 
 namespace rdyn::validate {
 
 namespace {
-
-// The same ranges as the other commands' (README, "Limits").
-constexpr double kMaxCadence_Hz = 1000.0, kMaxDuration_s = 1e5, kMinOutputInterval_s = 1e-6, kMaxRows = 1e7;
 
 // The output rows: every k-th row of the fine record and its last (the duration itself).
 DriveRecord every_kth_row(const DriveRecord& r, long k) {
@@ -64,15 +62,16 @@ int run_drive(const DriveArgs& a) {
   if (a.cadence_hz.has_value() == !a.profile.empty()) bad("--cadence-hz", "give --cadence-hz or --profile (one of them)");
   if (a.cadence_hz) {
     if (!revolute) bad("--cadence-hz", "a constant rate needs a revolute independent coordinate: give --profile");
-    if (!(std::isfinite(*a.cadence_hz) && *a.cadence_hz != 0 && std::abs(*a.cadence_hz) <= kMaxCadence_Hz))
+    if (!(std::isfinite(*a.cadence_hz) && *a.cadence_hz != 0 && std::abs(*a.cadence_hz) <= cli_limits::kMaxCadence_Hz))
       bad("--cadence-hz", fmt::format("must be a finite, non-zero rate with |F| ≤ {:g} rev/s (got {:g})",
-                                      kMaxCadence_Hz, *a.cadence_hz));
+                                      cli_limits::kMaxCadence_Hz, *a.cadence_hz));
   }
-  if (a.duration && !(std::isfinite(*a.duration) && *a.duration > 0 && *a.duration <= kMaxDuration_s))
-    bad("--duration", fmt::format("must be in (0, {:g}] s (got {:g})", kMaxDuration_s, *a.duration));
+  if (a.duration && !(std::isfinite(*a.duration) && *a.duration > 0 && *a.duration <= cli_limits::kMaxDuration_s))
+    bad("--duration", fmt::format("must be in (0, {:g}] s (got {:g})", cli_limits::kMaxDuration_s, *a.duration));
   const double dt = a.dt_out.value_or(scene.simulation.output_interval_s);
-  if (!(std::isfinite(dt) && dt >= kMinOutputInterval_s && dt <= kMaxDuration_s))
-    bad("--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", kMinOutputInterval_s, kMaxDuration_s, dt));
+  if (!(std::isfinite(dt) && dt >= cli_limits::kMinOutputInterval_s && dt <= cli_limits::kMaxDuration_s))
+    bad("--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", cli_limits::kMinOutputInterval_s,
+                                cli_limits::kMaxDuration_s, dt));
   if (!(a.grid_deg >= 0.05 && a.grid_deg <= 90) || std::abs(360 / a.grid_deg - std::round(360 / a.grid_deg)) > 1e-9 * 360 / a.grid_deg)
     bad("--grid-deg", fmt::format("must be in [0.05, 90] deg and divide 360° (got {:g})", a.grid_deg));
   if (a.model != "full" && a.model != "reduced") bad("--model", "full or reduced");
@@ -86,11 +85,12 @@ int run_drive(const DriveArgs& a) {
     if (a.cadence_hz) {
       const double duration = a.duration.value_or(1.0 / std::abs(*a.cadence_hz));  // one revolution
       if (dt > duration * (1 + 1e-12)) bad("--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, duration));
-      if (duration / step > kMaxRows) bad("--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
+      if (duration / step > cli_limits::kMaxOutputRows)
+        bad("--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
       m = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, step);
       m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
     } else {
-      m = profile_motion(a.profile, revolute, a.duration, step, kMaxRows);
+      m = profile_motion(a.profile, revolute, a.duration, step, cli_limits::kMaxOutputRows);
       if (dt > m.t.back() * (1 + 1e-12)) bad("--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, m.t.back()));
       m.how = "profile " + a.profile + " (natural cubic spline, from its first time)";
     }
@@ -101,9 +101,10 @@ int run_drive(const DriveArgs& a) {
   for (double v : coarse.qdot) rate_max = std::max(rate_max, std::abs(v));
   const double row_step = revolute ? M_PI / 180 : 1e-3;  // [rad or m] between statistics rows
   const long k = std::max(1L, static_cast<long>(std::ceil(dt * rate_max / row_step - 1e-9)));
-  if (static_cast<double>(k) * static_cast<double>(coarse.t.size()) > kMaxRows)
+  if (static_cast<double>(k) * static_cast<double>(coarse.t.size()) > cli_limits::kMaxOutputRows)
     bad(a.cadence_hz ? "--duration" : "--profile", fmt::format("the motion needs {:.3g} rows of at most 1° each; at most {:g}",
-                                  static_cast<double>(k) * static_cast<double>(coarse.t.size()), kMaxRows));
+                                  static_cast<double>(k) * static_cast<double>(coarse.t.size()),
+                                  cli_limits::kMaxOutputRows));
   const PrescribedMotion motion = k == 1 ? coarse : motion_at(dt / static_cast<double>(k));
   if (a.model == "full" && calc_drive_moves(motion) > kMaxDriveMoves)
     bad(a.cadence_hz ? "--duration" : "--profile",
