@@ -1,6 +1,6 @@
 // Command-line options that several rdyn subcommands share, declared once so that their names,
 // help and checks stay the same in every command (CLI11; used by validate/cli/main.cpp only, so the
-// rdyn_validate library does not depend on CLI11).
+// rdyn_validate_cli library does not depend on CLI11).
 #pragma once
 
 #include <string>
