@@ -18,7 +18,7 @@ struct MjcfOptions {
   // Joint coordinates [rad or m] at which the bodies are placed, one per scene joint (scene
   // order); empty: the joints' guesses. MuJoCo infers a `connect` equality's second anchor
   // from the configuration the model is written in (MJCF reference, "connect"), so the loops
-  // must be closed there: pass an assembled configuration (validate/commands.cpp does).
+  // must be closed there: pass an assembled configuration (validate/cli/commands.cpp does).
   std::vector<double> reference_q;
   // Fold every geared body calc_foldable_gears allows into its driver (inertia r²·I added to
   // the driver's Izz, no body and no gear equality), as the full model does by default.

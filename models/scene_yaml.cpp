@@ -864,7 +864,7 @@ void read_optimize(const Fields& f, Scene& s) {
     Fields l(n, path, f.ctx(), {"load", "same_as", "shift_deg", "shift_rad"});
     OptimizeLoad d;
     d.load = l.name("load");
-    // That the load exists is checked when optimizing (validate/optimize.cpp, resolve_design),
+    // That the load exists is checked when optimizing (validate/analysis/optimize.cpp, resolve_design),
     // at this line: a scene whose drive is switched off (a generator's hip_torque_Nm: 0, "no
     // drive") makes no such torque, and simulate, extract or inspect of it must not be refused
     // for a block only `rdyn optimize` reads (issue #23).

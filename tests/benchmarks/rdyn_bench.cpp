@@ -23,7 +23,7 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
-#include "validate/calibrate.hpp"
+#include "validate/analysis/calibrate.hpp"
 
 namespace {
 

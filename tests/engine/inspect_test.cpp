@@ -121,7 +121,7 @@ TEST(Inspect, AnInitialQInsideTheMarginOfADeadPointIsRefused) {
   }
 }
 
-// A prismatic coordinate without dead points (unbounded, exit 0 with a warning): tests/validate/inspect_test.cpp.
+// A prismatic coordinate without dead points (unbounded, exit 0 with a warning): tests/validate/cli/inspect_test.cpp.
 
 TEST(Inspect, GuessesFarFromTheAssemblyWarn) {
   // Guesses of the other branch's neighbourhood for the coupler: the assembly lands 20°+ away.

@@ -784,7 +784,7 @@ TEST(SceneYaml, OptimizeBlockReadsAndRefusesBadFields) {
     const std::string bad = with(y, c.from, c.to);
     EXPECT_GT(expect_refused(bad, c.field, c.says).line(), line_in(bad, "optimize:") - 1) << c.to;
   }
-  // A design load the scene does not make is `rdyn optimize`'s refusal (validate/optimize.cpp),
+  // A design load the scene does not make is `rdyn optimize`'s refusal (validate/analysis/optimize.cpp),
   // not the reader's: with the drive off ("no drive") the generator makes no hip torques.
   const Scene off = parse_scene(y, "b.yaml", {parse_override("bicycle_leg.hip_torque_Nm=0")});
   EXPECT_TRUE(std::none_of(off.joint_torques.begin(), off.joint_torques.end(),

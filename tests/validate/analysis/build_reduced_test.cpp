@@ -1,0 +1,78 @@
+// extract_from_full: the table and its timing by stage (summary.json extraction_stages_ms).
+#include "validate/analysis/build_reduced.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "models/scene_yaml.hpp"
+
+namespace rdyn::validate {
+namespace {
+
+void expect_stages_add_up(const Extraction& e) {
+  EXPECT_GT(e.stages.system_build_ms, 0.0);
+  EXPECT_GT(e.stages.assembly_ms, 0.0);
+  EXPECT_GT(e.stages.kinetostatics_ms, 0.0);
+  EXPECT_NEAR(e.stages.system_build_ms + e.stages.assembly_ms + e.stages.kinetostatics_ms, e.extraction_ms,
+              1e-9 * e.extraction_ms);
+}
+
+TEST(BuildReduced, PeriodicExtractionTimesEachStage) {
+  const auto e = extract_from_full(models::load_scene("bicycle"), 10, reduced::Method::Kinetostatic);
+  EXPECT_EQ(e.samples.q.size(), 36u);
+  EXPECT_FALSE(e.range);
+  expect_stages_add_up(e);
+  // One projection per grid point plus a few per switch angle (4 angles): the separate calls
+  // needed 99.
+  EXPECT_LE(e.calls, 36 + 4 * 4);
+}
+
+TEST(BuildReduced, RangeExtractionTimesEachStage) {
+  // A rocker: the full-turn attempt meets a dead point, the range comes from the dead points.
+  const auto e = extract_from_full(models::load_scene("fourbar-rocker"), 10, reduced::Method::Kinetostatic);
+  ASSERT_TRUE(e.range);
+  EXPECT_FALSE(e.samples.periodic);
+  expect_stages_add_up(e);
+}
+
+// A non-Grashof four-bar whose crank is blocked over only ~2° near 180° (crank 0.18004 m, the
+// ground pivot turned 2.5°): the 10° sweep steps over the blocked range onto the other assembly
+// and would call the table periodic. One more sample a turn later does not match the first
+// (the sweep did not close), so the dead points are looked for and the range between them is
+// sampled instead, on the assembled branch.
+TEST(BuildReduced, ASweepThatChangesBranchBecomesARangeTable) {
+  const auto scene = models::load_scene("fourbar", {{"bodies.crank.points.B.0", "0.18004"},
+                                                    {"ground_points.D.0", "0.299714"},
+                                                    {"ground_points.D.1", "0.013089"},
+                                                    {"initial.q_deg", "32"}});
+  const auto e = extract_from_full(scene, 10, reduced::Method::Kinetostatic);
+  ASSERT_TRUE(e.range);
+  EXPECT_FALSE(e.samples.periodic);
+  ASSERT_TRUE(e.dead_min && e.dead_max);
+  // The blocked range: from the upper dead point to the lower one a turn later, ~2° wide.
+  const double blocked = *e.dead_min + 2 * M_PI - *e.dead_max;
+  EXPECT_GT(blocked, 0.5 * M_PI / 180);
+  EXPECT_LT(blocked, 4.0 * M_PI / 180);
+}
+
+// The hard high-saddle leg is almost straight at the bottom of the stroke: at 10° the sweep
+// comes back a turn later with m1 85.00 where it started at 84.57 (it went round on another
+// assembly for part of the turn) and no dead point explains it, so the table is refused; at 1°
+// it closes. validate's ladder takes such tables anyway (require_closed_turn off): its errors
+// against the full model show what they cost.
+TEST(BuildReduced, ATurnThatDoesNotCloseIsRefusedUnlessTheLadderAsks) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/high-saddle.yaml");
+  try {
+    extract_from_full(scene, 10, reduced::Method::Kinetostatic);
+    ADD_FAILURE() << "a sweep that did not close its turn was accepted";
+  } catch (const reduced::SweepNotClosed& e) {
+    EXPECT_NE(std::string(e.what()).find("does not return to its start"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(extract_from_full(scene, 1, reduced::Method::Kinetostatic).samples.periodic);
+  EXPECT_TRUE(extract_from_full(scene, 10, reduced::Method::Kinetostatic, false).samples.periodic);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

@@ -1,0 +1,173 @@
+// Prescribed motion (validate/analysis/drive, `rdyn drive`): closed forms, the two models against each
+// other, a profile against the constant rate it describes, and the command's contract.
+#include "validate/analysis/drive.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "models/scene_yaml.hpp"
+#include "reduced/reduced_model.hpp"
+#include "tests/validate/run_rdyn.hpp"
+#include "validate/analysis/build_reduced.hpp"
+
+namespace rdyn::validate {
+namespace {
+
+namespace fs = std::filesystem;
+
+reduced::ReducedModel reduced_of(const models::Scene& scene, double grid_deg) {
+  const auto e = extract_from_full(scene, grid_deg, reduced::Method::Kinetostatic);
+  return reduced::make_reduced_model(e.samples, scene, reduced::Interpolation::Fourier);
+}
+
+// The hard parallelogram has constant m1, m2 = 0 and no losses; its gravity term is
+// Q_cons = −k cos q with k = g (m_crank·0.05 + m_rocker·0.05 + m_coupler·a). At a constant rate
+// the drive only holds gravity: drive = −Q_cons = k cos q (positive where the crank points along
+// +x: gravity pulls it down, the drive lifts).
+TEST(Drive, ParallelogramAtConstantRateHoldsGravityOnly) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  const double k = 9.81 * (0.5 * 0.05 + 0.7 * 0.05 + 1.2 * 0.1);
+  const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI * 2.0, 1.0, 0.005);  // two turns
+  const auto full = calc_drive_full(scene, motion);
+  const auto red = calc_drive_reduced(reduced_of(scene, 10), motion);
+  ASSERT_EQ(full.drive.size(), motion.t.size());
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    // ~5e-7 at the aligned (singular) positions, where the constraint split is least squares.
+    EXPECT_NEAR(full.drive[i], k * std::cos(motion.q[i]), 1e-6 * k) << motion.t[i];
+    EXPECT_NEAR(red.drive[i], k * std::cos(motion.q[i]), 1e-6 * k) << motion.t[i];
+    EXPECT_DOUBLE_EQ(full.power[i], full.drive[i] * motion.qdot[i]);
+  }
+  // Over whole turns gravity does no net work: mean drive power 0, RMS k/√2.
+  const auto st = calc_drive_stats(full);
+  EXPECT_NEAR(st.mean_power_W, 0.0, 1e-6 * k * motion.qdot[0]);
+  EXPECT_NEAR(st.rms, k / std::sqrt(2.0), 1e-4 * k);
+  EXPECT_NEAR(st.peak, k, 1e-3 * k);  // rows 3.6° apart: the sampled peak is within 1 − cos 1.8°
+}
+
+// A row exactly at an aligned (singular) position: the constraint split there is least squares,
+// so the full model takes the drive's limit along the branch from both sides (it gave 0.31 k).
+// The chain of 3 parallelograms the same at its flat rows: k = g [(N+1)/2 + N].
+TEST(Drive, FullModelAtASingularRowTakesTheBranchLimit) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  const double k = 9.81 * (0.5 * 0.05 + 0.7 * 0.05 + 1.2 * 0.1);
+  const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI, 0.5, 1.0 / 24);  // 15° rows through 180°
+  const auto full = calc_drive_full(scene, motion);
+  bool singular_row = false;
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    singular_row |= std::abs(std::remainder(motion.q[i], M_PI)) < 1e-12;
+    EXPECT_NEAR(full.drive[i], k * std::cos(motion.q[i]), 1e-6 * k) << motion.t[i];
+  }
+  EXPECT_TRUE(singular_row);
+  const auto chain = models::load_scene(RDYN_SCENES "/chains/chain-3.yaml");
+  const double kc = 9.81 * (4 / 2.0 + 3);
+  const auto cm = constant_rate_motion(chain.initial.q, 2 * M_PI, 1.0, 0.25);  // 90°, 180°, 270°, 360°, 450°
+  const auto cf = calc_drive_full(chain, cm);
+  for (size_t i = 0; i < cm.t.size(); ++i) EXPECT_NEAR(cf.drive[i], kc * std::cos(cm.q[i]), 1e-6 * kc) << cm.t[i];
+}
+
+// The bicycle with its hip torque gate, brake and knee force: full inverse dynamics against the
+// 5° table's inverse Eksergian equation, both ways through the gate switches.
+TEST(Drive, BicycleFullAndReducedAgree) {
+  const auto scene = models::load_scene("bicycle");
+  const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI * 1.0, 1.0, 0.002);
+  const auto full = calc_drive_full(scene, motion);
+  const auto red = calc_drive_reduced(reduced_of(scene, 5), motion);
+  const auto sf = calc_drive_stats(full);
+  ASSERT_EQ(full.force_names, red.force_names);
+  ASSERT_FALSE(full.forces.empty());
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    EXPECT_NEAR(red.drive[i], full.drive[i], 1e-4 * sf.peak) << motion.t[i];
+    EXPECT_NEAR(red.forces[0][i], full.forces[0][i], 1e-4 * sf.force_peaks[0]) << motion.t[i];
+  }
+  EXPECT_GT(sf.peak, 1.0);  // it does work against the brake and gravity
+}
+
+// A profile q(t) = q0 + ωt (a natural cubic spline of a straight line is the line) gives the
+// constant rate's drive; malformed profiles are refused naming the line.
+TEST(Drive, ProfileOfAConstantRateIsTheConstantRate) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rdyn_drive_{}", ::getpid());
+  fs::create_directories(dir);
+  const double w = 2 * M_PI * 0.8;
+  {
+    std::ofstream f(dir / "p.csv");
+    f << "# a line\nt,q_deg\n";
+    for (int i = 0; i <= 50; ++i) f << fmt::format("{:.17g},{:.17g}\n", 0.02 * i, (scene.initial.q + w * 0.02 * i) * 180 / M_PI);
+  }
+  const auto prof = profile_motion((dir / "p.csv").string(), true, std::nullopt, 0.01);
+  const auto cr = constant_rate_motion(scene.initial.q, w, 1.0, 0.01);
+  ASSERT_EQ(prof.t.size(), cr.t.size());
+  for (size_t i = 0; i < cr.t.size(); ++i) {
+    EXPECT_NEAR(prof.q[i], cr.q[i], 1e-12);
+    EXPECT_NEAR(prof.qdot[i], w, 1e-9 * w);
+    EXPECT_NEAR(prof.qddot[i], 0.0, 1e-8 * w);
+  }
+  auto refused = [&](const std::string& text, const std::string& field, int line) {
+    std::ofstream(dir / "bad.csv") << text;
+    try {
+      profile_motion((dir / "bad.csv").string(), true, std::nullopt, 0.01);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const models::SceneError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
+      EXPECT_EQ(e.line(), line) << e.what();
+    }
+  };
+  refused("t,q_deg\n0,0\n1,10\n0.5,20\n2,30\n", "t", 4);       // time going back
+  refused("t,q_m\n0,0\n1,1\n2,2\n3,3\n", "header", 1);          // metres for a revolute coordinate
+  refused("t,q_deg\n0,0\n1,nan\n2,2\n3,3\n", "row", 3);         // not finite
+  refused("t,q_deg\n0,0\n1,1\n2,2\n", "rows", 4);               // too few rows
+  fs::remove_all(dir);
+}
+
+TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rdyn_drive_cli_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto run = [&](std::vector<std::string> args) { return test::run_rdyn(args, dir); };
+  // Statistics come from rows at most 1° apart whatever --dt-out: 0.5 s rows of a 1 rev/s run.
+  auto r = run({"drive", RDYN_SCENES "/hard/parallelogram.yaml", "--cadence-hz", "1", "--duration", "2", "--dt-out",
+                "0.5", "--model", "reduced", "--out", "coarse"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto c = nlohmann::json::parse(test::slurp(dir / "coarse" / "run.json"));
+  const double kp = 9.81 * 0.18;
+  EXPECT_NEAR(c["drive_peak"].get<double>(), kp, 1e-4 * kp);
+  EXPECT_NEAR(c["drive_rms"].get<double>(), kp / std::sqrt(2.0), 1e-4 * kp);
+  const std::string coarse = test::slurp(dir / "coarse" / "timeseries.csv");
+  EXPECT_EQ(std::count(coarse.begin(), coarse.end(), '\n'), 6);  // header + 0, 0.5, 1, 1.5, 2
+  r = run({"drive", "fourbar", "--cadence-hz", "2", "--out", "out"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(test::slurp(dir / "out" / "run.json"));
+  EXPECT_EQ(j["drive_unit"], "N·m");
+  EXPECT_DOUBLE_EQ(j["duration_s"].get<double>(), 0.5);  // one revolution by default
+  EXPECT_TRUE(j["constraint_force_peaks_N"].contains("rocker_axial"));
+  const std::string csv = test::slurp(dir / "out" / "timeseries.csv");
+  EXPECT_EQ(csv.rfind("t,q,qdot,qddot,drive_Nm,drive_W,F_rocker_axial\n", 0), 0u);
+  // Bad input is exit 2 before any output: neither or both motions, a zero or infinite rate,
+  // a constant rate for a slider, a missing profile.
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"drive", "fourbar", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "1", "--profile", "p.csv", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "0", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "inf", "--out", "o2"},
+           {"drive", "slider-crank-slider", "--cadence-hz", "1", "--out", "o2"},
+           {"drive", "fourbar", "--profile", "missing.csv", "--out", "o2"},
+           {"drive", "fourbar", "--profile", "/dev/zero", "--out", "o2"},  // never ends: refused unread
+           {"drive", "fourbar", "--cadence-hz", "1", "--duration", "0.5", "--dt-out", "1", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "1000", "--duration", "10", "--out", "o2"}}) {  // hours of moves
+    r = run(args);
+    EXPECT_EQ(r.status, 2) << args[2] << " " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o2")) << args[2];
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

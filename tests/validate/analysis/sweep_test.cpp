@@ -1,0 +1,234 @@
+// Sweeps: the cartesian product of the axes, sharded into blocks whose CSVs concatenate.
+#include "validate/analysis/sweep.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "models/scene.hpp"
+#include "models/scene_yaml.hpp"
+#include "validate/analysis/calibrate.hpp"
+#include "validate/cli/sweep_axis.hpp"
+
+namespace rdyn::validate {
+namespace {
+
+TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.hip_torque_Nm=60:60:1"), parse_sweep_axis("bicycle_leg.crank_length_m=0.16:0.18:3")};
+  o.threads = 2;
+  const SweepResult r = run_sweep(o, false);
+  const std::string& whole = r.csv;
+  EXPECT_EQ(r.cases, 3);
+  EXPECT_EQ(r.failed, 0);
+  std::string parts;
+  o.shards = 2;
+  for (o.shard = 0; o.shard < 2; ++o.shard) parts += run_sweep(o, false).csv;
+  EXPECT_EQ(parts, whole);
+  // header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
+  EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 4);
+  EXPECT_EQ(whole.find("error"), whole.find("error\n"));  // only the header's column name
+  EXPECT_NE(whole.find(",status,drive_torque_Nm,"), std::string::npos) << whole;
+  EXPECT_NE(whole.find(",peak_knee_force_N,"), std::string::npos) << whole;  // the scene's force name
+  // Column 4 (case, two axes, status, torque): the torque falls as the crank lengthens.
+  std::vector<double> torque;
+  std::istringstream lines(whole);
+  std::string line;
+  std::getline(lines, line);  // header
+  while (std::getline(lines, line)) {
+    std::istringstream cells(line);
+    std::string cell;
+    for (int c = 0; c <= 4; ++c) std::getline(cells, cell, ',');
+    torque.push_back(std::stod(cell));
+  }
+  ASSERT_EQ(torque.size(), 3u);
+  EXPECT_GT(torque[0], torque[1]);
+  EXPECT_GT(torque[1], torque[2]);
+}
+
+}  // namespace
+}  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// Keys are checked on the base scene at both ends of each axis before any case runs.
+TEST(Sweep, UnknownKeysAndOutOfRangeEndsFailBeforeWork) {
+  SweepOptions o;
+  o.scene = "fourbar";
+  o.cadence_hz = 1.0;
+  o.power_w = 1.0;
+  o.axes = {parse_sweep_axis("no_such.key=1:2:3")};
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  o.axes = {parse_sweep_axis("bodies.crank.mass_kg=1:-1:3")};  // the far end is not a mass
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+}
+
+// A scene that cannot be calibrated at all (the four-bar has no drive torque) fails before
+// any case runs.
+TEST(Sweep, UncalibratableSceneFailsBeforeWork) {
+  SweepOptions o;
+  o.scene = "fourbar";
+  o.cadence_hz = 1.0;
+  o.power_w = 1.0;
+  o.axes = {parse_sweep_axis("bodies.crank.mass_kg=0.4:0.6:3")};
+  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+}
+
+// Removes a temporary scene file however the test ends (a throwing run_sweep included).
+struct RemoveOnExit {
+  std::filesystem::path path;
+  ~RemoveOnExit() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
+// A failing case is a row with status "error" and its message, and it is counted: the
+// four-bar driven by a crank torque, with the ground pivot D moved so far in the second case
+// that the loop cannot close.
+TEST(Sweep, FailingCasesAreCountedAndReported) {
+  namespace fs = std::filesystem;
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.01}\n");
+  std::ofstream(scene) << yaml;
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 1.0;
+  o.power_w = 0.01;
+  o.sets = {"gravity.enabled=false"};  // no stall: the torque–cadence map is monotonic
+  o.axes = {parse_sweep_axis("ground_points.D.0=0.30:3.0:2")};
+  o.threads = 2;
+  const SweepResult r = run_sweep(o, false);
+  EXPECT_EQ(r.cases, 2);
+  EXPECT_EQ(r.failed, 1) << r.csv;
+  const auto lines = r.csv.substr(r.csv.find('\n') + 1);
+  EXPECT_EQ(lines.find("0,0.3,ok,"), 0u) << r.csv;                 // the first case calibrates
+  EXPECT_NE(lines.find("1,3,error,,,,,,"), std::string::npos) << r.csv;  // the second names its loop
+}
+
+// A named load through the sweep: a flywheel's motor against viscous drag c, calibrated to a
+// mean speed (no power): each row holds s = c·ω/(1 − ω/ω0) in a column named for the load's kind.
+// The sweep's CSV lines (the header first), with every case expected to succeed.
+std::vector<std::string> successful_rows(const SweepOptions& o) {
+  const SweepResult r = run_sweep(o, false);
+  EXPECT_EQ(r.failed, 0) << r.csv;
+  std::vector<std::string> rows;
+  std::istringstream lines(r.csv);
+  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  return rows;
+}
+
+TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
+  namespace fs = std::filesystem;
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_motor_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ofstream(scene) << "name: flywheel\n"
+                          "bodies: [{name: wheel, mass_kg: 2.0, inertia_kgm2: 0.05}]\n"
+                          "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
+                          "independent: wheel\n"
+                          "loads:\n"
+                          "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n"
+                          "  - {type: motor, name: motor, joint: wheel, stall_torque_Nm: 1.0, no_load_speed_rad_s: 30}\n"
+                          "initial: {q_deg: 0, qdot: 5.0}\n";
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 2.0;
+  o.load = "motor";
+  // The wheel's inertia changes the mechanism (a new table); the drag coefficient does not (the
+  // thread's last table is reused): neither changes the closed form, s = c·ω/(1 − ω/ω0).
+  o.axes = {parse_sweep_axis("bodies.wheel.inertia_kgm2=0.05:0.1:2"), parse_sweep_axis("loads.drag.coefficient=0.01:0.03:3")};
+  o.threads = 1;
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_EQ(rows[0].find("case,bodies.wheel.inertia_kgm2,loads.drag.coefficient,status,motor_stall_torque_Nm,"), 0u)
+      << rows[0];
+  const double w = 2 * M_PI * 2.0;
+  size_t k = 1;
+  for (int inertia = 0; inertia < 2; ++inertia)
+    for (double c : {0.01, 0.02, 0.03}) {
+      const std::string& line = rows[k++];
+      double s = 0;
+      ASSERT_EQ(std::sscanf(line.substr(line.find(",ok,") + 4).c_str(), "%lf", &s), 1) << line;
+      EXPECT_NEAR(s, c * w / (1 - w / 30.0), 1e-8) << line;
+    }
+}
+
+// The loops' branch checks are not in the scene hash (they only refuse an assembly): a case
+// whose check fails is an error row whatever case ran before it in the thread, never a reused
+// table of the other branch.
+TEST(Sweep, ABranchCheckIsNeverSkippedByAReusedTable) {
+  namespace fs = std::filesystem;
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("point_b: C}"), 11, "point_b: C, branch: {joint: rocker, sign: positive}}");
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_branch_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ofstream(scene) << yaml;
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 1.0;
+  o.load = "drive";
+  o.threads = 1;
+  for (const char* axis : {"loops.C.branch.sign=1:-1:2", "loops.C.branch.sign=-1:1:2"}) {
+    o.axes = {parse_sweep_axis(axis)};
+    const SweepResult r = run_sweep(o, false);
+    EXPECT_EQ(r.failed, 1) << axis << "\n" << r.csv;
+    std::istringstream lines(r.csv);
+    std::string line;
+    std::getline(lines, line);
+    while (std::getline(lines, line)) {
+      const bool negative = line.find(",-1,") != std::string::npos;
+      EXPECT_EQ(line.find(",error,") != std::string::npos, negative) << axis << ": " << line;
+    }
+  }
+}
+
+// A case on a reused table is the case calibrated on its own: a bicycle sweep over the rider's
+// height (a new table each) and the resistance's power (a value: the thread's table is reused)
+// against calibrate() of each scene, to the last digit the CSV prints.
+TEST(Sweep, ReusedTableGivesTheCaseItsOwnCalibration) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.subject.height_m=1.7:1.8:2"),
+            parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:2")};
+  o.threads = 1;
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 5u);
+  size_t k = 1;
+  for (double h : {1.7, 1.8})
+    for (double p : {100.0, 150.0}) {
+      const std::string& line = rows[k++];
+      const auto scene = models::load_scene(
+          "bicycle", {{"bicycle_leg.subject.height_m", fmt::format("{:.17g}", h)},
+                      {"bicycle_leg.resistance.power_W", fmt::format("{:.17g}", p)}});
+      CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+      opt.full_max_s = 0.0;
+      Progress quiet(false);
+      const auto own = calibrate(scene, opt, quiet);
+      EXPECT_NE(line.find(fmt::format(",ok,{:.10g},", own.load_value)), std::string::npos)
+          << line << " vs " << own.load_value;
+    }
+}
+
+}  // namespace
+}  // namespace rdyn::validate

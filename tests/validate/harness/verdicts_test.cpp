@@ -1,0 +1,82 @@
+#include "validate/harness/verdicts.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/validate/harness/run_records.hpp"
+
+namespace rdyn::validate {
+namespace {
+
+using test::record;
+
+TEST(Verdicts, ThresholdsDecideTheirQuantityTheTargetTheOthers) {
+  const RunRecord rec = record("reduced", 1e-3, {{"qdot", 2e-4}, {"F", 3e-3}, {"mean_qdot", 1e-6}});
+  ThresholdResult loose{{"F", 30.0, "", 0.1}, 0.05, true, "coarse run"};
+  ThresholdResult tight{{"F", 10.0, "", 0.01}, 0.02, false, "10° run"};
+  const auto v = calc_verdicts({"qdot", "F", "mean_qdot"}, &rec, {loose, tight}, 1e-3);
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_EQ(v[0].quantity, "qdot");
+  EXPECT_DOUBLE_EQ(v[0].error, 2e-4);
+  EXPECT_DOUBLE_EQ(v[0].limit, 1e-3);
+  EXPECT_TRUE(v[0].pass);
+  EXPECT_FALSE(v[0].decides);  // no threshold: for information
+  // F: the tightest threshold decides, on its own run.
+  EXPECT_DOUBLE_EQ(v[1].error, 3e-3);
+  EXPECT_DOUBLE_EQ(v[1].limit, 0.01);
+  EXPECT_EQ(v[1].judged_on, "10° run");
+  EXPECT_DOUBLE_EQ(v[1].judged_error, 0.02);
+  EXPECT_FALSE(v[1].pass);
+  EXPECT_TRUE(v[1].decides);
+  // Without a recommended setting nothing passes on the target.
+  const auto none = calc_verdicts({"qdot"}, nullptr, {}, 1e-3);
+  EXPECT_FALSE(none[0].pass);
+  EXPECT_TRUE(std::isinf(none[0].error));
+}
+
+TEST(Verdicts, BaselinesAreCostRatios) {
+  const RunRecord rec = record("reduced", 0.01, {{"qdot", 1e-4}});
+  const RunRecord ref = record("full", 4.0, {{"qdot", 0.0}});
+  std::vector<RunRecord> runs{record("full", 2.0, {{"qdot", 1e-5}}),
+                              record("full", 0.5, {{"qdot", 1e-3}}), rec};
+  runs.push_back(record("full", 0.1, {}));
+  runs.back().failure = "stopped";  // not a baseline
+  const auto b = calc_baselines(rec, ref, runs, 0);
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(b[0].what, "reference");
+  EXPECT_DOUBLE_EQ(b[0].speedup, 400);
+  EXPECT_EQ(b[1].what, "matched-error full run");
+  EXPECT_DOUBLE_EQ(b[1].speedup, 200);
+  EXPECT_EQ(b[2].what, "cheapest full run");
+  EXPECT_DOUBLE_EQ(b[2].speedup, 50);
+}
+
+TEST(Verdicts, ErrorBudgetSeparatesTableAndIntegration) {
+  RunRecord fast = record("reduced", 0.001, {{"F", 5e-4}});
+  fast.integrator = "rk4-fixed";
+  fast.tolerance = 0;
+  RunRecord tight = record("reduced", 0.01, {{"F", 2e-4}});
+  tight.tolerance = 1e-10;
+  RunRecord other_grid = tight;
+  other_grid.grid_deg = 5;
+  other_grid.errors.signals[0].max_rel = 1e-7;
+  const auto b = calc_error_budget(fast, {other_grid, tight, fast}, 1e-9, "F", 1e-10);
+  EXPECT_DOUBLE_EQ(b.reference, 1e-9);
+  EXPECT_DOUBLE_EQ(b.table, 2e-4);
+  EXPECT_DOUBLE_EQ(b.integration, 3e-4);
+  EXPECT_DOUBLE_EQ(b.total, 5e-4);
+  EXPECT_EQ(b.table_run, tight.label());
+  // No tight run at that grid: the table share is unknown, not zero.
+  EXPECT_TRUE(std::isnan(calc_error_budget(fast, {other_grid}, 1e-9, "F", 1e-10).table));
+  // Output interpolation is measured on the run itself, apart from the total; unknown when
+  // the run has no Hermite rows compared.
+  EXPECT_TRUE(std::isnan(b.output_interpolation));
+  fast.output_interpolation.signals = {{"qdot", 1.0, 7e-9, 1e-9}, {"F", 1.0, 3e-6, 1e-6}};
+  const auto c = calc_error_budget(fast, {tight, fast}, 1e-9, "F", 1e-10);
+  EXPECT_DOUBLE_EQ(c.output_interpolation, 3e-6);
+  EXPECT_DOUBLE_EQ(c.total, 5e-4);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

@@ -1,0 +1,78 @@
+#include "validate/analysis/build_reduced.hpp"
+
+#include <chrono>
+
+#include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
+#include "engine/reduced_source.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+using clock = std::chrono::steady_clock;
+double ms(clock::time_point a, clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+}  // namespace
+
+Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduced::Method method,
+                             bool require_closed_turn) {
+  const auto start = clock::now();
+  const engine::FullModel model(scene);
+  const double build_ms = ms(start, clock::now());
+  Extraction e = extract_from_full(model, grid_deg, method, require_closed_turn);
+  e.stages.system_build_ms = build_ms;
+  e.extraction_ms += build_ms;
+  return e;
+}
+
+Extraction extract_from_full(const engine::FullModel& model, double grid_deg, reduced::Method method,
+                             bool require_closed_turn) {
+  const models::Scene& scene = model.scene();
+  const auto start = clock::now();
+  reduced::ExtractOptions opt;
+  opt.step_rad = grid_deg * 3.14159265358979323846 / 180.0;
+  opt.method = method;
+  opt.require_closed_turn = require_closed_turn;
+  Extraction e;
+  auto finish = [&](const engine::FullKinetostaticSource& source) {
+    const auto end = clock::now();
+    e.extraction_ms = ms(start, end);
+    e.stages.kinetostatics_ms = e.extraction_ms - e.stages.system_build_ms - e.stages.assembly_ms;
+    e.calls = source.calls();
+    return e;
+  };
+  // A revolute without a declared range is first swept as a full turn (the periodic table,
+  // at no extra cost); a dead point on the way means it has a range instead.
+  const auto& ind = *scene.find_joint(scene.independent);
+  std::optional<engine::IndependentDomain> domain;
+  if (ind.type == models::JointType::Revolute && !scene.independent_range) {
+    try {
+      const auto t = clock::now();
+      engine::FullKinetostaticSource source(model);
+      e.stages.assembly_ms = ms(t, clock::now());
+      e.samples = reduced::extract_samples(source, scene, opt);
+      return finish(source);
+    } catch (const engine::EngineError&) {
+      domain = engine::calc_independent_domain(model);
+      if (domain->periodic) throw;  // not a dead point: the sweep's own failure
+    } catch (const reduced::SweepNotClosed&) {
+      // The sweep changed branch on the way round (over a narrow blocked range): the dead points
+      // bound a range, when the walk finds them; otherwise the sweep's message stands.
+      domain = engine::calc_independent_domain(model);
+      if (domain->periodic) throw;
+    }
+  }
+  // The declared range or the one between the dead points (engine/independent_range.hpp).
+  if (!domain) domain = engine::calc_independent_domain(model);
+  if (!domain->unbounded_reason.empty()) throw engine::EngineError(domain->unbounded_reason);
+  opt.range = reduced::ExtractRange{domain->min, domain->max, domain->min_edge, domain->max_edge};
+  e.range = opt.range;
+  e.dead_min = domain->dead_min;
+  e.dead_max = domain->dead_max;
+  const auto t = clock::now();
+  engine::FullKinetostaticSource source(model, /*wrap_turns=*/false);
+  e.stages.assembly_ms = ms(t, clock::now());  // a failed full-turn attempt counts as kinetostatics
+  e.samples = reduced::extract_samples(source, scene, opt);
+  return finish(source);
+}
+
+}  // namespace rdyn::validate

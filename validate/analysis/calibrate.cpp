@@ -1,0 +1,835 @@
+#include "validate/analysis/calibrate.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <fmt/format.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_roots.h>
+
+#include "engine/full_model.hpp"
+#include "engine/independent_range.hpp"
+#include "reduced/reduced_model.hpp"
+#include "reduced/simulate_reduced.hpp"
+#include "reduced/steady_cycle.hpp"
+#include "validate/analysis/operating_point.hpp"
+#include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/confirm_full.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+// Acceptance of a calibration (relative cadence error). Reduced: the steady cycle is solved
+// to 1e-12 and the load value to 1e-10 relative, so 1e-6 is met with a wide margin by any
+// genuine root. Full: kFullCadenceTolerance (validate/analysis/confirm_full.hpp).
+constexpr double kReducedCadenceTolerance = 1e-6;
+// Power mode: the steady cycle's mean dissipated power within 1e-8 of P (relative; the cycle is
+// solved to 1e-12 and the load to 1e-10, so a converged secant reaches it), in at most 30 load
+// searches (the secant converges in 3–6).
+constexpr double kPowerTolerance = 1e-8;
+// Drive and dissipated power on the reduced steady cycle may differ by the table's
+// interpolation residual up to this fraction (the bicycle at 1 Hz, 125 W: 1.2e-6).
+constexpr double kEnergyBalanceTolerance = 1e-3;
+constexpr int kMaxPowerPasses = 30;
+
+// The load being calibrated: one joint torque, one motor's stall torque, or every joint
+// torque together. Each entry is applied as sign·T with T ≥ 0 the calibrated magnitude.
+struct Entry {
+  bool motor = false;
+  size_t index = 0;    // into scene.joint_torques, scene.motors or scene.point_forces (same order in the reduced model)
+  double sign = 1.0;   // the scene value's sign (a motor's: its no-load speed's)
+  bool point_force = false;  // a point force's tension (index into point_forces)
+};
+struct Selection {
+  std::vector<Entry> entries;
+  std::string name, kind, unit;
+  bool together = false;  // several loads, each set to sign·T: the result is the magnitude T
+};
+
+// A calibration must meet its own target (issue #9): a cadence off by more than `tolerance`
+// (relative) is a numerical failure, naming what was measured (`what`) at which load value.
+void check_cadence(const char* what, double measured_hz, double target_hz, double tolerance, const Selection& sel,
+                   double value) {
+  const double miss = std::abs(measured_hz - target_hz) / target_hz;
+  if (!(miss <= tolerance))
+    throw models::NumericalError(fmt::format("{} is {:.6g} Hz at {} = {:.6g} {}, target {:g} Hz (off by {:.3g} %, "
+                                             "allowed {:g} %)",
+                                             what, measured_hz, sel.name, value, sel.unit, target_hz, 100 * miss,
+                                             100 * tolerance));
+}
+
+// The value of entry e in the scene / in the reduced model (its torques, motors and point
+// forces are the scene's, in order).
+double& value_of(models::Scene& s, const Entry& e) {
+  return e.motor ? s.motors[e.index].stall_torque
+                 : e.point_force ? s.point_forces[e.index].value : s.joint_torques[e.index].value;
+}
+double& value_of(reduced::ReducedModel& m, const Entry& e) {
+  return e.motor ? m.motors[e.index].stall : e.point_force ? m.point_forces[e.index].value : m.torques[e.index].value;
+}
+const std::string& name_of(const models::Scene& s, const Entry& e) {
+  return e.motor ? s.motors[e.index].name : e.point_force ? s.point_forces[e.index].name : s.joint_torques[e.index].name;
+}
+
+const char* unit_of(const models::Scene& s, const std::string& joint) {
+  const auto* j = s.find_joint(joint);
+  return j && j->type == models::JointType::Prismatic ? "N" : "N·m";
+}
+
+// The index of the first element of `v` (loads of one kind) named `name`; none: empty.
+template <class Load>
+std::optional<size_t> index_named(const std::vector<Load>& v, const std::string& name) {
+  for (size_t i = 0; i < v.size(); ++i)
+    if (v[i].name == name) return i;
+  return std::nullopt;
+}
+
+// Which load `opt.load` names (empty: every joint torque). Throws SceneError naming
+// opt.load_field for an unknown load or one that is not a drive load.
+Selection select_load(const models::Scene& scene, const CalibrationOptions& opt) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
+  };
+  auto candidates = [&] {
+    std::string c;
+    for (const auto& t : scene.joint_torques) c += (c.empty() ? "" : ", ") + t.name;
+    for (const auto& m : scene.motors) c += (c.empty() ? "" : ", ") + m.name;
+    for (const auto& f : scene.point_forces) c += (c.empty() ? "" : ", ") + f.name;
+    return c.empty() ? std::string("the scene has none") : "the scene has " + c;
+  };
+  Selection sel;
+  if (opt.load.empty()) {
+    if (scene.joint_torques.empty())
+      fail("validation.calibrate.load",
+           "name the load to calibrate (validation.calibrate.load or --load): without a name every joint "
+           "torque is scaled together, and the scene has no joint torque (" + candidates() + ")");
+    std::string units;
+    for (size_t i = 0; i < scene.joint_torques.size(); ++i) {
+      const auto& t = scene.joint_torques[i];
+      sel.entries.push_back({false, i, t.value < 0 ? -1.0 : 1.0});
+      sel.name += (sel.name.empty() ? "" : "+") + t.name;
+      const std::string u = unit_of(scene, t.joint);
+      if (units.empty()) units = u;
+      else if (units != u) units = "N·m|N";
+    }
+    sel.kind = "joint_torques";
+    sel.unit = units;
+    return sel;
+  }
+  if (opt.load.find('+') != std::string::npos) {
+    // Several loads scaled together (a muscle on each leg): each is selected by its own name,
+    // all in one unit; each gets sign·T, the result is the magnitude T.
+    std::string rest = opt.load + "+";
+    std::string kinds;
+    for (size_t at; (at = rest.find('+')) != std::string::npos; rest.erase(0, at + 1)) {
+      CalibrationOptions one = opt;
+      one.load = rest.substr(0, at);
+      if (one.load.empty())
+        fail(opt.load_field, "'" + opt.load + "' has an empty name: give names joined by '+' (a+b)");
+      const Selection part = select_load(scene, one);
+      if (part.entries[0].motor)
+        fail(opt.load_field, "motor '" + one.load + "' is calibrated alone (its power depends on the speed): name "
+                             "joint torques or point forces with '+'");
+      for (const auto& e : sel.entries)
+        if (e.index == part.entries[0].index && e.motor == part.entries[0].motor &&
+            e.point_force == part.entries[0].point_force)
+          fail(opt.load_field, "'" + one.load + "' is named twice in '" + opt.load + "'");
+      if (!sel.unit.empty() && sel.unit != part.unit)
+        fail(opt.load_field, fmt::format("'{}' mixes units ({} and {}): loads calibrated together share one unit",
+                                         opt.load, sel.unit, part.unit));
+      sel.unit = part.unit;
+      sel.entries.push_back(part.entries[0]);
+      kinds = kinds.empty() || kinds == part.kind ? part.kind : "loads";
+    }
+    sel.name = opt.load;
+    sel.kind = kinds == "loads" ? kinds : kinds + "s";  // point_forces, joint_torques, ...
+    sel.together = true;
+    return sel;
+  }
+  if (!models::is_valid_name(opt.load)) fail(opt.load_field, models::invalid_name_message(opt.load));
+  sel.name = opt.load;
+  auto selected = [&](Entry e, const std::string& unit, const std::string& kind) {
+    sel.entries.push_back(e);
+    sel.unit = unit;
+    sel.kind = kind;
+    return sel;
+  };
+  if (const auto i = index_named(scene.joint_torques, opt.load)) {
+    const auto& t = scene.joint_torques[*i];
+    const std::string unit = unit_of(scene, t.joint);
+    return selected({false, *i, t.value < 0 ? -1.0 : 1.0}, unit, unit == "N" ? "joint_force" : "joint_torque");
+  }
+  if (const auto i = index_named(scene.motors, opt.load)) {
+    // The stall torque keeps the no-load speed's sign (check_scene: same signs).
+    const auto& m = scene.motors[*i];
+    const std::string unit = unit_of(scene, m.joint);
+    return selected({true, *i, m.no_load_speed < 0 ? -1.0 : 1.0}, unit,
+                    unit == "N" ? "motor_stall_force" : "motor_stall_torque");
+  }
+  // A point force's tension [N] (the amplitude with a profile): work per revolution per newton, like a torque.
+  if (const auto i = index_named(scene.point_forces, opt.load))
+    return selected({false, *i, scene.point_forces[*i].value < 0 ? -1.0 : 1.0, true}, "N", "point_force");
+  if (index_named(scene.resistances, opt.load))
+    fail(opt.load_field, "'" + opt.load + "' is a resistance: calibrate adjusts a drive load, a joint_torque, "
+                         "point_force or motor (" + candidates() + "); the resistance follows from --power-w");
+  if (index_named(scene.springs, opt.load))
+    fail(opt.load_field, "'" + opt.load + "' is a spring, which does no net work per revolution: calibrate adjusts "
+                         "a joint_torque or a motor (" + candidates() + ")");
+  fail(opt.load_field, "no joint_torque, point_force or motor named '" + opt.load + "' (" + candidates() + ")");
+  return sel;
+}
+
+// The selected load set to magnitude T (signs kept) in a scene, and with a power the one
+// resistance's coefficient (NaN: unchanged).
+models::Scene with_load(models::Scene s, const Selection& sel, double T, double coefficient) {
+  for (const auto& e : sel.entries) value_of(s, e) = e.sign * T;
+  if (std::isfinite(coefficient)) s.resistances[0].coefficient = coefficient;
+  return s;
+}
+
+// The same in the reduced model (its torques and motors are the scene's, in order).
+void set_load(reduced::ReducedModel& m, const Selection& sel, double T) {
+  for (const auto& e : sel.entries) value_of(m, e) = e.sign * T;
+}
+
+struct Cycle {
+  bool ok = false;
+  double speed = 0.0;            // q̇ at the section q = q_s on the steady cycle
+  double period = 0.0;           // [s]
+  reduced::SteadyCycle detail;   // extremes, work, counts (when ok)
+};
+
+// Steady cycle of the reduced model at section q_s (reduced/steady_cycle.hpp): by the first
+// integral of Eksergian's equation, by time stepping (Poincaré map) where q̇ does not keep its
+// sign. Not ok when neither finds one (a stall). `extremes`: also sample the cycle for the
+// speed fluctuation and the peak constraint forces.
+Cycle steady_cycle(const reduced::ReducedModel& m, double q_s, double v_guess, double tol, int& evals,
+                   bool extremes = false) {
+  reduced::SteadyCycleOptions o;
+  o.q_section = q_s;
+  o.qdot_guess = v_guess;
+  o.tolerance = tol;
+  o.extremes = extremes;
+  try {
+    const auto c = reduced::find_steady_cycle(m, o);
+    evals += c.passes;
+    return {true, c.qdot_section, c.period_s, c};
+  } catch (const models::NumericalError&) {
+    return {};  // (the failed search's passes are not counted)
+  }
+}
+
+struct RootContext {
+  reduced::ReducedModel* m;
+  const Selection* sel;
+  double q_s, v_guess, target_hz, tol;
+  int* evals;
+};
+
+double cadence_error(double T, void* p) {
+  auto* c = static_cast<RootContext*>(p);
+  set_load(*c->m, *c->sel, T);
+  const Cycle cy = steady_cycle(*c->m, c->q_s, c->v_guess, c->tol, *c->evals);
+  return (cy.ok ? 1.0 / cy.period : 0.0) - c->target_hz;
+}
+
+struct FullCheck {
+  SteadyConfirmation c;
+  int revolutions = 0;  // m of the measure
+};
+
+// The full model at the calibrated values, started from the reduced steady cycle's point: its
+// one initial state is q and q̇ of that cycle at the same phase (the scene's own initial speed,
+// whether it gave qdot or cadence_Hz, and its q are replaced, never combined), run until steady.
+FullCheck confirm_on_full(const models::Scene& scene, const Selection& sel, const CalibrationOptions& opt,
+                          const CalibrationResult& r) {
+  models::Scene sf = with_load(scene, sel, std::abs(r.load_value), r.resistance_coefficient);
+  sf.initial = models::Initial{r.steady_q, r.steady_qdot};
+  SteadyConfirmOptions fc;
+  fc.cadence_hz = r.mean_cadence_hz_reduced;
+  fc.max_duration_s = opt.full_max_s;
+  return {confirm_full_steady(sf, fc), fc.revolutions};
+}
+
+// A confirmation that did not settle within the cap, or settled away from F, is exit 1; the
+// message gives the reduced operating point and what the full model reached.
+void check_full(const FullCheck& full, const CalibrationOptions& opt, const Selection& sel,
+                const CalibrationResult& r) {
+  const auto& mz = full.c.measures;
+  const double miss = std::abs(mz.cadence_hz - opt.cadence_hz) / opt.cadence_hz;
+  if (full.c.steady && miss <= kFullCadenceTolerance) return;
+  const std::string reduced_point = fmt::format(
+      "the reduced operating point: {} = {:.6g} {}{}, steady cycle through q = {:.6g} rad at q̇ = {:.6g} rad/s, "
+      "mean cadence {:.6g} Hz",
+      sel.name, r.load_value, sel.unit,
+      std::isfinite(r.resistance_coefficient) ? fmt::format(", resistance coefficient {:.6g}", r.resistance_coefficient)
+                                              : std::string(),
+      r.steady_q, r.steady_qdot, r.mean_cadence_hz_reduced);
+  const int m = full.revolutions;
+  std::string reached = fmt::format("{} whole revolutions in {:g} s of simulated time", mz.revolutions,
+                                    full.c.duration_s);
+  if (!std::isfinite(mz.cadence_hz))
+    reached += fmt::format(", fewer than the {} the steady test compares", 2 * m);
+  else if (!std::isfinite(mz.previous_cadence_hz))
+    reached += fmt::format("; mean cadence {:.6g} Hz over the last {} (fewer than the {} the steady test compares)",
+                           mz.cadence_hz, m, 2 * m);
+  else
+    reached += fmt::format("; mean cadence {:.6g} Hz over the last {} and {:.6g} Hz over the {} before",
+                           mz.cadence_hz, m, mz.previous_cadence_hz, m);
+  if (!full.c.steady)
+    throw models::NumericalError(fmt::format(
+        "calibration not confirmed: the full model is not steady within {:g} s of simulated time (steady: the mean "
+        "cadence of the last {} whole revolutions within {:g} % of the {} before); it reached {}; {}",
+        opt.full_max_s, full.revolutions, 100 * SteadyConfirmOptions{}.steady_tolerance, full.revolutions, reached,
+        reduced_point));
+  throw models::NumericalError(fmt::format(
+      "calibration not confirmed: the full model's steady mean cadence over whole revolutions is {:.6g} Hz, target "
+      "{:g} Hz (off by {:.3g} %, allowed {:g} %); it reached {}; {}",
+      mz.cadence_hz, opt.cadence_hz, 100 * miss, 100 * kFullCadenceTolerance, reached, reduced_point));
+}
+
+}  // namespace
+
+CalibrationOptions calibration_options_of(const models::Scene& scene, double cadence_hz, double power_w,
+                                          const std::string& load) {
+  CalibrationOptions o;
+  const auto& v = scene.validation;
+  o.cadence_hz = cadence_hz > 0 ? cadence_hz : v.calibrate_cadence_Hz;
+  o.power_w = power_w > 0 ? power_w : v.calibrate_power_W;
+  o.load = !load.empty() ? load : v.calibrate_load;
+  o.load_field = !load.empty() ? "--load" : "validation.calibrate.load";
+  return o;
+}
+
+std::string load_value_column(const models::Scene& scene, const CalibrationOptions& opt) {
+  const Selection sel = select_load(scene, opt);
+  const bool joint = sel.kind.rfind("joint", 0) == 0;
+  if (sel.unit == "N·m") return joint ? "drive_torque_Nm" : sel.kind + "_Nm";
+  if (sel.unit == "N") return sel.kind == "joint_torques" && !sel.together ? "drive_force_N" : sel.kind + "_N";
+  return "drive_load";
+}
+
+namespace {
+
+// check_calibratable without the full model: options, the load, the resistance, a revolute
+// without a range.
+void check_calibration_input(const models::Scene& scene, const CalibrationOptions& opt) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, 0, field, msg);
+  };
+  if (!(opt.cadence_hz > 0)) fail("--cadence-hz", "must be positive");
+  if (!(opt.power_w >= 0)) fail("--power-w", "must be positive");
+  select_load(scene, opt);
+  if (opt.power_w > 0) {
+    if (scene.resistances.size() != 1)
+      fail("loads", fmt::format("a power to dissipate needs exactly one resistance (the scene has {}); without "
+                                "--power-w the resistances stay as given and only the load changes",
+                                scene.resistances.size()));
+    const auto& res = scene.resistances[0];
+    if (!models::fixed_speed_ratio(scene, res.body))
+      fail("loads." + res.name, "the resistance's body must turn at a fixed ratio to the independent coordinate");
+  }
+  // The mean speed is set by losses that grow with speed (viscous, quadratic resistances) or a
+  // drive that falls with it (a motor). Resistances of constant magnitude take the same energy
+  // per revolution at every speed, and torques and forces depend on position only: then every
+  // speed is a steady cycle at the one load value that balances a revolution, and none is
+  // singled out (the calibrated "cadence" would be an accident of interpolation errors).
+  bool speed_sets_losses = !scene.motors.empty();
+  for (const auto& res : scene.resistances) speed_sets_losses |= res.law != models::ResistanceLaw::Constant;
+  if (!speed_sets_losses && !scene.resistances.empty())
+    throw models::SceneError(
+        scene.source_file, scene.line_of("loads." + scene.resistances[0].name), "loads." + scene.resistances[0].name,
+         fmt::format("every resistance has a constant magnitude (law: constant), which takes the same energy per "
+                     "revolution at any speed, and no motor drives: every speed is then a steady cycle at one load "
+                     "value, so no load value holds {:g} Hz rather than another; give a resistance a viscous or "
+                     "quadratic law, or drive with a motor",
+                     opt.cadence_hz));
+  // A mean rate in rev/s needs a coordinate that turns fully: a rocker or a stroke moves within
+  // a range (docs/theory.md §6c) and has no steady revolution to hold.
+  const auto* indep = scene.find_joint(scene.independent);
+  if (indep->type != models::JointType::Revolute || scene.independent_range)
+    fail("independent", fmt::format("calibration holds a mean rate in rev/s, so '{}' must be a revolute that turns "
+                                    "fully; it moves within a range",
+                                    scene.independent));
+}
+
+void fail_dead_points(const models::Scene& scene) {
+  throw models::SceneError(scene.source_file, 0, "independent",
+                           fmt::format("calibration holds a mean rate in rev/s, so '{}' must turn fully; it cannot "
+                                       "(it meets dead points: see rdyn inspect)",
+                                       scene.independent));
+}
+
+}  // namespace
+
+namespace {
+
+// check_calibratable's full-model part on a built system.
+void check_full_turn(const models::Scene& scene, const engine::FullModel& model) {
+  const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
+  if (!engine::calc_independent_domain(model).periodic) fail_dead_points(scene);
+}
+
+}  // namespace
+
+void check_calibratable(const models::Scene& scene, const CalibrationOptions& opt) {
+  check_calibration_input(scene, opt);
+  check_full_turn(scene, engine::FullModel(scene));
+}
+
+double calc_resistance_coefficient(const models::Scene& scene, const CalibrationOptions& opt) {
+  if (!(opt.power_w > 0)) return NAN;  // mean-speed mode: the resistances stay as given
+  const auto& res = scene.resistances[0];
+  const double omega_b = std::abs(*models::fixed_speed_ratio(scene, res.body)) * 2 * M_PI * opt.cadence_hz;
+  return opt.power_w / std::pow(omega_b, models::dissipation_exponent(res.law));  // P = c·ω^n
+}
+
+models::Scene with_unit_load(const models::Scene& scene, const CalibrationOptions& opt) {
+  return with_load(scene, select_load(scene, opt), 1.0, calc_resistance_coefficient(scene, opt));
+}
+
+CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
+                                    const CalibrationOptions& opt, Progress& progress) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
+  };
+  const Selection sel = select_load(scene, opt);
+  const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
+  CalibrationResult r;
+  r.load = sel.name;
+  r.load_kind = sel.kind;
+  r.load_unit = sel.unit;
+  r.resistance_coefficient = calc_resistance_coefficient(scene, opt);
+  // Power mode: c = P/ω_Fⁿ dissipates P only at constant speed; on a fluctuating steady cycle the
+  // resistance dissipates c·⟨ωⁿ⟩ ≠ P (a motor-driven crank at 2.3× fluctuation: 25 W for 20 W).
+  // So the coefficient is adjusted too, around the load search, until the steady cycle both
+  // holds F (the load) and dissipates P (the coefficient): a secant on ln c ↦ ln(P_diss/P),
+  // whose slope is near 1 (P_diss = c·⟨ωⁿ⟩, ⟨ωⁿ⟩ nearly independent of c), at most
+  // kMaxPowerPasses load searches.
+  const bool power_mode = std::isfinite(r.resistance_coefficient);
+  if (power_mode && m.brakes.size() != 1)
+    throw models::NumericalError(fmt::format("calibration: the reduced model has {} resistances, the power mode one",
+                                             m.brakes.size()));
+  double T = 0.0, W_unit = 0.0, ln_c_prev = NAN, f_prev = NAN;
+  int evals = 0;
+  Cycle cy;
+  for (int pass = 0;; ++pass) {
+    if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
+    set_load(m, sel, 1.0);  // the energy balance below reads the selected loads at unit value
+
+    // First guess from the energy balance per revolution at the constant target rate: the
+    // load's work T·W_unit balances the work of every other non-conservative load, W_other
+    // (springs and gravity do none over a revolution). Both are linear in the load values:
+    // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
+    const int n = 3600;
+    const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
+    std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
+        selected_force(m.point_forces.size(), 0);
+    for (const auto& en : sel.entries)
+      (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
+    W_unit = 0.0;
+    double W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
+    // The other loads' work per revolution one by one (named when they already balance the
+    // resistances: the real cause when the selected load has nothing left to do).
+    std::vector<double> W_torque(m.torques.size(), 0.0), W_force(m.point_forces.size(), 0.0),
+        W_motor(m.motors.size(), 0.0);
+    double W_brakes = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double q = scene.initial.q + (i + 0.5) * dq;
+      for (size_t k = 0; k < m.torques.size(); ++k) {
+        const auto& t = m.torques[k];
+        const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
+        // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
+        const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
+        const double r_j = tau * m.table.eval(t.c_r, q);
+        if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
+        if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
+        if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq, W_torque[k] += t.value * r_j * dq;
+      }
+      // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
+      for (size_t k = 0; k < m.point_forces.size(); ++k) {
+        const auto& f = m.point_forces[k];
+        const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
+        const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
+        if (selected_force[k]) W_scale += std::abs(Q) * dq;
+        if (on) (selected_force[k] ? W_unit : W_other) += f.value * Q * dq;
+        if (on && !selected_force[k]) W_other_scale += std::abs(f.value * Q) * dq, W_force[k] += f.value * Q * dq;
+      }
+      for (size_t k = 0; k < m.motors.size(); ++k) {
+        const auto& mo = m.motors[k];
+        const double r_j = m.table.eval(mo.c_r, q);
+        const double w = mo.stall * (1.0 - r_j * qd / mo.no_load_speed) * r_j * dq;
+        if (selected_motor[k]) {
+          W_unit += w;
+          W_scale += std::abs(r_j) * dq;
+          max_motor_rate = std::max(max_motor_rate, r_j * qd / mo.no_load_speed);
+        } else {
+          W_other += w;
+          W_other_scale += std::abs(w);
+          W_motor[k] += w;
+        }
+      }
+      for (const auto& b : m.brakes) {
+        const double w = m.table.eval(b.c_w, q);
+        const double wb = models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
+        W_other += wb;
+        W_other_scale += std::abs(wb);
+        W_brakes += wb;
+      }
+    }
+    r.work_per_rev_per_unit = W_unit;
+    if (!(std::abs(W_unit) > 1e-9 * W_scale) && sel.kind.rfind("motor", 0) != 0)
+      fail(load_field, fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
+                                   "mean speed: calibrate a load that drives the mechanism",
+                                   sel.name, W_unit, sel.unit));
+    if (!(W_unit > 0)) {
+      if (sel.kind.rfind("motor", 0) == 0)
+        fail(load_field,
+             fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load speed "
+                         "{:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall torque of "
+                         "the no-load speed's sign holds the target (lower the target or raise the no-load speed)",
+                         sel.name, opt.cadence_hz, max_motor_rate, scene.motors[sel.entries[0].index].no_load_speed,
+                         W_unit, sel.unit));
+      fail(load_field, fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
+                                   "per {}): give it the opposite sign",
+                                   sel.name, W_unit, sel.unit));
+    }
+    // The resistances dissipate but other drive loads already supply it (e.g. a scene's muscles
+    // calibrated for this operating point, and a torque added beside them): the selected load
+    // has no work left to do. Name those loads: "nothing dissipates" would be untrue.
+    std::string drivers;
+    auto add_driver = [&](const std::string& name, double W) {
+      if (W > 1e-9 * W_other_scale) drivers += fmt::format("{}'{}' {:+.4g} J", drivers.empty() ? "" : ", ", name, W);
+    };
+    for (size_t k = 0; k < W_torque.size(); ++k) add_driver(scene.joint_torques[k].name, W_torque[k]);
+    for (size_t k = 0; k < W_force.size(); ++k) add_driver(scene.point_forces[k].name, W_force[k]);
+    for (size_t k = 0; k < W_motor.size(); ++k) add_driver(scene.motors[k].name, W_motor[k]);
+    if (!(W_other < -1e-9 * W_other_scale) && W_brakes < -1e-9 * W_other_scale && !drivers.empty())
+      fail(load_field, fmt::format("at {:g} Hz the other drive loads already supply what the resistances dissipate "
+                                   "({:.4g} J per revolution): {} ({:+.3g} J net), so '{}' has no work left to do "
+                                   "and cannot set the mean speed; calibrate those loads instead, or remove them",
+                                   opt.cadence_hz, W_brakes, drivers, W_other, sel.name));
+    // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
+    // returns its work over a revolution).
+    if (!(W_other < -1e-9 * W_other_scale) || W_other == 0.0)
+      fail(load_field, fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
+                                   "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
+                                   "validation.calibrate.power_W) or a resistance",
+                                   opt.cadence_hz, W_other, sel.name));
+    r.initial_guess = -W_other / W_unit;
+
+    // One Newton iteration for the cycle, the load and (power mode) the coefficient together,
+    // from the energy balance's guess; the nested searches where it does not converge.
+    std::optional<OperatingPoint> direct;
+    if (opt.direct && pass == 0) {
+      OperatingPointTargets tg;
+      tg.q_section = scene.initial.q;
+      tg.qdot_guess = qd;
+      tg.cadence_hz = opt.cadence_hz;
+      tg.power_w = power_mode ? opt.power_w : NAN;
+      tg.tolerance = opt.tolerance;
+      progress.note("calibrate: operating point (Newton on the first integral)");
+      try {
+        direct = solve_operating_point(
+            m, tg, r.initial_guess, r.resistance_coefficient,
+            [&](double load, double c) {
+              set_load(m, sel, load);
+              if (power_mode) m.brakes[0].coefficient = c;
+            },
+            evals);
+      } catch (const models::NumericalError&) {
+        direct.reset();  // no first integral here (a table that is not periodic): the nested route
+      }
+    }
+    if (direct) {
+      T = direct->load;
+      if (power_mode) r.resistance_coefficient = direct->coefficient;
+    } else {
+      if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
+      // Brent (GSL) on the load's magnitude: mean steady cadence = F.
+      RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
+      gsl_function fn{cadence_error, &ctx};
+      double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
+      double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
+      for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
+      for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
+        hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
+      if (!(flo <= 0 && fhi >= 0))
+        throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
+                                                 sel.name, lo, hi, sel.unit, opt.cadence_hz));
+      gsl_set_error_handler_off();
+      std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
+          gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
+      gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
+      T = r.initial_guess;
+      for (int it = 0; it < 100; ++it) {
+        gsl_root_fsolver_iterate(solver.get());
+        T = gsl_root_fsolver_root(solver.get());
+        progress.count("calibrate: load search", it + 1, it + 1);
+        if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
+                                   1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
+          break;
+      }
+    }
+    progress.note("");
+    // A value the scene format refuses (|load| or |amplitude|·max|τ| above limits::kMaxForce, a
+    // resistance coefficient beyond its body's bound) is no result: a written scene would not load.
+    try {
+      models::check_scene(with_load(scene, sel, T, r.resistance_coefficient));
+    } catch (const models::SceneError& e) {
+      throw models::NumericalError(fmt::format(
+          "calibration: holding {:g} Hz needs {} = {:.6g} {}, beyond what a scene allows (the limit is {:g} {} per "
+          "load): {}: {}; choose a lower power or another operating point",
+          opt.cadence_hz, sel.name, T, sel.unit, models::limits::kMaxForce, sel.unit, e.field(), e.message()));
+    }
+    const double sign = sel.entries[0].sign;
+    r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
+    r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
+    set_load(m, sel, T);
+    cy = steady_cycle(m, scene.initial.q, direct ? direct->qdot_section : qd, opt.tolerance, evals, true);
+    if (!cy.ok)
+      throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
+                                               "({:.6g} {})", r.load_value, sel.unit));
+    r.steady_q = scene.initial.q;
+    r.steady_qdot = cy.speed;
+    r.mean_cadence_hz_reduced = 1.0 / cy.period;
+    // The result must meet its own target (issue #9): the root finder converges to 1e-10
+    // relative, so the reduced cadence is off by far less than kReducedCadenceTolerance unless
+    // the bracket held a discontinuity (a stall) instead of a root.
+    check_cadence("calibration missed its target: the reduced model's steady cadence", r.mean_cadence_hz_reduced,
+                  opt.cadence_hz, kReducedCadenceTolerance, sel, r.load_value);
+    r.load_searches = pass + 1;
+    if (!power_mode) break;
+    const double P_diss = cy.detail.dissipated_power_W;
+    const double f = std::log(P_diss / opt.power_w);  // 0 at the target
+    if (!std::isfinite(f))
+      throw models::NumericalError(fmt::format("calibration: the resistance dissipates {:.6g} W on the steady cycle "
+                                               "at {:g} Hz; no coefficient reaches {:g} W",
+                                               P_diss, opt.cadence_hz, opt.power_w));
+    if (std::abs(f) <= kPowerTolerance) break;
+    if (pass + 1 >= kMaxPowerPasses)
+      throw models::NumericalError(fmt::format(
+          "calibration did not converge: after {} load searches the steady cycle at {:g} Hz dissipates {:.8g} W "
+          "(resistance coefficient {:.6g}), target {:g} W (allowed {:g} %)",
+          pass + 1, opt.cadence_hz, P_diss, r.resistance_coefficient, opt.power_w, 100 * kPowerTolerance));
+    const double ln_c = std::log(r.resistance_coefficient);
+    double slope = std::isfinite(ln_c_prev) && ln_c != ln_c_prev ? (f - f_prev) / (ln_c - ln_c_prev) : 1.0;
+    if (!(slope > 0.1 && slope < 10)) slope = 1.0;  // a wild secant: the fixed-point step
+    ln_c_prev = ln_c, f_prev = f;
+    r.resistance_coefficient = std::exp(ln_c - f / slope);
+  }
+  r.mean_dissipated_power_w = cy.detail.dissipated_power_W;
+  // On a steady cycle the drive supplies what the resistances dissipate. The reduced model's
+  // own residual — an interpolated m2 that is not exactly ½ dm1/dq acts as a power ∝ q̇³
+  // (docs/theory.md §5; ~1.5e-4 W on the bicycle's 10° table at 1 Hz, 1e-6 of 125 W) — is
+  // small unless the operating point's energy flow is small against it (a very low power, a
+  // very high cadence): then the calibrated value is the interpolation error's, not the
+  // mechanism's, and that is no result.
+  {
+    const double drive = cy.detail.drive_power_W, diss = cy.detail.dissipated_power_W;
+    if (!(std::abs(drive - diss) <= kEnergyBalanceTolerance * std::max(std::abs(drive), std::abs(diss))))
+      throw models::NumericalError(fmt::format(
+          "calibration: on the reduced model's steady cycle at {:g} Hz the drive supplies {:.6g} W but the resistances "
+          "dissipate {:.6g} W ({:.2g} % apart, allowed {:g} %): the table's interpolation error is not small against "
+          "this operating point's energy flow; extract on a finer grid (--grid-deg)",
+          opt.cadence_hz, drive, diss, 100 * std::abs(drive - diss) / std::max(std::abs(drive), std::abs(diss)),
+          100 * kEnergyBalanceTolerance));
+  }
+  r.evaluations = evals;
+
+  // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
+  r.speed_fluctuation = cy.detail.speed_fluctuation;
+  if (!scene.outputs.constraint_forces.empty()) {
+    r.force_name = scene.outputs.constraint_forces[0].name;
+    r.peak_force_N = cy.detail.peak_force_N[0];
+  }
+  r.peak_forces_N = cy.detail.peak_force_N;
+  if (sel.entries[0].motor) {
+    // A motor's power depends on the speed: trapezoid rule over the periodic cycle samples
+    // (spectrally accurate for a smooth periodic integrand).
+    const auto& mo = m.motors[sel.entries[0].index];
+    reduced::ReducedOptions ro;
+    ro.duration_s = cy.period;
+    ro.output_interval_s = cy.period / 1440;
+    ro.tolerance = opt.tolerance;
+    const auto cyc = reduced::simulate_reduced(m, r.steady_q, r.steady_qdot, ro);
+    double E = 0.0;
+    for (size_t i = 0; i + 1 < cyc.t.size(); ++i) {
+      auto p = [&](size_t k) {
+        const double u = m.table.eval(mo.c_r, cyc.q[k]) * cyc.qdot[k];
+        return mo.stall * (1.0 - u / mo.no_load_speed) * u;
+      };
+      E += 0.5 * (p(i) + p(i + 1)) * (cyc.t[i + 1] - cyc.t[i]);
+    }
+    r.mean_power_w = E / cy.period;
+  } else {
+    r.mean_power_w = T * W_unit / cy.period;  // a position-dependent load: its work per revolution is exact
+  }
+
+  r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
+  return r;
+}
+
+CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
+  // Dead points are looked for twice, because each route alone misses some: the domain walk
+  // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts)
+  // and the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over
+  // the blocked range twice comes back on its branch and closes). The walk costs about an
+  // extraction (2.9 ms on the bicycle); sweeps pay it once per table. One system serves both.
+  check_calibration_input(scene, opt);
+  const engine::FullModel model(scene);
+  check_full_turn(scene, model);
+  auto e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+  if (e.range || !e.samples.periodic) fail_dead_points(scene);
+  CalibrationTable t;
+  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
+  t.samples = std::move(e.samples);
+  return t;
+}
+
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  // The table does not depend on load values: extract once.
+  progress.note("calibrate: extracting the reduced table");
+  auto r = calibrate(scene, extract_calibration_table(scene, opt), opt, progress);
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& table, const CalibrationOptions& opt,
+                            Progress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  check_calibration_input(scene, opt);
+  const Selection sel = select_load(scene, opt);
+  auto m = reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table);
+  CalibrationResult r = calibrate_reduced(m, scene, opt, progress);
+
+  // Confirmation with the full model from the same point of the steady cycle.
+  r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
+  if (!(opt.full_max_s > 0)) {
+    r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return r;
+  }
+  progress.note("calibrate: confirming with the full model");
+  const FullCheck full = confirm_on_full(scene, sel, opt, r);
+  r.mean_cadence_hz_full = full.c.measures.cadence_hz;
+  r.speed_fluctuation_full = full.c.measures.speed_fluctuation;
+  r.peak_force_full_N = full.c.measures.peak_force_N;
+  r.full_revolutions = full.c.measures.revolutions;
+  r.full_duration_s = full.c.duration_s;
+  try {
+    check_full(full, opt, sel, r);
+  } catch (const models::NumericalError& e) {
+    if (!opt.keep_unconfirmed) throw;
+    r.unconfirmed = e.what();
+  }
+  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+namespace {
+
+// The YAML key holding the value of load entry `e` (empty: not a key of the text, i.e. made
+// by the bicycle_leg generator).
+std::string value_key(const std::string& text, const models::Scene& scene, const Entry& e) {
+  const std::string base = "loads." + name_of(scene, e) + ".";
+  // A point force listed in the text: force_N (created when a profiled one leaves it at 1).
+  if (e.point_force) return models::scene_yaml_has(text, base + "type") ? base + "force_N" : "";
+  for (const char* k : e.motor ? std::vector<const char*>{"stall_torque_Nm", "stall_force_N"}
+                               : std::vector<const char*>{"torque_Nm", "force_N"})
+    if (models::scene_yaml_has(text, base + k)) return base + k;
+  return "";
+}
+
+}  // namespace
+
+void check_writable(const std::string& text, const models::Scene& scene, const CalibrationOptions& opt) {
+  const Selection sel = select_load(scene, opt);
+  if (opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg")) return;  // hip_torque_Nm
+  for (const auto& e : sel.entries)
+    if (value_key(text, scene, e).empty())
+      throw models::SceneError(scene.source_file, 0, "--write-scene",
+                               "'" + sel.name + "' is made by the scene's generator, not written in its loads: "
+                               "only the generator's own drive value (every joint torque, no --load) can be written");
+}
+
+std::string calibrated_scene_yaml(const std::string& source, const std::string& text,
+                                  const std::vector<models::Override>& base, const models::Scene& scene,
+                                  const CalibrationOptions& opt, const CalibrationResult& r) {
+  check_writable(text, scene, opt);
+  const Selection sel = select_load(scene, opt);
+  const double T = std::abs(r.load_value);
+  std::vector<models::Override> o = base;
+  auto num = [](double v) { return fmt::format("{:.12g}", v); };
+  const bool generated_drive = opt.load.empty() && models::scene_yaml_has(text, "bicycle_leg");
+  if (generated_drive) {
+    // Torques the scene lists under `loads` (profiled hips, say) are scaled there; the
+    // generated constant hip torques through hip_torque_Nm, only when the generator made some.
+    bool generated = false;
+    for (const auto& t : scene.joint_torques) {
+      if (!models::scene_yaml_has(text, "loads." + t.name + ".joint")) {
+        generated = true;
+        continue;
+      }
+      // The joint's unit decides the key (scene_yaml refuses the other one).
+      const models::Joint* j = scene.find_joint(t.joint);
+      const std::string key = j && j->type == models::JointType::Prismatic ? "force_N" : "torque_Nm";
+      o.push_back({"loads." + t.name + "." + key, num((t.value < 0 ? -1 : 1) * T)});
+    }
+    if (generated) o.push_back({"bicycle_leg.hip_torque_Nm", num(T)});
+  } else {
+    for (const auto& e : sel.entries) o.push_back({value_key(text, scene, e), num(e.sign * T)});
+  }
+  // power_W at cadence_Hz means c = power_W/ω_Fⁿ (constant speed): the nominal power that gives
+  // the calibrated coefficient, which dissipates P on the fluctuating steady cycle.
+  const std::string nominal_w =
+      opt.power_w > 0 ? fmt::format("{:.17g}", opt.power_w * r.resistance_coefficient /
+                                                   calc_resistance_coefficient(scene, opt))
+                      : std::string();
+  if (opt.power_w > 0) {
+    if (models::scene_yaml_has(text, "bicycle_leg")) {
+      o.push_back({"bicycle_leg.resistance.power_W", nominal_w});
+      o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
+    } else {
+      const auto& res = scene.resistances[0];
+      if (models::scene_yaml_has(text, "loads." + res.name + ".dissipates")) {
+        o.push_back({"loads." + res.name + ".dissipates.power_W", nominal_w});
+        o.push_back({"loads." + res.name + ".dissipates.cadence_Hz", num(opt.cadence_hz)});
+      } else {
+        o.push_back({"loads." + res.name + ".coefficient", num(r.resistance_coefficient)});
+      }
+    }
+  }
+  o.push_back({"initial.q", fmt::format("{:.17g}", r.steady_q)});
+  o.push_back({"initial.qdot", fmt::format("{:.17g}", r.steady_qdot)});
+  const std::string body = models::rewrite_scene_yaml(
+      text, scene.source_file, o, {"initial.q", "initial.q_deg", "initial.qdot", "initial.cadence_Hz"});
+  // The source name goes into a YAML comment: one line, no control characters (a file name
+  // with a newline must not add keys to the scene).
+  std::string from;
+  for (char c : source) from += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+  const std::string point =
+      opt.power_w > 0 ? fmt::format("with the resistance dissipating {:.6g} W on the steady cycle at {:.6g} Hz (its\n"
+                                    "# power_W is nominal: the power of its coefficient at a constant {:.6g} Hz)",
+                                    opt.power_w, opt.cadence_hz, opt.cadence_hz)
+                      : std::string("with the resistances as given");
+  // An unconfirmed result (written with --force) says so in its first comment, on one line each.
+  std::string warning;
+  if (!r.unconfirmed.empty()) {
+    warning = "# NOT CONFIRMED on the full model (written with --force): ";
+    for (char c : r.unconfirmed) warning += c == '\n' ? ' ' : c;
+    warning += "\n";
+  }
+  return fmt::format(
+      "# Calibrated by `rdyn calibrate` from {}: {} ({}) = {:.6g} {} holds a mean cadence of {:.6g} Hz\n"
+      "# (reduced) / {} (full) {}. The initial\n"
+      "# conditions are a point of the steady cycle.\n{}{}",
+      from, r.load, r.load_kind, r.load_value, r.load_unit, r.mean_cadence_hz_reduced,
+      std::isfinite(r.mean_cadence_hz_full) ? fmt::format("{:.6g} Hz", r.mean_cadence_hz_full) : "no measure",
+      point, warning, body);
+}
+
+}  // namespace rdyn::validate

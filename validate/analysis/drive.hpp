@@ -1,0 +1,68 @@
+// Prescribed motion (`rdyn drive`): the independent coordinate follows a given q(t) — a constant
+// rate, or a profile read from a CSV — and each model answers what the drive on q must supply and
+// what the constraints carry, with every other load of the scene applied. Full model: inverse
+// dynamics, the kinetostatic call with every load on (engine/kinetostatic.hpp). Reduced model: the
+// inverse form of Eksergian's equation (reduced::calc_drive). Plain functions returning records;
+// the command (validate/cli/drive_command.cpp) writes them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "models/scene.hpp"
+#include "reduced/reduced_model.hpp"
+
+namespace rdyn::validate {
+
+// q(t) and its derivatives on the output grid [s, rad or m].
+struct PrescribedMotion {
+  std::vector<double> t, q, qdot, qddot;
+  std::string how;  // plain words, for run.json
+};
+
+// q = q0 + rate·t on [0, duration] every dt (the last row at the duration itself).
+PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s, double dt_s);
+
+// A profile t,q_deg (revolute) or t,q_m (prismatic) from a CSV file, interpolated by a natural
+// cubic spline (GSL; q̇ and q̈ its first and second derivatives), sampled every dt from its first
+// time over `duration_s` (≤ its span; empty: the span). Throws models::SceneError naming the
+// file, the line and the column for an unreadable or malformed profile (fewer than 4 rows, times
+// not increasing, a value not finite, the wrong unit for the independent coordinate), or naming
+// --duration / --dt-out when the duration exceeds the span or makes more than max_rows rows.
+PrescribedMotion profile_motion(const std::string& path, bool revolute, std::optional<double> duration_s, double dt_s,
+                                double max_rows = 1e7);
+
+// The full model follows the branch in moves of at most kDriveMove between rows (one
+// kinetostatic sample each, ~0.1–0.3 ms); calc_drive_moves counts them for a motion, so the
+// command can refuse one that would take hours before any work (kMaxDriveMoves), and a run
+// stops after kDriveMaxWall_s all the same.
+constexpr double kDriveMove = 5.0 * 3.14159265358979323846 / 180;
+constexpr double kMaxDriveMoves = 2e5;
+constexpr double kDriveMaxWall_s = 600.0;
+double calc_drive_moves(const PrescribedMotion& motion);
+
+struct DriveRecord {
+  std::vector<double> t, q, qdot, qddot;
+  std::vector<double> drive;  // generalized force the drive adds on q [N·m or N]
+  std::vector<double> power;  // drive·q̇ [W]
+  std::vector<std::string> force_names;
+  std::vector<std::vector<double>> forces;  // [force][row] F_E [N]
+  double wall_s = 0.0;
+};
+
+// Inverse dynamics of the full model along the motion (continuation from the assembled
+// configuration). Throws engine::EngineError where the motion leaves the mechanism's range.
+DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& motion);
+// The reduced model's inverse Eksergian equation along the motion. Throws reduced::TableError
+// where the motion leaves the table's range.
+DriveRecord calc_drive_reduced(const reduced::ReducedModel& model, const PrescribedMotion& motion);
+
+struct DriveStats {
+  double rms = 0.0, peak = 0.0, mean = 0.0;  // of the drive (peak: largest |drive|)
+  double mean_power_W = 0.0, peak_power_W = 0.0;
+  std::vector<double> force_peaks;  // largest |F_E| per constraint force
+};
+DriveStats calc_drive_stats(const DriveRecord& r);
+
+}  // namespace rdyn::validate

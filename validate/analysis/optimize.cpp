@@ -1,0 +1,669 @@
+#include "validate/analysis/optimize.hpp"
+
+#include <nlopt.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "reduced/profile_columns.hpp"
+#include "reduced/reduced_model.hpp"
+#include "reduced/simulate_reduced.hpp"
+#include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/confirm_full.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr double kTwoPi = 2 * M_PI;
+// Sampled constraints: τ(θ_i) ≥ 0 at 5° spacing (a series of ≤ 12 harmonics has no dip
+// narrower than ~15° that falls between samples by more than a few percent of its depth), and
+// the bound on |value·τ| at 1° spacing.
+constexpr int kNonnegativeSamples = 72;
+constexpr int kBoundSamples = 360;
+// A failed evaluation (no steady cycle, no amplitude holding F): a large finite objective,
+// 10× the constant strategy's, and a violated bound, never NaN into NLopt.
+constexpr double kPenalty = 10.0;
+// Coefficients searched within ±kCoefficientBound of a unit mean (a0 = 1 of the first shape).
+constexpr double kCoefficientBound = 4.0;
+constexpr double kInitialStep = 0.2;
+
+// A shape group: design loads sharing one series (same_as), shifted per load.
+struct Group {
+  bool fixed_a0 = false;  // the first group's a0 ≡ 1 (the amplitude carries the scale)
+  bool nonnegative = true;
+  double bound = 0.0;     // max |value·τ| [N·m or N]
+  int offset = 0;         // first parameter in x
+  double a0_start = 1.0;
+};
+struct DesignLoad {
+  size_t torque = 0;      // index into scene.joint_torques
+  int group = 0;
+  double shift = 0.0;     // [rad]: τ(θ) = τ_group(θ − shift)
+};
+struct Design {
+  std::string of;
+  int H = 3;
+  std::vector<Group> groups;
+  std::vector<DesignLoad> loads;
+  int n = 0;  // parameters
+};
+
+struct Series {
+  double a0 = 0.0;
+  std::vector<double> a, b;
+};
+
+double eval_series(const Series& s, double th) {
+  double v = s.a0;
+  for (size_t k = 0; k < s.a.size(); ++k) v += s.a[k] * std::cos((k + 1) * th) + s.b[k] * std::sin((k + 1) * th);
+  return v;
+}
+
+// min_θ τ(θ) of a nonnegative group's series: the true minimum, not a sample (below).
+double series_minimum(const Series& s) { return calc_fourier_minimum(s.a0, s.a, s.b); }
+
+Series group_series(const Design& d, int g, const double* x) {
+  const Group& gr = d.groups[g];
+  Series s;
+  int i = gr.offset;
+  s.a0 = gr.fixed_a0 ? 1.0 : x[i++];
+  s.a.assign(x + i, x + i + d.H);
+  s.b.assign(x + i + d.H, x + i + 2 * d.H);
+  return s;
+}
+
+// τ(θ − s) as a series in θ: cos k(θ−s) = cos kθ cos ks + sin kθ sin ks, sin k(θ−s) = sin kθ cos ks − cos kθ sin ks.
+Series shifted(const Series& s, double shift) {
+  Series r = s;
+  for (size_t k = 0; k < s.a.size(); ++k) {
+    const double c = std::cos((k + 1) * shift), sn = std::sin((k + 1) * shift);
+    r.a[k] = s.a[k] * c - s.b[k] * sn;
+    r.b[k] = s.a[k] * sn + s.b[k] * c;
+  }
+  return r;
+}
+
+// The scene with every design load profiled by its group's series at x.
+models::Scene shaped_scene(models::Scene s, const Design& d, const double* x) {
+  for (const auto& dl : d.loads) {
+    const Series sr = shifted(group_series(d, dl.group, x), dl.shift);
+    models::LoadProfile p;
+    p.of = d.of;
+    p.a0 = sr.a0, p.a = sr.a, p.b = sr.b;
+    s.joint_torques[dl.torque].profile = p;
+  }
+  return s;
+}
+
+// The design: groups, loads, their starting point; SceneError naming the field.
+Design resolve_design(const models::Scene& s, const models::OptimizeSpec& spec, const OptimizeOptions& opt) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    const int line = s.line_of("optimize.loads") ? s.line_of("optimize.loads") : s.line_of("optimize");
+    throw models::SceneError(s.source_file, line, field, msg);
+  };
+  Design d;
+  d.H = opt.harmonics > 0 ? opt.harmonics : spec.harmonics;
+  d.of = spec.of.empty() ? s.independent : spec.of;
+  const double max_load = opt.max_load > 0 ? opt.max_load : spec.max_load;
+  // `key`: the design entry's own key (its line, or its --set), when the name comes from the block.
+  auto index_of = [&](const std::string& name, const std::string& key) {
+    for (size_t i = 0; i < s.joint_torques.size(); ++i)
+      if (s.joint_torques[i].name == name) return i;
+    const std::string msg = "no joint_torque named '" + name + "' to design (design loads are the scene's joint "
+                            "torques as loaded, --set overrides applied)";
+    if (!key.empty() && (s.line_of(key) > 0 || s.field_of(key) != key))
+      throw models::SceneError(s.source_file, s.line_of(key), s.field_of(key), msg);
+    fail("optimize.loads", msg);
+    return size_t(0);
+  };
+  std::vector<models::OptimizeLoad> listed = spec.loads;
+  if (listed.empty())
+    for (const auto& t : s.joint_torques)
+      if (std::find(opt.add_torques.begin(), opt.add_torques.end(), t.joint) == opt.add_torques.end() ||
+          t.name != "torque_" + t.joint)
+        listed.push_back({t.name, "", 0.0});
+  std::vector<std::string> group_of_name;
+  for (size_t k = 0; k < listed.size(); ++k) {
+    const auto& l = listed[k];
+    DesignLoad dl;
+    dl.torque = index_of(l.load, spec.loads.empty() ? "" : fmt::format("optimize.loads[{}].load", k));
+    if (l.same_as.empty()) {
+      dl.group = static_cast<int>(d.groups.size());
+      Group g;
+      g.fixed_a0 = d.groups.empty();
+      g.nonnegative = spec.nonnegative;
+      g.bound = max_load;
+      d.groups.push_back(g);
+      group_of_name.push_back(l.load);
+    } else {
+      const auto it = std::find(group_of_name.begin(), group_of_name.end(), l.same_as);
+      if (it == group_of_name.end())
+        fail("optimize.loads", "'" + l.load + "' takes the shape of '" + l.same_as + "', which is not listed before it");
+      dl.group = static_cast<int>(it - group_of_name.begin());
+      dl.shift = l.shift_rad;
+    }
+    d.loads.push_back(dl);
+  }
+  for (const auto& j : opt.add_torques) {  // signed shapes of their own, starting from zero
+    DesignLoad dl;
+    dl.torque = index_of("torque_" + j, "");
+    dl.group = static_cast<int>(d.groups.size());
+    Group g;
+    g.fixed_a0 = d.groups.empty();
+    g.nonnegative = false;
+    g.bound = opt.add_torque_max;
+    g.a0_start = 0.0;
+    d.groups.push_back(g);
+    d.loads.push_back(dl);
+  }
+  // Calibration scales every joint torque together: each must be a design load.
+  for (size_t i = 0; i < s.joint_torques.size(); ++i)
+    if (std::none_of(d.loads.begin(), d.loads.end(), [&](const DesignLoad& dl) { return dl.torque == i; }))
+      fail("optimize.loads", fmt::format("joint torque '{}' is not a design load: the amplitude is calibrated for "
+                                         "every joint torque together, so list it (a shape of its own or same_as)",
+                                         s.joint_torques[i].name));
+  for (auto& g : d.groups) {
+    g.offset = d.n;
+    d.n += (g.fixed_a0 ? 0 : 1) + 2 * d.H;
+  }
+  return d;
+}
+
+struct Evaluation {
+  std::vector<double> x;
+  bool ok = false;
+  double objective = 0.0;          // peak or p-norm [N]
+  double peak = 0.0;               // [N]
+  std::vector<double> max_tau;     // per group: max |τ(θ)| over the samples
+  CalibrationResult cal;
+};
+
+// Per-run state of the search: the model whose tau columns each candidate refits.
+struct Workspace {
+  const models::Scene* scene = nullptr;  // with the added torques, design loads profiled
+  const Design* design = nullptr;
+  CalibrationOptions copt;
+  reduced::Samples samples;
+  reduced::ReducedModel model;
+  reduced::Interpolation interp = reduced::Interpolation::Fourier;
+  int force = 0;
+  bool pnorm = false;
+  double p = 8.0;
+  double objective_scale = 1.0;  // the constant strategy's objective
+  Evaluation last;
+  int evaluations = 0, failures = 0;
+  Progress* progress = nullptr;
+  int max_evaluations = 0;
+};
+
+// (mean |F|^p)^(1/p) over one steady cycle, sampled at 720 equal time steps.
+double calc_pnorm(const reduced::ReducedModel& m, double q, double qdot, double period, double tol, int k, double p) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = period;
+  ro.output_interval_s = period / 720;
+  ro.tolerance = tol;
+  const auto ts = reduced::simulate_reduced(m, q, qdot, ro);
+  double peak = 0.0;
+  for (size_t i = 0; i + 1 < ts.t.size(); ++i) peak = std::max(peak, std::abs(ts.forces[k][i]));
+  if (!(peak > 0)) return 0.0;
+  double sum = 0.0;
+  const size_t n = ts.t.size() - 1;
+  for (size_t i = 0; i < n; ++i) sum += std::pow(std::abs(ts.forces[k][i]) / peak, p);  // scaled: no overflow
+  return peak * std::pow(sum / n, 1.0 / p);
+}
+
+const Evaluation& evaluate(Workspace& w, const double* x) {
+  if (w.last.x.size() == static_cast<size_t>(w.design->n) && std::equal(w.last.x.begin(), w.last.x.end(), x))
+    return w.last;
+  Evaluation e;
+  e.x.assign(x, x + w.design->n);
+  const Design& d = *w.design;
+  for (int g = 0; g < static_cast<int>(d.groups.size()); ++g) {
+    const Series s = group_series(d, g, x);
+    double mx = 0.0;
+    for (int i = 0; i < kBoundSamples; ++i) mx = std::max(mx, std::abs(eval_series(s, kTwoPi * i / kBoundSamples)));
+    e.max_tau.push_back(mx);
+  }
+  ++w.evaluations;
+  try {
+    const models::Scene sx = shaped_scene(*w.scene, d, x);
+    const auto sx_unit = with_unit_load(sx, w.copt);
+    w.samples = reduced::with_profile_columns(std::move(w.samples), sx_unit);
+    reduced::refit_profile_columns(w.model, w.samples, w.interp);
+    Progress silent(false);
+    e.cal = calibrate_reduced(w.model, sx_unit, w.copt, silent);
+    e.peak = e.cal.peak_forces_N.at(w.force);
+    e.objective = w.pnorm ? calc_pnorm(w.model, e.cal.steady_q, e.cal.steady_qdot, 1.0 / e.cal.mean_cadence_hz_reduced,
+                                       w.copt.tolerance, w.force, w.p)
+                          : e.peak;
+    e.ok = std::isfinite(e.objective) && std::isfinite(e.cal.load_value);
+  } catch (const models::NumericalError&) {
+    e.ok = false;  // no cycle or no amplitude holding F: a penalty, not an error
+  } catch (const models::SceneError&) {
+    e.ok = false;  // a shape doing no net work (the amplitude cannot hold F)
+  }
+  if (!e.ok) ++w.failures;
+  if (w.progress) w.progress->count("optimize: evaluations", w.evaluations, w.max_evaluations);
+  w.last = std::move(e);
+  return w.last;
+}
+
+// Lifts every nonnegative group's series whose true minimum m is below 0 to τ ≥ 0 at every
+// angle: a free a0 rises by δ = −m; with a0 ≡ 1 (the first group) the series becomes
+// (τ + δ)/(1 + δ), its harmonics divided by 1 + δ. Returns the largest δ (0: none needed).
+double repair_nonnegative(const Design& d, std::vector<double>& x) {
+  double largest = 0.0;
+  for (int g = 0; g < static_cast<int>(d.groups.size()); ++g) {
+    if (!d.groups[g].nonnegative) continue;
+    const double m = series_minimum(group_series(d, g, x.data()));
+    if (!(m < 0)) continue;
+    const double delta = -m * (1 + 1e-12) + 1e-15;  // strictly lifted past rounding
+    largest = std::max(largest, delta);
+    const int first = d.groups[g].offset;
+    if (d.groups[g].fixed_a0) {
+      for (int k = 0; k < 2 * d.H; ++k) x[first + k] /= 1 + delta;
+    } else {
+      x[first] += delta;
+    }
+  }
+  return largest;
+}
+
+double objective_fn(unsigned n, const double* x, double* grad, void* data) {
+  (void)n;
+  (void)grad;  // derivative-free (COBYLA)
+  auto& w = *static_cast<Workspace*>(data);
+  const auto& e = evaluate(w, x);
+  return e.ok ? e.objective / w.objective_scale : kPenalty;
+}
+
+// Inequality constraints c(x) ≤ 0: −τ_g(θ_i) for nonnegative groups, then per group
+// (A·max|τ_g| − bound)/bound.
+void constraints_fn(unsigned m, double* result, unsigned n, const double* x, double* grad, void* data) {
+  (void)n;
+  (void)grad;
+  auto& w = *static_cast<Workspace*>(data);
+  const Design& d = *w.design;
+  unsigned i = 0;
+  for (int g = 0; g < static_cast<int>(d.groups.size()); ++g) {
+    if (!d.groups[g].nonnegative) continue;
+    const Series s = group_series(d, g, x);
+    for (int k = 0; k < kNonnegativeSamples; ++k) result[i++] = -eval_series(s, kTwoPi * k / kNonnegativeSamples);
+    result[i++] = -series_minimum(s);  // between the samples too (the samples steer COBYLA's linear model)
+  }
+  const auto& e = evaluate(w, x);
+  for (int g = 0; g < static_cast<int>(d.groups.size()); ++g)
+    result[i++] = e.ok ? (std::abs(e.cal.load_value) * e.max_tau[g] - d.groups[g].bound) / d.groups[g].bound : 1.0;
+  (void)m;
+}
+
+}  // namespace
+
+double calc_fourier_minimum(double a0, const std::vector<double>& a, const std::vector<double>& b) {
+  const size_t H = std::max(a.size(), b.size());
+  auto coef = [&](const std::vector<double>& c, size_t k) { return k < c.size() ? c[k] : 0.0; };
+  // τ, τ′, τ″ at θ.
+  auto eval = [&](double th, double& d1, double& d2) {
+    double v = a0;
+    d1 = d2 = 0.0;
+    for (size_t k = 0; k < H; ++k) {
+      const double n = static_cast<double>(k + 1), c = std::cos(n * th), s = std::sin(n * th);
+      const double ak = coef(a, k), bk = coef(b, k);
+      v += ak * c + bk * s;
+      d1 += n * (bk * c - ak * s);
+      d2 -= n * n * (ak * c + bk * s);
+    }
+    return v;
+  };
+  // A grid of N = 16(H + 1) angles (≥ 8 points per period of the highest harmonic): each local
+  // minimum of the samples brackets one of τ's (τ′ has at most 2H zeros), refined by Newton on
+  // τ′ within ± one spacing (quadratic convergence; 30 steps bound it).
+  const size_t N = 16 * (H + 1);
+  const double h = kTwoPi / static_cast<double>(N);
+  std::vector<double> v(N);
+  double d1 = 0.0, d2 = 0.0, lowest = HUGE_VAL;
+  for (size_t i = 0; i < N; ++i) v[i] = eval(h * static_cast<double>(i), d1, d2), lowest = std::min(lowest, v[i]);
+  for (size_t i = 0; i < N && H > 0; ++i) {
+    if (!(v[i] <= v[(i + N - 1) % N] && v[i] <= v[(i + 1) % N])) continue;
+    const double th0 = h * static_cast<double>(i);
+    double th = th0;
+    for (int it = 0; it < 30; ++it) {
+      eval(th, d1, d2);
+      if (!(d2 > 0)) break;  // not convex here: the samples already hold the minimum's value
+      const double step = d1 / d2;
+      th -= step;
+      if (std::abs(th - th0) > h) break;  // left its cell: another cell's minimum
+      lowest = std::min(lowest, eval(th, d1, d2));
+      if (std::abs(step) < 1e-14) break;
+    }
+  }
+  return lowest;
+}
+
+models::Scene scene_with_added_torques(const models::Scene& scene, const OptimizeOptions& opt) {
+  models::Scene s = scene;
+  for (const auto& j : opt.add_torques) {
+    auto fail = [&](const std::string& msg) { throw models::SceneError(scene.source_file, 0, "--add-torque", msg); };
+    if (!models::is_valid_name(j)) fail(models::invalid_name_message(j));
+    const auto* joint = s.find_joint(j);
+    if (!joint) fail("unknown joint '" + j + "'");
+    if (joint->type != models::JointType::Revolute) fail("'" + j + "' is not a revolute joint");
+    const std::string name = "torque_" + j;
+    if (std::count(opt.add_torques.begin(), opt.add_torques.end(), j) > 1) fail("joint '" + j + "' is given twice");
+    for (const auto& t : s.joint_torques)
+      if (t.name == name) fail("the scene already has a joint torque named '" + name + "'");
+    s.joint_torques.push_back({name, j, 1.0, std::nullopt, std::nullopt});
+  }
+  return s;
+}
+
+void check_optimize_options(const models::Scene& scene, const OptimizeOptions& opt) {
+  auto fail = [&](const std::string& field, const std::string& msg) {
+    throw models::SceneError(scene.source_file, 0, field, msg);
+  };
+  if (opt.harmonics != 0 && (opt.harmonics < 1 || opt.harmonics > models::kMaxOptimizeHarmonics))
+    fail("--harmonics", fmt::format("must be a whole number in [1, {}] (got {})", models::kMaxOptimizeHarmonics,
+                                    opt.harmonics));
+  if (!opt.objective.empty() && opt.objective != "peak" && opt.objective != "pnorm")
+    fail("--objective", "expected peak or pnorm");
+  if (opt.p != 0 && !(opt.p >= 2 && opt.p <= 64)) fail("--p", fmt::format("must be in [2, 64] (got {:g})", opt.p));
+  if (opt.max_load != 0 && !(opt.max_load > 0 && opt.max_load <= models::limits::kMaxForce))
+    fail("--max-load", fmt::format("must be in (0, {:g}] N·m or N (got {:g})", models::limits::kMaxForce, opt.max_load));
+  if (!(opt.add_torque_max > 0 && opt.add_torque_max <= models::limits::kMaxForce))
+    fail("--add-torque-max", fmt::format("must be in (0, {:g}] N·m (got {:g})", models::limits::kMaxForce,
+                                         opt.add_torque_max));
+  if (opt.max_evaluations < 1 || opt.max_evaluations > kMaxOptimizeEvaluations)
+    fail("--max-evaluations", fmt::format("must be in [1, {}] (got {})", kMaxOptimizeEvaluations, opt.max_evaluations));
+  if (!(opt.rel_tolerance >= 1e-12 && opt.rel_tolerance <= 0.1))
+    fail("--rel-tolerance", fmt::format("must be in [1e-12, 0.1] (got {:g})", opt.rel_tolerance));
+  if (!(opt.full_duration_s >= kMinOptimizeFullDuration_s && opt.full_duration_s <= kMaxOptimizeFullDuration_s))
+    fail("--full-duration", fmt::format("must be in [{:g}, {:g}] s (got {:g})", kMinOptimizeFullDuration_s,
+                                        kMaxOptimizeFullDuration_s, opt.full_duration_s));
+  if (!(opt.full_skip_s >= 0 && opt.full_skip_s <= 0.5 * opt.full_duration_s))
+    fail("--full-skip", fmt::format("must be in [0, half the full duration] s (got {:g})", opt.full_skip_s));
+  const auto& cf = scene.outputs.constraint_forces;
+  const std::string force = !opt.force_name.empty() ? opt.force_name
+                            : scene.optimize && !scene.optimize->force.empty() ? scene.optimize->force
+                                                                               : std::string();
+  if (cf.empty()) fail("outputs.constraint_forces", "optimize minimises a constraint force: request one");
+  if (scene.joint_torques.empty())
+    fail("loads", "optimize shapes joint torques and the scene has none: add a joint_torque, or one with --add-torque "
+                  "JOINT, and remove the scene's drive loads of other kinds (point forces and motors are not design loads)");
+  // One amplitude scales the design loads (every joint torque) to hold the cadence, every other
+  // load as given. A motor or a point force would drive beside them, neither shaped nor scaled:
+  // with a motor as the real drive (slider-crank) the design load is the piston's load, which
+  // does no net work per revolution; with muscles calibrated for the operating point
+  // (bicycle-muscle) an added torque has nothing left to do. Refused before any work.
+  std::string designed;
+  for (const auto& t : scene.joint_torques) designed += (designed.empty() ? "'" : ", '") + t.name + "'";
+  auto refuse_drive = [&](const std::string& kind, const std::string& name, const std::string& joint) {
+    throw models::SceneError(
+        scene.source_file, scene.line_of("loads." + name), "loads." + name,
+        fmt::format("{} '{}' drives the mechanism but is not a design load: optimize shapes the joint torques ({}) "
+                    "and calibrates one amplitude for them to hold the cadence, every other load as given, so the "
+                    "drive must be joint torques alone; give the drive as a joint_torque{} and remove the {}",
+                    kind, name, designed, joint.empty() ? "" : " on joint '" + joint + "'", kind));
+  };
+  for (const auto& mo : scene.motors) refuse_drive("motor", mo.name, mo.joint);
+  for (const auto& pf : scene.point_forces) refuse_drive("point force", pf.name, "");
+  if (!force.empty() &&
+      std::none_of(cf.begin(), cf.end(), [&](const models::ConstraintForceRequest& c) { return c.name == force; }))
+    fail(opt.force_name.empty() ? "optimize.force" : "--force-name",
+         "no requested constraint force named '" + force + "' (outputs.constraint_forces)");
+  if (!scene.find_joint(scene.independent) || scene.find_joint(scene.independent)->type != models::JointType::Revolute)
+    fail("independent", "optimize shapes loads over a revolute independent coordinate that turns fully");
+}
+
+OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& opt, Progress& progress) {
+  const auto start = Clock::now();
+  const models::Scene scene = scene_with_added_torques(scene_in, opt);
+  check_optimize_options(scene, opt);
+  const models::OptimizeSpec spec = scene.optimize.value_or(models::OptimizeSpec{});
+  const Design design = resolve_design(scene, spec, opt);
+
+  OptimizeResult r;
+  r.scene = scene.name;
+  r.objective = !opt.objective.empty() ? opt.objective : spec.objective;
+  r.p = opt.p > 0 ? opt.p : spec.p;
+  r.harmonics = design.H;
+  r.profile_of = design.of;
+  r.independent = scene.independent;
+  r.full_duration_s = opt.full_duration_s;
+  r.cadence_hz = opt.cadence_hz;
+  r.power_w = opt.power_w;
+  r.force_name = !opt.force_name.empty() ? opt.force_name
+                 : !spec.force.empty()   ? spec.force
+                                         : scene.outputs.constraint_forces[0].name;
+  int force = 0;
+  while (scene.outputs.constraint_forces[force].name != r.force_name) ++force;
+  for (const auto& dl : design.loads) {
+    r.design_loads.push_back(scene.joint_torques[dl.torque].name);
+    r.shift_deg.push_back(dl.shift * 180 / M_PI);
+  }
+  for (size_t i = 0; i < design.loads.size(); ++i) {
+    std::string same;
+    for (size_t j = 0; j < i; ++j)
+      if (design.loads[j].group == design.loads[i].group) {
+        same = r.design_loads[j];
+        break;
+      }
+    r.same_as.push_back(same);
+  }
+  for (const auto& j : opt.add_torques) r.added_loads.push_back("torque_" + j);
+
+  // Calibration as `rdyn calibrate` does it, every joint torque (the design loads) together.
+  CalibrationOptions copt;
+  copt.cadence_hz = opt.cadence_hz;
+  copt.power_w = opt.power_w;
+  copt.load_field = "optimize.loads";
+  copt.grid_deg = opt.grid_deg;
+  copt.interpolation = opt.interpolation;
+  copt.full_max_s = 0;
+  std::vector<double> x0(design.n, 0.0);
+  for (const auto& g : design.groups)
+    if (!g.fixed_a0) x0[g.offset] = g.a0_start;
+  const models::Scene s0 = shaped_scene(scene, design, x0.data());  // the constant strategy, profiled
+  check_calibratable(s0, copt);
+  r.resistance_coefficient = calc_resistance_coefficient(s0, copt);
+
+  // One extraction; the shape's angle is q itself or the joint-position column of `of`.
+  progress.note("optimize: extracting the reduced table");
+  models::Scene s_extract = s0;
+  if (design.of != scene.independent &&
+      std::find(s_extract.outputs.joints.begin(), s_extract.outputs.joints.end(), design.of) ==
+          s_extract.outputs.joints.end())
+    s_extract.outputs.joints.push_back(design.of);
+  Workspace w;
+  w.design = &design;
+  w.copt = copt;
+  w.interp = reduced::parse_interpolation(opt.interpolation);
+  w.samples = extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
+  w.model = reduced::make_reduced_model(w.samples, with_unit_load(s0, copt), w.interp);
+  w.scene = &scene;
+  w.force = force;
+  w.pnorm = r.objective == "pnorm";
+  w.p = r.p;
+  w.max_evaluations = opt.max_evaluations + 1;
+
+  // The constant strategy: its refusals are the scene's (exit 2), its failure exit 1.
+  {
+    const auto s0u = with_unit_load(s0, copt);
+    Progress silent(false);
+    const auto cal = calibrate_reduced(w.model, s0u, copt, silent);
+    (void)cal;
+  }
+  const Evaluation e0 = evaluate(w, x0.data());
+  if (!e0.ok) throw models::NumericalError("optimize: the constant strategy has no steady cycle holding the cadence");
+  w.objective_scale = e0.objective > 0 ? e0.objective : 1.0;
+  r.max_load = design.groups[0].bound > 0 ? design.groups[0].bound : 5.0 * std::abs(e0.cal.load_value);
+  std::vector<Group> groups = design.groups;
+  for (auto& g : groups)
+    if (!(g.bound > 0)) g.bound = r.max_load;  // the documented default: 5× the constant strategy's value
+  Design bounded = design;
+  bounded.groups = groups;
+  w.design = &bounded;
+  w.last = Evaluation{};
+
+  // COBYLA: derivative-free, handles the sampled inequality constraints directly.
+  progress.note("optimize: searching");
+  const auto t_search = Clock::now();
+  nlopt_opt o = nlopt_create(NLOPT_LN_COBYLA, static_cast<unsigned>(design.n));
+  std::unique_ptr<nlopt_opt_s, decltype(&nlopt_destroy)> guard(o, nlopt_destroy);
+  std::vector<double> lb(design.n, -kCoefficientBound), ub(design.n, kCoefficientBound);
+  for (const auto& g : bounded.groups)
+    if (!g.fixed_a0 && g.nonnegative) lb[g.offset] = 0.0;
+  nlopt_set_lower_bounds(o, lb.data());
+  nlopt_set_upper_bounds(o, ub.data());
+  nlopt_set_min_objective(o, objective_fn, &w);
+  unsigned m = 0;
+  for (const auto& g : bounded.groups) m += (g.nonnegative ? kNonnegativeSamples + 1 : 0) + 1;
+  std::vector<double> ctol(m, 1e-9);
+  nlopt_add_inequality_mconstraint(o, m, constraints_fn, &w, ctol.data());
+  nlopt_set_xtol_rel(o, opt.rel_tolerance);
+  nlopt_set_ftol_rel(o, opt.rel_tolerance);
+  nlopt_set_maxeval(o, opt.max_evaluations);
+  nlopt_set_initial_step1(o, kInitialStep);
+  std::vector<double> x = x0;
+  double fmin = 0.0;
+  w.evaluations = 0;
+  w.progress = &progress;
+  const nlopt_result res = design.n > 0 ? nlopt_optimize(o, x.data(), &fmin) : NLOPT_SUCCESS;
+  r.stop_reason = res == NLOPT_MAXEVAL_REACHED ? "max_evaluations"
+                  : res == NLOPT_XTOL_REACHED  ? "xtol"
+                  : res == NLOPT_FTOL_REACHED  ? "ftol"
+                  : res == NLOPT_ROUNDOFF_LIMITED ? "roundoff"
+                  : res > 0                    ? "converged"
+                                               : fmt::format("nlopt error {}", static_cast<int>(res));
+  r.evaluations = w.evaluations;
+  r.failed_evaluations = w.failures;
+  r.optimise_wall_s = std::chrono::duration<double>(Clock::now() - t_search).count();
+  // COBYLA meets its constraints only to its own tolerance (the bicycle's optimum dipped to
+  // −1.3e-4 of the mean): lift each nonnegative shape to τ ≥ 0 at every angle, then recalibrate.
+  r.nonnegative_repair = repair_nonnegative(bounded, x);
+  // NLopt returns the best feasible point it saw; a search that found nothing better keeps x0.
+  Evaluation best = evaluate(w, x.data());
+  bool feasible = best.ok;
+  for (size_t g = 0; g < bounded.groups.size() && feasible; ++g) {
+    feasible = std::abs(best.cal.load_value) * best.max_tau[g] <= bounded.groups[g].bound * (1 + 1e-6);
+    // τ ≥ 0 at every angle (after the repair: to rounding).
+    if (bounded.groups[g].nonnegative) feasible = feasible && series_minimum(group_series(bounded, g, x.data())) >= -1e-12;
+  }
+  if (!feasible || !(best.objective < e0.objective)) {
+    x = x0;
+    best = e0;
+  }
+
+  // Both strategies: curves over the angle and the full model from their steady points.
+  auto strategy = [&](const std::vector<double>& xs, const Evaluation& e, const std::string& label) {
+    StrategyResult sr;
+    sr.amplitude = std::abs(e.cal.load_value);
+    sr.peak_reduced_N = e.peak;
+    sr.objective_reduced = e.objective;
+    sr.cadence_reduced_hz = e.cal.mean_cadence_hz_reduced;
+    sr.mean_power_w = e.cal.mean_power_w;
+    sr.steady_q = e.cal.steady_q;
+    sr.steady_qdot = e.cal.steady_qdot;
+    models::Scene sx = shaped_scene(scene, bounded, xs.data());
+    for (const auto& dl : bounded.loads) {
+      auto& t = sx.joint_torques[dl.torque];
+      t.value = (scene.joint_torques[dl.torque].value < 0 ? -1.0 : 1.0) * sr.amplitude;
+      sr.a0.push_back(t.profile->a0);
+      sr.a.push_back(t.profile->a);
+      sr.b.push_back(t.profile->b);
+      double mx = 0;
+      for (int i = 0; i < kBoundSamples; ++i)
+        mx = std::max(mx, std::abs(models::calc_joint_torque(t, kTwoPi * i / kBoundSamples)));
+      sr.max_torque_Nm = std::max(sr.max_torque_Nm, mx);
+    }
+    // Each strategy's own coefficient: the one its steady cycle dissipates P with (calibrate_reduced).
+    if (std::isfinite(e.cal.resistance_coefficient)) sx.resistances[0].coefficient = e.cal.resistance_coefficient;
+    sx.initial.q = sr.steady_q;
+    sx.initial.qdot = sr.steady_qdot;
+    // Reduced curves: the shape's model at the calibrated value over one cycle.
+    const auto sxu = with_unit_load(sx, copt);
+    w.samples = reduced::with_profile_columns(std::move(w.samples), sxu);
+    reduced::refit_profile_columns(w.model, w.samples, w.interp);
+    for (auto& t : w.model.torques) t.value = t.value < 0 ? -sr.amplitude : sr.amplitude;
+    const double period = 1.0 / sr.cadence_reduced_hz;
+    reduced::ReducedOptions ro;
+    ro.duration_s = period;
+    ro.output_interval_s = period / 1440;
+    ro.tolerance = 1e-10;
+    const auto cyc = reduced::simulate_reduced(w.model, sr.steady_q, sr.steady_qdot, ro);
+    auto& c = sr.curves;
+    c.torque_Nm.assign(bounded.loads.size(), std::vector<double>(360));
+    for (int a = 0; a < 360; ++a) {
+      const double q = a * M_PI / 180;
+      c.angle_deg.push_back(a);
+      for (size_t l = 0; l < bounded.loads.size(); ++l) {
+        const auto& t = sx.joint_torques[bounded.loads[l].torque];
+        const auto& mt = w.model.torques[bounded.loads[l].torque];
+        const bool on = mt.gate < 0 || reduced::calc_switching(w.model, mt.gate, q, sr.steady_qdot) > 0;
+        // The tau column is τ(θ_of(q)) whichever joint the shape reads.
+        c.torque_Nm[l][a] = on ? t.value * w.model.table.eval(mt.c_tau, q) : 0.0;
+      }
+    }
+    // Force over the angle: the cycle's rows by angle.
+    std::vector<std::pair<double, double>> pts;
+    for (size_t i = 0; i < cyc.t.size(); ++i) pts.push_back({cyc.q[i], cyc.forces[force][i]});
+    c.force_reduced_N = calc_by_angle(std::move(pts));
+    progress.note("optimize: full model, " + label + " strategy");
+    // Mean cadence over whole revolutions after full_skip_s, the force's peak and last revolution.
+    FullConfirmOptions fc;
+    fc.duration_s = opt.full_duration_s;
+    fc.skip_s = opt.full_skip_s;
+    fc.force = force;
+    const FullConfirmation fw = confirm_full(sx, fc);
+    sr.cadence_full_hz = fw.cadence_hz;
+    sr.peak_full_N = fw.peak_force_N;
+    c.force_full_N = fw.force_1deg;
+    return std::make_pair(sr, sx);
+  };
+  auto [c0, scene0] = strategy(x0, e0, "constant");
+  auto [c1, scene1] = strategy(x, best, "optimised");
+  (void)scene0;
+  r.constant = c0;
+  r.optimised = c1;
+  // The optimised scene's coefficient (each strategy dissipates P on its own steady cycle).
+  if (std::isfinite(r.resistance_coefficient)) r.resistance_coefficient = best.cal.resistance_coefficient;
+  scene1.optimize.reset();
+  scene1.description = fmt::format("{} Optimised by rdyn optimize: {} shaped over {} to minimise the peak {} force at {:g} Hz.",
+                                   scene.description.substr(0, 3000), fmt::join(r.design_loads, ", "), design.of,
+                                   r.force_name, opt.cadence_hz);
+  r.optimised_scene = scene1;
+  // The published values beside a calibration (validation.compare) describe the scene's own
+  // strategy, not the optimised one: a validate of the optimised scene must not compare them.
+  r.optimised_scene.validation.compare.clear();
+  r.reduction_reduced = 1 - c1.peak_reduced_N / c0.peak_reduced_N;
+  r.reduction_full = 1 - c1.peak_full_N / c0.peak_full_N;
+  r.agreement = std::abs(c1.peak_full_N - c1.peak_reduced_N) / c1.peak_full_N;
+  auto cadence_ok = [&](double f) { return std::isfinite(f) && std::abs(f - opt.cadence_hz) <= kFullCadenceTolerance * opt.cadence_hz; };
+  r.full_cadence_ok = cadence_ok(c0.cadence_full_hz) && cadence_ok(c1.cadence_full_hz);
+  r.full_better = std::isfinite(c1.peak_full_N) && c1.peak_full_N < c0.peak_full_N;
+  r.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
+}
+
+std::string optimize_failure_message(const OptimizeResult& r) {
+  std::string m;
+  auto reached = fmt::format(
+      "reached: peak {} {:.6g} N (constant) → {:.6g} N (optimised) on the full model, {:.6g} → {:.6g} N reduced; "
+      "full-model cadence {:.6g} Hz (constant), {:.6g} Hz (optimised), target {:g} Hz",
+      r.force_name, r.constant.peak_full_N, r.optimised.peak_full_N, r.constant.peak_reduced_N,
+      r.optimised.peak_reduced_N, r.constant.cadence_full_hz, r.optimised.cadence_full_hz, r.cadence_hz);
+  if (!r.full_cadence_ok)
+    m = fmt::format("optimize not confirmed: the full model misses the cadence by more than 1 % ({})", reached);
+  else if (!r.full_better)
+    m = fmt::format("optimize not confirmed: the optimised strategy is not better on the full model ({})", reached);
+  return m;
+}
+
+}  // namespace rdyn::validate

@@ -1,0 +1,127 @@
+#include "validate/analysis/sweep.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "models/scene_hash.hpp"
+#include "models/scene_yaml.hpp"
+#include "validate/analysis/calibrate.hpp"
+#include "validate/io/escape.hpp"
+#include "validate/io/progress.hpp"
+
+namespace rdyn::validate {
+
+SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
+  if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
+    throw models::SceneError("", 0, "--shard", "expected i/N with 0 ≤ i < N");
+  std::vector<models::Override> fixed;
+  for (const auto& s : opt.sets) fixed.push_back(models::parse_override(s));
+  // The base scene must load (fails early, before any thread starts).
+  const models::Scene base = models::load_scene(opt.scene, fixed);
+  // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
+  CalibrationOptions copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
+  copt.grid_deg = opt.grid_deg;
+  copt.full_max_s = 0.0;  // reduced model only: this is what sweeps are for
+  if (!(copt.cadence_hz > 0))
+    throw models::SceneError(base.source_file, 0, "--cadence-hz",
+                             "give it, or a validation.calibrate block in the scene");
+  check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
+  // Every axis at both ends of its range on the base scene: unknown keys and values out of
+  // range fail here, before any thread starts.
+  for (const auto& a : opt.axes)
+    for (double v : {a.values.front(), a.values.back()}) {
+      std::vector<models::Override> o = fixed;
+      o.push_back({a.key, fmt::format("{:.17g}", v)});
+      models::load_scene(opt.scene, o);
+    }
+
+  for (size_t i = 0; i < opt.axes.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (opt.axes[i].key == opt.axes[j].key)
+        throw models::SceneError("", 0, "--vary " + opt.axes[i].key, "the key is varied twice; give it once");
+  constexpr long kMaxCases = 1000000;
+  long total = 1;
+  for (const auto& a : opt.axes) {
+    total *= static_cast<long>(a.values.size());
+    if (total > kMaxCases)
+      throw models::SceneError("", 0, "--vary", fmt::format("more than {} cases in all", kMaxCases));
+  }
+  const long per = (total + opt.shards - 1) / opt.shards;
+  const long first = std::min(total, per * opt.shard), last = std::min(total, first + per);
+  const long n = last - first;
+
+  std::vector<std::string> rows(n);
+  std::atomic<long> next{0}, done{0}, failed{0};
+  std::mutex progress_mutex;
+  Progress progress(show_progress);
+  const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
+  const std::string value_column = load_value_column(base, copt);
+  auto work = [&] {
+    Progress quiet(false);
+    // The last table this thread extracted, by scene hash: cases that differ only in load
+    // values, resistance coefficients, cadence or power share it (calibrate's extraction and
+    // fit are 3/4 of a case; cases take consecutive indices and the last axis varies fastest).
+    std::optional<std::pair<std::string, CalibrationTable>> last;
+    for (long k; (k = next.fetch_add(1)) < n;) {
+      const long index = first + k;
+      std::vector<models::Override> o = fixed;
+      std::string params;
+      long rest = index;
+      for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
+        const double v = it->values[rest % it->values.size()];
+        rest /= static_cast<long>(it->values.size());
+        o.push_back({it->key, fmt::format("{:.17g}", v)});
+        params = fmt::format(",{:.10g}", v) + params;
+      }
+      std::string row;
+      try {
+        const auto scene = models::load_scene(opt.scene, o);
+        // The scene hash leaves out the loops' branch checks (they only refuse an assembly, which
+        // a reused table would skip): they are part of the key.
+        std::string key = models::scene_hash_hex(models::scene_hash(scene));
+        for (const auto& l : scene.loops)
+          if (l.branch) key += fmt::format("|{}:{}:{}", l.name, l.branch->joint, l.branch->sign);
+        if (!last || last->first != key) {
+          last.reset();  // a failed extraction leaves none
+          last.emplace(key, extract_calibration_table(scene, copt));
+        }
+        const auto r = calibrate(scene, last->second, copt, quiet);
+        // No constraint force requested: an empty field, never NaN.
+        const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
+        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
+                          r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
+      } catch (const std::exception& e) {
+        row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
+        ++failed;
+      }
+      rows[k] = row;
+      const long d = ++done;
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      progress.count("sweep", d, n);
+    }
+  };
+  const int threads = static_cast<int>(std::clamp<long>(
+      opt.threads > 0 ? opt.threads : static_cast<long>(std::thread::hardware_concurrency()), 1, std::max(1L, n)));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+  for (auto& t : pool) t.join();
+
+  std::string csv;
+  if (opt.shard == 0) {
+    csv = "case";
+    for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
+    csv += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n", value_column,
+                       force.empty() ? "constraint" : force);
+  }
+  for (const auto& r : rows) csv += r + "\n";
+  return {csv, n, failed.load()};
+}
+
+}  // namespace rdyn::validate

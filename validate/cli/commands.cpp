@@ -1,0 +1,533 @@
+#include "validate/cli/commands.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <cctype>
+#include <map>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "engine/forward_dynamics.hpp"
+#include "engine/full_model.hpp"
+#include "models/scene_yaml.hpp"
+#include "reduced/joint_outputs.hpp"
+#include "reduced/reduced_model.hpp"
+#include "reduced/simulate_reduced.hpp"
+#include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/calibrate.hpp"
+#include "validate/cli/cli_limits.hpp"
+#include "validate/io/escape.hpp"
+#include "validate/harness/harness.hpp"
+#include "validate/cli/inspect.hpp"
+#include "validate/report/report.hpp"
+#include "validate/harness/summary.hpp"
+#include "validate/analysis/sweep.hpp"
+#include "validate/cli/sweep_axis.hpp"
+#include "validate/io/progress.hpp"
+#include "validate/io/output_dir.hpp"
+#include "validate/harness/peers.hpp"
+#include "validate/report/timeseries_csv.hpp"
+#include "models/mjcf_export.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+std::vector<models::Override> overrides_of(const std::vector<std::string>& sets) {
+  std::vector<models::Override> overrides;
+  for (const auto& s : sets) overrides.push_back(models::parse_override(s));
+  return overrides;
+}
+
+models::Scene load(const std::string& scene, const std::vector<std::string>& sets) {
+  return models::load_scene(scene, overrides_of(sets));
+}
+
+void require_in(const std::string& option, double v, double lo, double hi, const char* unit) {
+  if (!(std::isfinite(v) && v >= lo && v <= hi))
+    throw ArgumentError(fmt::format("{}: must be a finite number in [{:g}, {:g}]{} (got {})", option, lo, hi, unit, v));
+}
+
+void require_positive_up_to(const std::string& option, double v, double hi, const char* unit) {
+  if (!(std::isfinite(v) && v > 0 && v <= hi))
+    throw ArgumentError(fmt::format("{}: must be a finite number in (0, {:g}]{} (got {})", option, hi, unit, v));
+}
+
+void require_grid(const std::string& option, double g) {
+  require_in(option, g, cli_limits::kMinGrid_deg, cli_limits::kMaxGrid_deg, " deg");
+  const double n = 360.0 / g;
+  if (std::abs(n - std::round(n)) > 1e-9 * n)
+    throw ArgumentError(fmt::format("{}: {:g}° does not divide 360° into whole steps", option, g));
+}
+
+// Duration, output interval and the number of rows they make.
+void require_timing(double duration, double dt_out) {
+  require_positive_up_to("--duration", duration, cli_limits::kMaxDuration_s, " s");
+  require_in("--dt-out", dt_out, cli_limits::kMinOutputInterval_s, duration, " s (and at most --duration)");
+  if (duration / dt_out > cli_limits::kMaxOutputRows)
+    throw ArgumentError(fmt::format("--dt-out: {:g} s over {:g} s makes {:.3g} rows; at most {:g}", dt_out, duration,
+                                    duration / dt_out, cli_limits::kMaxOutputRows));
+}
+
+// Recognisers of rdyn's own single-file outputs, so a re-run may replace them.
+bool is_rdyn_table(const std::string& head) { return head.rfind("# rdyn-table", 0) == 0; }
+bool is_rdyn_mjcf(const std::string& head) { return head.rfind("<mujoco model=", 0) == 0; }
+bool is_rdyn_calibrated_scene(const std::string& head) { return head.rfind("# Calibrated by `rdyn calibrate`", 0) == 0; }
+bool is_rdyn_sweep(const std::string& head) {
+  // Shard 0 starts with the header; other shards with a case row "<index>,...,ok|error,".
+  if (head.rfind("case,", 0) == 0) return true;
+  const std::string first = head.substr(0, head.find('\n'));
+  return !first.empty() && std::isdigit(static_cast<unsigned char>(first[0])) &&
+         (first.find(",ok,") != std::string::npos || first.find(",error,") != std::string::npos);
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
+
+}  // namespace
+
+int run_simulate(const SimulateArgs& a) {
+  const models::Scene scene = load(a.scene, a.sets);
+  const double duration = a.duration.value_or(scene.simulation.duration_s);
+  const double dt_out = a.dt_out.value_or(scene.simulation.output_interval_s);
+  const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
+  require_timing(duration, dt_out);
+  // Every number given is checked, also those of the other model: a typo is never ignored.
+  require_in("--tolerance", tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
+  require_in("--reduced-tolerance", a.reduced_tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
+  require_grid("--grid-deg", a.grid_deg);
+  require_in("--fixed-step", a.fixed_step, cli_limits::kMinFixedStep_s, cli_limits::kMaxFixedStep_s, " s");
+  if (a.model == "reduced" && a.reduced_integrator == "rk4-fixed" &&
+      duration / a.fixed_step > cli_limits::kMaxFixedSteps)
+    throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}", a.fixed_step,
+                                    duration, duration / a.fixed_step, cli_limits::kMaxFixedSteps));
+  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+
+  nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
+                        {"duration_s", duration},  {"output_interval_s", dt_out}};
+  {  // The assembled configuration (every joint coordinate at t = 0), with its warnings.
+    const auto assembly = engine::calc_assembly(engine::FullModel(scene));
+    for (const auto& w : assembly.warnings) std::fprintf(stderr, "rdyn: warning: %s\n", w.c_str());
+    run["assembly"] = assembly_json(assembly);
+  }
+  models::TimeSeries ts;
+  if (a.model == "full") {
+    engine::FullModelOptions mo;
+    mo.route = a.route == "reaction" ? engine::ConstraintForceRoute::Reaction : engine::ConstraintForceRoute::Actuator;
+    engine::FullModel model(scene, mo);
+    engine::ForwardOptions opt{duration, dt_out, tolerance, a.integrator};
+    ts = engine::simulate_full(model, opt);
+    run.update({{"tolerance", tolerance},
+                {"integrator", a.integrator},
+                {"constraint_force_route", a.route},
+                {"simbody_bodies", model.num_simbody_bodies()},
+                {"max_loop_gap_m", ts.stats.max_constraint_error}});
+  } else {
+    // Joint outputs: the table and the model carry one constraint line per reaction component.
+    const models::Scene rscene = reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene;
+    reduced::Samples samples;
+    double extraction_ms = 0.0;
+    if (!a.table.empty()) {
+      // Checked before opening: a FIFO without a writer would block (models::non_regular_file_kind).
+      if (const std::string kind = models::non_regular_file_kind(a.table); !kind.empty())
+        throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
+      samples = reduced::read_samples_csv(a.table);
+      run["table"] = a.table;
+    } else {
+      auto e = extract_from_full(rscene, a.grid_deg, reduced::parse_method(a.method));
+      samples = std::move(e.samples);
+      extraction_ms = e.extraction_ms;
+      run.update({{"grid_deg", a.grid_deg}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
+      if (e.range) {  // range table: its span [rad or m] and what ends it
+        run["independent_range"] = {{"min", e.range->min}, {"max", e.range->max}, {"min_edge", e.range->min_edge},
+                                    {"max_edge", e.range->max_edge}};
+        if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
+      }
+    }
+    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
+                                                   a.energy_consistent);
+    reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
+    ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
+    if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(scene, model, ts);
+    // The interpolant the table was built with (a range table's not-a-knot spline stands in for
+    // fourier), not the option's name.
+    run.update({{"interpolation", model.table.fit},
+                {"energy_consistent_m2", a.energy_consistent},
+                {"integrator", a.reduced_integrator},
+                {"tolerance", a.reduced_tolerance},
+                {"extraction_ms", extraction_ms},
+                {"events", ts.stats.events}});
+  }
+  write_timeseries_csv(out.file("timeseries.csv"), ts);
+  const auto eb = energy_balance(ts);
+  run.update({{"steps_taken", ts.stats.steps_taken},
+              {"steps_attempted", ts.stats.steps_attempted},
+              {"smallest_step_s", ts.stats.smallest_step_s},
+              {"wall_time_s", ts.stats.wall_time_s},
+              {"wall_time_per_simulated_s", ts.stats.wall_time_s / duration},
+              {"energy_balance_residual_J", eb.max_residual_J},
+              {"energy_scale_J", eb.energy_scale_J}});
+  write_json(out.file("run.json"), run);
+  out.commit();
+  std::fprintf(stderr, "%s\n",
+               fmt::format("rdyn: {} ({} model) {:.3g} s simulated in {:.3g} s wall, {} steps; energy balance "
+                           "residual {:.3g} J of {:.3g} J; wrote {}/timeseries.csv",
+                           scene.name, a.model, duration, ts.stats.wall_time_s, ts.stats.steps_taken,
+                           eb.max_residual_J, eb.energy_scale_J, a.out)
+                   .c_str());
+  return 0;
+}
+
+int run_extract(const ExtractArgs& a) {
+  require_grid("--grid-deg", a.grid_deg);
+  const models::Scene scene = load(a.scene, a.sets);
+  const auto method = reduced::parse_method(a.method);
+  OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
+  const auto e = extract_from_full(reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene,
+                                   a.grid_deg, method);
+  out.write(reduced::format_samples_csv(e.samples));
+  out.commit();
+  std::string range;  // range tables: the span and, when found, the dead points
+  if (e.range) {
+    const bool rev = e.samples.revolute;
+    const double k = rev ? 180.0 / M_PI : 1.0;
+    const char* unit = rev ? "°" : " m";
+    range = fmt::format("; range [{:.9g}, {:.9g}]{} ({} / {})", e.range->min * k, e.range->max * k, unit,
+                        e.range->min_edge, e.range->max_edge);
+    if (e.dead_min && e.dead_max)
+      range += fmt::format(", dead points at {:.9g}{} and {:.9g}{}", *e.dead_min * k, unit, *e.dead_max * k, unit);
+  }
+  std::fprintf(stderr, "%s\n",
+               fmt::format("rdyn: extracted {} ({}, {}° grid, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
+                           "wrote {}",
+                           scene.name, a.method, a.grid_deg, e.samples.q.size(), range, e.extraction_ms, e.calls,
+                           a.out)
+                   .c_str());
+  return 0;
+}
+
+int run_calibrate(const CalibrateArgs& a) {
+  const auto base = overrides_of(a.sets);
+  if (a.cadence_given) require_positive_up_to("--cadence-hz", a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
+  if (a.power_given) require_positive_up_to("--power-w", a.power_w, cli_limits::kMaxPower_W, " W");
+  require_grid("--grid-deg", a.grid_deg);
+  const std::string text = models::read_scene_text(a.scene);  // once: the scene may be a stream
+  const models::Scene scene = models::parse_scene(text, models::resolve_scene_path(a.scene), base);
+  CalibrationOptions opt = calibration_options_of(scene, a.cadence_given ? a.cadence_hz : 0.0,
+                                                  a.power_given ? a.power_w : 0.0, a.load);
+  if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
+  opt.grid_deg = a.grid_deg;
+  opt.interpolation = a.interpolation;
+  // --write-scene with --force: a full-model miss still writes the scene (marked), then exit 1.
+  opt.keep_unconfirmed = a.force && !a.write_scene.empty();
+  if (!a.write_scene.empty()) check_writable(text, scene, opt);
+  std::unique_ptr<OutputFile> out;  // fails early on an unusable destination
+  if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
+  Progress progress;
+  const auto r = calibrate(scene, opt, progress);
+  auto number_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  const bool joint_torque = std::isfinite(r.torque_Nm);
+  nlohmann::json j = {
+      {"scene", scene.name},
+      {"target_cadence_hz", opt.cadence_hz},
+      {"target_power_w", opt.power_w > 0 ? nlohmann::json(opt.power_w) : nlohmann::json(nullptr)},
+      {"load", r.load},
+      {"load_kind", r.load_kind},
+      {"load_value", r.load_value},
+      {"load_unit", r.load_unit},
+      {"initial_guess", r.initial_guess},
+      {"resistance_coefficient", number_or_null(r.resistance_coefficient)},
+      {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
+      {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
+      {"full_revolutions", r.full_duration_s > 0 ? nlohmann::json(r.full_revolutions) : nlohmann::json(nullptr)},
+      {"full_duration_s", r.full_duration_s > 0 ? nlohmann::json(r.full_duration_s) : nlohmann::json(nullptr)},
+      {"mean_power_w", r.mean_power_w},
+      {"mean_dissipated_power_w", r.mean_dissipated_power_w},
+      {"load_searches", r.load_searches},
+      {"peak_force_N", r.force_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.peak_force_N)},
+      {"peak_force_full_N", r.force_name.empty() ? nlohmann::json(nullptr) : number_or_null(r.peak_force_full_N)},
+      {"force_name", r.force_name},
+      {"speed_fluctuation", r.speed_fluctuation},
+      {"speed_fluctuation_full", number_or_null(r.speed_fluctuation_full)},
+      {"work_per_rev_per_unit", r.work_per_rev_per_unit},
+      {"steady_q", r.steady_q},
+      {"steady_qdot", r.steady_qdot},
+      {"steady_cycles_computed", r.evaluations},
+      {"wall_time_s", r.wall_time_s},
+  };
+  if (joint_torque) {  // the keys of joint-torque calibrations before loads were named (compatibility)
+    j["drive_torque_Nm"] = r.torque_Nm;
+    j["initial_guess_Nm"] = r.initial_guess;
+    j["drive_work_per_rev_per_Nm"] = r.work_per_rev_per_unit;
+  }
+  if (out) {
+    out->write(calibrated_scene_yaml(a.scene, text, base, scene, opt, r));
+    out->commit();
+    j["written_scene"] = a.write_scene;
+  }
+  if (!r.unconfirmed.empty())
+    throw models::NumericalError(r.unconfirmed + "; the scene was written to " + a.write_scene +
+                                 " all the same (--force), marked as not confirmed");
+  std::printf("%s\n", j.dump(2).c_str());
+  return 0;
+}
+
+namespace {
+
+// One scene's validation into `dir`; the scene-level summary entry for a suite.
+nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
+                            Progress& progress, bool& pass) {
+  const ValidationResult v = run_validation(scene, opt, progress);
+  const nlohmann::json full = summary_json(v);
+  render_report(full, dir);
+  pass = v.pass;
+  nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
+                      {"note", v.note}};
+  for (const char* k : {"speedup_at_matched_error", "extraction_ms", "thresholds", "reference", "steady_window",
+                        "headline", "matched_full", "matched_reduced", "recommended_reduced", "verdicts", "baselines",
+                        "duration_s", "per_second_measured"})
+    if (full.contains(k)) j[k] = full[k];
+  j["headline"] = headline(full);
+  if (v.showcase_run >= 0) j["reduced_10deg"] = full["runs"][v.showcase_run];
+  // Stability metrics of both models: the reference's and the default reduced run's energy
+  // balance, drift per cycle, constraint violation, accepted/rejected steps, smallest step.
+  j["stability"] = {{"full", full["reference"]["stability"]},
+                    {"reduced", v.showcase_run >= 0 ? full["runs"][v.showcase_run] : nlohmann::json(nullptr)}};
+  return j;
+}
+
+// One row of the suite index: the scene's verdicts in one cell each.
+std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
+  const std::string status = entry.value("status", std::string("error"));
+  std::string verdicts;
+  if (entry.contains("verdicts"))
+    for (const auto& v : entry["verdicts"]) {
+      const double e = v["judged_error"].is_number() ? v["judged_error"].get<double>() : NAN;
+      const double l = v["limit"].is_number() ? v["limit"].get<double>() : NAN;
+      const bool p = v.value("pass", false);
+      if (!v.value("decides", false)) continue;  // the scene's thresholds only (validate/harness/verdicts.hpp)
+      verdicts += fmt::format("<span class={}>{} {} ≤ {} {}</span><br>", p ? "pass" : "fail",
+                              html_escape(v.value("quantity", std::string())),
+                              std::isfinite(e) ? fmt::format("{:.3g} %", 100 * e) : "n/a", fmt::format("{:.3g} %", 100 * l),
+                              p ? "pass" : "FAIL");
+    }
+  std::string speed = "—";
+  if (entry.contains("baselines"))
+    for (const auto& b : entry["baselines"])
+      if (b.value("what", std::string()) == "matched-error full run" && b["speedup"].is_number())
+        speed = fmt::format("{:.3g}×", b["speedup"].get<double>());
+  const std::string what = entry.contains("error") ? entry.value("error", std::string()) : entry.value("note", std::string());
+  return fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td>"
+                     "<td>{3}</td><td class=l>{4}</td></tr>",
+                     html_escape(stem), html_escape(status), verdicts, html_escape(speed), html_escape(what));
+}
+
+}  // namespace
+
+int run_sweep_command(const SweepArgs& a) {
+  SweepOptions o;
+  o.scene = a.scene;
+  o.sets = a.sets;
+  o.cadence_hz = a.cadence_hz.value_or(0.0);  // SweepOptions: 0 is the scene's
+  o.power_w = a.power_w.value_or(0.0);
+  o.load = a.load;
+  o.threads = a.threads.value_or(0);  // 0: the hardware's threads
+  o.grid_deg = a.grid_deg;
+  require_grid("--grid-deg", a.grid_deg);
+  // A typed value is checked even when it is 0: `--threads 0` meant no default (issue #23).
+  if (a.threads) require_in("--threads", *a.threads, 1, cli_limits::kMaxThreads, "");
+  if (a.cadence_hz) require_positive_up_to("--cadence-hz", *a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
+  if (a.power_w) require_positive_up_to("--power-w", *a.power_w, cli_limits::kMaxPower_W, " W");
+  {
+    int used = 0;
+    if (std::sscanf(a.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 ||
+        used != static_cast<int>(a.shard.size()) || o.shards < 1 || o.shards > 1000000 || o.shard < 0 ||
+        o.shard >= o.shards)
+      throw ArgumentError("--shard: expected i/N with whole numbers 0 ≤ i < N ≤ 1000000, got '" + a.shard + "'");
+  }
+  if (a.vary.empty()) throw ArgumentError("--vary: give at least one key=a:b:n");
+  for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
+  OutputFile out(a.out, a.force, is_rdyn_sweep);  // fails early on an unusable destination
+  const SweepResult r = run_sweep(o, Progress().enabled());
+  out.write(r.csv);
+  out.commit();
+  if (r.failed > 0) {
+    std::fprintf(stderr, "rdyn: sweep shard %s: %ld of %ld cases failed (rows with status 'error' in %s)\n",
+                 a.shard.c_str(), r.failed, r.cases, a.out.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "rdyn: sweep shard %s: %ld cases; wrote %s\n", a.shard.c_str(), r.cases, a.out.c_str());
+  return 0;
+}
+
+namespace {
+
+// A suite scene's file stem names its report folder: it must be a plain name (no '/', no
+// leading dot, no characters that need quoting in HTML or a shell) and unique in the suite.
+constexpr size_t kMaxSuiteScenes = 1000;
+
+bool plain_name(const std::string& s) {
+  if (s.empty() || s.size() > 64) return false;
+  if (!(std::isalnum(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) return false;
+  return true;
+}
+
+std::vector<std::string> suite_files(const std::string& suite) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(suite, ec)) throw models::SceneError(suite, 0, "--suite", "not a folder of scenes");
+  std::vector<std::string> files;
+  for (auto it = fs::directory_iterator(suite, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const auto ext = it->path().extension();
+    if (ext != ".yaml" && ext != ".yml") continue;
+    std::error_code fe;
+    if (!it->is_regular_file(fe))  // a dangling link, a FIFO, a device or a folder named *.yaml
+      throw models::SceneError(it->path().string(), 0, "--suite", "not a readable scene file (a link to nothing, a FIFO, a "
+                                                                  "device or a folder); remove it or rename it");
+    files.push_back(it->path().string());
+    if (files.size() > kMaxSuiteScenes)
+      throw models::SceneError(suite, 0, "--suite", fmt::format("more than {} scenes", kMaxSuiteScenes));
+  }
+  if (ec) throw models::SceneError(suite, 0, "--suite", "cannot list the folder: " + ec.message());
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw models::SceneError(suite, 0, "--suite", "the folder has no .yaml scenes");
+  std::map<std::string, std::string> seen;
+  for (const auto& f : files) {
+    const std::string stem = fs::path(f).stem().string();
+    if (!plain_name(stem))
+      throw models::SceneError(f, 0, "--suite",
+                               "the file name must be a plain name (letters, digits, '_', '-', '.'; not starting with "
+                               "'.' or '-'; at most 64 characters): it names the scene's report folder");
+    if (stem == "summary.json" || stem == "index.html")
+      throw models::SceneError(f, 0, "--suite", "the name '" + stem + "' is the suite's own output file; rename the scene");
+    if (seen.count(stem))
+      throw models::SceneError(f, 0, "--suite", "has the same name as " + seen[stem] + " (both would write " + stem + "/)");
+    seen[stem] = f;
+  }
+  return files;
+}
+
+int run_suite(const ValidateArgs& a, Progress& progress) {
+  namespace fs = std::filesystem;
+  const auto files = suite_files(a.suite);
+  const auto overrides = overrides_of(a.sets);  // a malformed --set is the user's error (exit 2), not a scene's
+  OutputDir out(a.out, a.force);
+  ValidationOptions opt;
+  opt.quick = !a.thorough;
+  opt.peers = a.peers;
+  nlohmann::json scenes = nlohmann::json::array();
+  bool all_pass = true;
+  std::string rows;
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string stem = fs::path(files[i]).stem().string();
+    progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
+    nlohmann::json entry;
+    try {
+      const auto scene = models::load_scene(files[i], overrides);
+      out.make_subfolder(stem);
+      bool pass = false;
+      entry = validate_one(scene, opt, out.file(stem), progress, pass);
+      all_pass &= pass;
+    } catch (const OutputError&) {
+      throw;  // the output itself failed: nothing is written
+    } catch (const std::exception& e) {  // a failing scene does not stop the others
+      entry = {{"name", stem}, {"file", files[i]}, {"status", "error"}, {"error", e.what()}};
+      all_pass = false;
+    }
+    entry["report"] = stem + "/report.html";
+    rows += suite_row(stem, entry);
+    scenes.push_back(entry);
+  }
+  write_json(out.file("summary.json"),
+             {{"suite", a.suite}, {"status", all_pass ? "pass" : "fail"}, {"scenes", scenes}});
+  write_text_file(out.file("index.html"),
+                  "<!DOCTYPE html><html><head><meta charset='utf-8'><title>rdyn suite</title><style>body{font-family:"
+                  "sans-serif;max-width:1000px;margin:2em auto}td,th{border:1px solid #ccc;padding:3px 6px}table{"
+                  "border-collapse:collapse}.pass{color:#070}.fail,.error{color:#a00}</style></head><body><h1>rdyn "
+                  "validation suite: " + html_escape(a.suite) + "</h1><table><tr><th>scene</th><th>status</th>"
+                  "<th>verdicts (error, limit)</th><th>speed vs matched full run</th><th>what it tests / error</th></tr>" +
+                  rows + "</table></body></html>\n");
+  out.commit();
+  std::fprintf(stderr, "rdyn: suite %s: %s; wrote %s/index.html\n", a.suite.c_str(),
+               all_pass ? "all scenes pass" : "FAILURES", a.out.c_str());
+  return all_pass ? 0 : 1;
+}
+
+}  // namespace
+
+// Largest summary.json `rdyn report` reads (the bicycle's full ladder writes ~0.7 MB).
+constexpr std::uintmax_t kMaxSummaryBytes = 64u << 20;
+
+int run_report(const ReportArgs& a) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (const std::string kind = models::non_regular_file_kind(a.summary); !kind.empty())  // before opening
+    throw ArgumentError(a.summary + ": not a regular file (" + kind + "): give the summary.json of `rdyn validate`");
+  if (!fs::is_regular_file(a.summary, ec))
+    throw ArgumentError(a.summary + ": not a readable file (give the summary.json of `rdyn validate`)");
+  const auto size = fs::file_size(a.summary, ec);
+  if (ec || size > kMaxSummaryBytes)
+    throw ArgumentError(fmt::format("{}: larger than {} MB, not a summary of `rdyn validate`", a.summary,
+                                    kMaxSummaryBytes >> 20));
+  std::ifstream in(a.summary, std::ios::binary);
+  nlohmann::json summary;
+  try {
+    summary = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ArgumentError(fmt::format("{}: not valid JSON ({})", a.summary, e.what()));
+  }
+  if (!summary.is_object() || !summary.contains("scene") || !summary.contains("runs"))
+    throw ArgumentError(a.summary + ": not a summary of `rdyn validate` (no 'scene' and 'runs')");
+  OutputDir out(a.out, a.force);
+  try {
+    render_report(summary, out.file(""));
+  } catch (const nlohmann::json::exception& e) {
+    // A hand-edited summary: a key missing or of the wrong type.
+    throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
+  }
+  out.commit();
+  std::fprintf(stderr, "rdyn: re-rendered %s into %s/report.html\n", a.summary.c_str(), a.out.c_str());
+  return 0;
+}
+
+int run_validate(const ValidateArgs& a) {
+  if (!a.suite.empty() && !a.scene.empty()) throw ArgumentError("give a scene or --suite, not both");
+  if (a.suite.empty() && a.scene.empty()) throw ArgumentError("give a scene or --suite FOLDER");
+  if (a.quick && a.thorough) throw ArgumentError("--quick and --thorough: give one of them");
+  check_peers(a.peers);  // before any work: a peer this build cannot run is exit 2
+  Progress progress;
+  if (!a.suite.empty()) return run_suite(a, progress);
+  const auto scene = load(a.scene, a.sets);
+  OutputDir out(a.out, a.force);
+  ValidationOptions opt;
+  opt.quick = a.quick;
+  opt.peers = a.peers;
+  const ValidationResult v = run_validation(scene, opt, progress);
+  const nlohmann::json summary = summary_json(v);
+  render_report(summary, out.file(""));
+  out.commit();
+  std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
+  if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
+  return v.pass ? 0 : 1;
+}
+
+int run_export_mjcf(const ExportMjcfArgs& a) {
+  require_in("--timestep", a.timestep_s, cli_limits::kMinFixedStep_s, cli_limits::kMaxFixedStep_s, " s");
+  const models::Scene scene = load(a.scene, a.sets);
+  OutputFile out(a.out, a.force, is_rdyn_mjcf);  // fails early on an unusable destination
+  models::MjcfOptions opt;
+  opt.reference_q = calc_initial_joint_state(scene).q;  // loops closed where MJCF infers its anchors
+  opt.fold_geared_bodies = a.fold;
+  opt.timestep_s = a.timestep_s;
+  opt.integrator = a.integrator;
+  out.write(models::export_mjcf(scene, opt));
+  out.commit();
+  return 0;
+}
+
+}  // namespace rdyn::validate

@@ -1,0 +1,110 @@
+// The rdyn subcommands. Each returns the process exit status; errors are thrown and
+// mapped to statuses by main (2 for bad input).
+#pragma once
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "validate/io/argument_error.hpp"
+
+namespace rdyn::validate {
+
+struct SimulateArgs {
+  std::string scene;
+  std::string model = "full";  // full | reduced
+  std::optional<double> duration;   // empty: the scene's
+  std::optional<double> dt_out;
+  std::optional<double> tolerance;  // full-model integrator accuracy
+  std::string integrator = "rkmerson";
+  std::string route = "actuator";
+  std::vector<std::string> sets;
+  std::string out;
+  bool force = false;  // write into a folder that holds files rdyn did not write
+  // reduced model
+  std::string table;  // CSV from `rdyn extract`; empty: extract now
+  double grid_deg = 10.0;
+  std::string method = "kinetostatic";
+  std::string interpolation = "fourier";  // measured more accurate than cubic (docs/theory.md)
+  bool energy_consistent = false;
+  std::string reduced_integrator = "rk8pd";
+  double reduced_tolerance = 1e-8;  // measured: integration error ≪ interpolation error at 10° (docs/theory.md)
+  double fixed_step = 1e-3;
+};
+int run_simulate(const SimulateArgs& args);
+
+struct ExtractArgs {
+  std::string scene;
+  double grid_deg = 10.0;
+  std::string method = "kinetostatic";
+  std::vector<std::string> sets;
+  std::string out;  // FILE.csv
+  bool force = false;  // replace a file rdyn did not write
+};
+int run_extract(const ExtractArgs& args);
+
+struct CalibrateArgs {
+  std::string scene;
+  // Given on the command line, else the scene's validation.calibrate, else 1 Hz / no power
+  // (mean-speed mode: the resistances stay as given).
+  double cadence_hz = 1.0;
+  double power_w = 0.0;
+  bool cadence_given = false, power_given = false;
+  std::string load;  // --load: a joint_torque or motor; empty: validation.calibrate.load, else every joint torque
+  std::vector<std::string> sets;
+  std::string write_scene;  // optional output YAML
+  bool force = false;
+  double grid_deg = 10.0;
+  std::string interpolation = "fourier";
+};
+int run_calibrate(const CalibrateArgs& args);
+
+struct ValidateArgs {
+  std::string scene;  // or suite
+  std::string suite;  // folder of scenes
+  std::string out;
+  std::vector<std::string> sets;
+  bool quick = false;     // short ladders (default for --suite)
+  bool thorough = false;  // full ladders even for --suite
+  bool force = false;
+  std::vector<std::string> peers;  // peer engines beside the full model (validate/harness/peers.hpp)
+};
+int run_validate(const ValidateArgs& args);
+
+// Re-renders a report from a summary.json written by `rdyn validate`.
+struct ReportArgs {
+  std::string summary;  // path of summary.json
+  std::string out;      // output folder
+  bool force = false;
+};
+int run_report(const ReportArgs& args);
+
+struct SweepArgs {
+  std::string scene;
+  std::vector<std::string> vary;
+  std::vector<std::string> sets;
+  std::string out;
+  std::string shard = "0/1";
+  std::optional<int> threads;                  // none: the hardware's threads
+  std::optional<double> cadence_hz, power_w;   // none: the scene's validation.calibrate
+  std::string load;  // --load, as for calibrate
+  double grid_deg = 10.0;
+  bool force = false;
+};
+int run_sweep_command(const SweepArgs& args);
+
+// `rdyn export-mjcf`: the scene as MJCF (MuJoCo XML), its loops closed at the assembled initial
+// configuration (models/mjcf_export.hpp).
+struct ExportMjcfArgs {
+  std::string scene;
+  std::vector<std::string> sets;
+  std::string out = "/dev/stdout";
+  bool force = false;
+  bool fold = false;             // fold geared bodies into their drivers
+  double timestep_s = 1e-3;      // <option timestep>
+  std::string integrator = "Euler";
+};
+int run_export_mjcf(const ExportMjcfArgs& args);
+
+}  // namespace rdyn::validate

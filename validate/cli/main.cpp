@@ -1,0 +1,309 @@
+// rdyn command-line interface. Exit status (README, "Exit status"): 0 success; 1 a numerical
+// failure (an integrator that cannot go on, an energy balance that does not close, a
+// calibration or validation that misses its target); 2 bad input (scene, arguments, table,
+// output destination, a mechanism that cannot assemble), with the file, line and field.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "engine/full_model.hpp"
+#include "models/scene.hpp"
+#include "reduced/samples.hpp"
+#include "validate/cli/cli_options.hpp"
+#include "validate/cli/commands.hpp"
+#include "validate/cli/expand.hpp"
+#include "validate/cli/inspect.hpp"
+#include "validate/cli/drive_command.hpp"
+#include "validate/cli/optimize_command.hpp"
+#include "validate/io/output_dir.hpp"
+#include "validate/harness/peers.hpp"
+
+namespace {
+constexpr int kExitBadInput = 2;
+constexpr int kExitNumerical = 1;
+}
+
+int main(int argc, char** argv) {
+  using namespace rdyn::validate;
+  CLI::App app{
+      "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
+      "full multibody model (Simbody).\n"
+      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
+  app.require_subcommand(1);
+
+  SimulateArgs sim;
+  auto* simulate = app.add_subcommand(
+      "simulate",
+      "Simulate a scene with the full model (Simbody forward dynamics) or the reduced model, and write "
+      "DIR/timeseries.csv (t,q,qdot,qddot,energy,work,F_<name>...) and DIR/run.json (settings, cost, "
+      "energy-balance residual).");
+  simulate->add_option("scene", sim.scene, "Scene name or YAML file")->required();
+  simulate->add_option("--model", sim.model, "full (Simbody) or reduced (tables + Eksergian's equation)")
+      ->check(CLI::IsMember({"full", "reduced"}));
+  double duration = 0, dt_out = 0, tolerance = 0;  // copied into `sim` when given
+  auto* duration_opt = simulate->add_option("--duration", duration, "Simulated time [s] (default: the scene's)");
+  auto* dt_out_opt = simulate->add_option("--dt-out", dt_out, "Output interval [s] (default: the scene's)");
+  simulate->add_option("--set", sim.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  simulate->add_option("--out", sim.out, "Output folder (written atomically)")->required();
+  simulate->add_flag("--force", sim.force, kForceHelpDir);
+  auto* full = simulate->add_option_group("full model");
+  auto* tolerance_opt = full->add_option("--tolerance", tolerance, "Integrator accuracy (default: the scene's)");
+  full->add_option("--integrator", sim.integrator, "rkmerson, rk3 or cpodes")
+      ->check(CLI::IsMember({"rkmerson", "rk3", "cpodes"}));
+  full->add_option("--constraint-force-route", sim.route,
+                   "actuator (pin + prescribed slider, the paper's constraint actuator) or reaction "
+                   "(Simbody's joint reaction projected on the direction)")
+      ->check(CLI::IsMember({"actuator", "reaction"}));
+  auto* red = simulate->add_option_group("reduced model");
+  red->add_option("--table", sim.table, "Reduced table from `rdyn extract` (default: extract now)");
+  red->add_option("--grid-deg", sim.grid_deg, "Grid step when extracting [deg] (default 10, as the paper)");
+  red->add_option("--method", sim.method, "Extraction method")
+      ->check(CLI::IsMember({"kinetostatic", "paper-sweep", "integrated", "direct"}));
+  red->add_option("--interp", sim.interpolation,
+                  "Interpolation: cubic (periodic spline), akima, linear, or fourier (trigonometric, periodic only)")
+      ->check(CLI::IsMember({"cubic", "akima", "linear", "fourier"}));
+  red->add_flag("--energy-consistent", sim.energy_consistent, "Use m2 = ½ dm1/dq of the m1 interpolant");
+  red->add_option("--reduced-integrator", sim.reduced_integrator, "rk8pd, rkf45, rkck (adaptive) or rk4-fixed")
+      ->check(CLI::IsMember({"rk8pd", "rkf45", "rkck", "rk4-fixed"}));
+  red->add_option("--reduced-tolerance", sim.reduced_tolerance, "Adaptive integrator tolerance (default 1e-8)");
+  red->add_option("--fixed-step", sim.fixed_step, "rk4-fixed step [s] (default 1e-3)");
+
+  ExtractArgs ext;
+  auto* extract = app.add_subcommand(
+      "extract",
+      "Extract the reduced parameters of a scene from kinetostatic calls of the full model and write a portable "
+      "table: q_deg,m1,m2,me1_<f>,me2_<f>,Q_cons,V,Qx_cons_<f>,r_<joint>...,rx_<f>_<joint>...,w_<body>...");
+  extract->add_option("scene", ext.scene, "Scene name or YAML file")->required();
+  extract->add_option("--grid-deg", ext.grid_deg,
+                      "Grid step [deg]; must divide 360 (default 10). Range tables: intervals of at most this "
+                      "over a revolute range, 360/step intervals over a prismatic one");
+  extract->add_option("--method", ext.method, "kinetostatic, paper-sweep, integrated or direct")
+      ->check(CLI::IsMember({"kinetostatic", "paper-sweep", "integrated", "direct"}));
+  extract->add_option("--set", ext.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  extract->add_option("--out", ext.out, "Output CSV file")->required();
+  extract->add_flag("--force", ext.force, kForceHelpFile);
+
+  CalibrateArgs cal;
+  auto* calibrate = app.add_subcommand(
+      "calibrate",
+      "Find (GSL Brent) the value of a drive load -- a joint torque or force, or a motor's stall torque with its "
+      "no-load speed kept (--load), or every joint torque together -- that holds the mean steady rate of the "
+      "independent coordinate at F rev/s with the reduced model, confirmed with the full model. With --power-w "
+      "the scene's one resistance is set too, so that the steady cycle dissipates P watts on average at F; "
+      "without, the resistances stay as given. "
+      "Prints JSON on standard output (load, load_kind, load_value, load_unit, drive_torque_Nm for joint torques, "
+      "mean_cadence_hz_reduced, mean_cadence_hz_full, mean_power_w, mean_dissipated_power_w, load_searches, "
+      "force_name and its peak_force_N, "
+      "speed_fluctuation, ...); progress goes to standard error.");
+  calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
+  add_operating_point_options(*calibrate, cal.cadence_hz, cal.cadence_given, cal.power_w, cal.power_given);
+  // An empty --load would silently mean "no load named" (every joint torque): refuse it.
+  const CLI::Validator names_a_load(
+      [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
+  calibrate->add_option("--load", cal.load,
+                        "The joint_torque, point_force or motor to adjust, or joint torques or point forces joined "
+                        "by + (default: the scene's validation.calibrate.load, else every joint torque together)")
+      ->check(names_a_load);
+  calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
+  calibrate->add_flag("--force", cal.force, kForceHelpFile);
+  add_scene_overrides(*calibrate, cal.sets);
+  add_reduced_table_options(*calibrate, cal.grid_deg, cal.interpolation);
+
+  ValidateArgs val;
+  auto* validate = app.add_subcommand(
+      "validate",
+      "Validate the reduced model against full forward dynamics: a converged reference, a ladder of full-model "
+      "tolerances and of reduced models (grid × interpolation × integrator; fixed steps from the scene's time "
+      "scale), errors over the steady cycles (the whole run when it has none), median timings of repeats up to a "
+      "minimum wall time, the matched-error speedup, calibration when the scene declares an operating point. Writes "
+      "DIR/summary.json (every number and the data of every figure), the CSVs and gnuplot scripts behind every "
+      "figure, and DIR/report.html (rendered from summary.json; verdicts first). With --suite, every scene of a "
+      "folder and an index with their verdicts (exit status 1 if any fails its thresholds).");
+  validate->add_option("scene", val.scene, "Scene name or YAML file");
+  validate->add_option("--suite", val.suite, "Folder of scenes to validate (each may declare thresholds)");
+  validate->add_option("--out", val.out, "Output folder (written atomically)")->required();
+  validate->add_flag("--force", val.force, kForceHelpDir);
+  validate->add_option("--set", val.sets, "Override a scalar of the scene(s): key.path=value (repeatable)");
+  validate->add_flag("--quick", val.quick, "Short ladders and single repeats (default for --suite)");
+  validate->add_flag("--thorough", val.thorough, "Full ladders for --suite too");
+  validate->add_option("--peers", val.peers,
+                       "Peer engines to run beside the full model: mujoco (MuJoCo's Euler and RK4 at fixed steps from "
+                       "the scene's time scale, in summary.json's peers and the accuracy-against-cost figure; needs "
+                       "rdyn built with MuJoCo)")
+      ->check(CLI::IsMember(kPeers));
+
+  ReportArgs rep;
+  auto* report = app.add_subcommand(
+      "report",
+      "Re-render a validation report from its summary.json alone (e.g. after editing a gnuplot style or moving "
+      "the folder): writes DIR/report.html, the figures' data, scripts and SVGs, and a copy of the summary.");
+  report->add_option("summary", rep.summary, "summary.json written by `rdyn validate`")->required();
+  report->add_option("--out", rep.out, "Output folder (written atomically)")->required();
+  report->add_flag("--force", rep.force, kForceHelpDir);
+
+  SweepArgs sw;
+  auto* sweep = app.add_subcommand(
+      "sweep",
+      "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
+      "One CSV row per case: the varied parameters, the calibrated drive load, the peak of the first constraint "
+      "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
+      "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
+  sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
+  sweep->add_option("--vary", sw.vary, "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)")
+      ->required();
+  sweep->add_option("--set", sw.sets, "Fixed override key.path=value (repeatable)");
+  sweep->add_option("--out", sw.out, "Output CSV file")->required();
+  sweep->add_flag("--force", sw.force, kForceHelpFile);
+  sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
+  // Typed values are kept apart from the defaults, so a typed 0 is refused instead of meaning "default".
+  sweep->add_option_function<int>("--threads", [&sw](const int& v) { sw.threads = v; },
+                                  "Worker threads, 1..256 (default: hardware threads)");
+  sweep->add_option_function<double>("--cadence-hz", [&sw](const double& v) { sw.cadence_hz = v; },
+                                     "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
+  sweep->add_option_function<double>(
+      "--power-w", [&sw](const double& v) { sw.power_w = v; },
+      "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as given)");
+  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load);
+  sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+
+  InspectArgs ins;
+  auto* inspect = app.add_subcommand(
+      "inspect",
+      "Assemble a scene and print, as JSON on standard output, what a newcomer needs while writing it: every "
+      "joint coordinate and body pose at t = 0 (degrees and metres), the degrees of freedom (rank of the "
+      "constraint Jacobian), each loop's closure gap, the range of the independent coordinate (full turn or its "
+      "dead points, found by continuation) and warnings (also on standard error).");
+  inspect->add_option("scene", ins.scene, "Scene name or YAML file")->required();
+  inspect->add_option("--set", ins.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  ExportMjcfArgs mj;
+  auto* export_mjcf = app.add_subcommand(
+      "export-mjcf",
+      "Write the scene as MJCF (MuJoCo XML): bodies, hinges and slides, loops as connect equalities and gears as "
+      "joint equalities, written at the assembled initial configuration; a comment lists the loads MJCF cannot "
+      "express (rdyn's MuJoCo runner applies them at every step).");
+  export_mjcf->add_option("scene", mj.scene, "Scene name or YAML file")->required();
+  export_mjcf->add_option("--out", mj.out, "Output XML file (default: standard output)");
+  export_mjcf->add_flag("--force", mj.force, kForceHelpFile);
+  export_mjcf->add_option("--set", mj.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  export_mjcf->add_flag("--fold", mj.fold, "Fold geared bodies into their drivers (as the full model does)");
+  export_mjcf->add_option("--timestep", mj.timestep_s, "<option timestep> [s] (default 1e-3)");
+  export_mjcf->add_option("--integrator", mj.integrator, "<option integrator>: Euler or RK4")
+      ->check(CLI::IsMember({"Euler", "RK4"}));
+
+  OptimizeArgs opz;
+  auto* optimize = app.add_subcommand(
+      "optimize",
+      "Find the shape of drive loads (truncated Fourier series of a joint angle, the scene's `optimize` block) that "
+      "minimises the peak (or p-norm) of a constraint force over the reduced steady cycle, the amplitude calibrated "
+      "per shape to hold the mean cadence (with --power-w: the resistance dissipating P at F); NLopt COBYLA; both the "
+      "constant strategy and the optimum confirmed with the full model. Writes DIR/summary.json, profile.csv, "
+      "report.html.");
+  optimize->add_option("scene", opz.scene, "Scene name or YAML file")->required();
+  add_operating_point_options(*optimize, opz.cadence_hz, opz.cadence_given, opz.power_w, opz.power_given);
+  optimize->add_option("--harmonics", opz.harmonics, "Harmonics H of each shape, 1..12 (default: the scene's, else 3)");
+  optimize->add_option("--objective", opz.objective, "peak (default) or pnorm: (mean |F|^p)^(1/p) over the cycle")
+      ->check(CLI::IsMember({"peak", "pnorm"}));
+  optimize->add_option("--p", opz.p, "Exponent of pnorm, 2..64 (default 8)");
+  optimize->add_option("--max-load", opz.max_load,
+                       "Bound on |value·τ(θ)| of the scene's design loads [N·m or N] (default: the scene's optimize.max_load, "
+                       "else 5× the constant strategy's value; loads added by --add-torque take --add-torque-max)");
+  auto* opz_force_name = optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
+  optimize->add_option("--add-torque", opz.add_torques,
+                       "Add a profiled torque torque_<JOINT> on a revolute joint as a further design load (signed "
+                       "shape; repeatable)");
+  optimize->add_option("--add-torque-max", opz.add_torque_max, "Bound on |torque_<JOINT>| [N·m] (default 50)");
+  optimize->add_option("--max-evaluations", opz.max_evaluations, "Optimiser evaluations, 1..100000 (default 400)");
+  optimize->add_option("--rel-tolerance", opz.rel_tolerance, "Optimiser relative tolerance (default 1e-4)");
+  add_reduced_table_options(*optimize, opz.grid_deg, opz.interpolation);
+  optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
+  add_scene_overrides(*optimize, opz.sets);
+  add_output_folder(*optimize, opz.out, opz.force);
+  DriveArgs drv;
+  auto* drive = app.add_subcommand(
+      "drive",
+      "Prescribed motion: the independent coordinate follows a constant rate (--cadence-hz) or a profile q(t) "
+      "(--profile t,q_deg or t,q_m CSV, natural cubic spline) with every other load of the scene applied, and each "
+      "model says what the drive must supply. Writes DIR/timeseries.csv (t,q,qdot,qddot,drive_Nm or drive_N, "
+      "drive_W, F_<name>...) and DIR/run.json (drive RMS, peak, mean, mean and peak power, constraint-force peaks).");
+  drive->add_option("scene", drv.scene, "Scene name or YAML file")->required();
+  double drive_cadence = 0, drive_duration = 0, drive_dt = 0;
+  auto* drive_cadence_opt =
+      drive->add_option("--cadence-hz", drive_cadence, "Constant rate [rev/s] of a revolute coordinate (sign: direction)");
+  drive->add_option("--profile", drv.profile, "CSV of t,q_deg (revolute) or t,q_m (prismatic) to follow");
+  drive->add_option("--model", drv.model, "full (Simbody inverse dynamics, default) or reduced")
+      ->check(CLI::IsMember({"full", "reduced"}));
+  auto* drive_duration_opt =
+      drive->add_option("--duration", drive_duration, "Time [s] (default: one revolution, or the profile's span)");
+  auto* drive_dt_opt = drive->add_option("--dt-out", drive_dt, "Output interval [s] (default: the scene's)");
+  add_reduced_table_options(*drive, drv.grid_deg, drv.interpolation);
+  add_scene_overrides(*drive, drv.sets);
+  add_output_folder(*drive, drv.out, drv.force);
+  ExpandArgs exp;
+  auto* expand = app.add_subcommand(
+      "expand",
+      "Write the scene as rdyn reads it -- generators (bicycle_leg) expanded into bodies and joints, --set "
+      "overrides applied, named points as coordinates, every default explicit, angles in radians -- as YAML that "
+      "every command loads as the same scene (checked before writing: the text is read back and must give the "
+      "same scene). Comments of the original are not kept.");
+  expand->add_option("scene", exp.scene, "Scene name or YAML file")->required();
+  expand->add_option("--set", exp.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  expand->add_option("--out", exp.out, "Output YAML file (default: standard output)");
+  expand->add_flag("--force", exp.force, kForceHelpFile);
+
+  require_decimal_numbers(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+
+  if (duration_opt->count()) sim.duration = duration;
+  if (dt_out_opt->count()) sim.dt_out = dt_out;
+  opz.force_name_given = opz_force_name->count() > 0;
+  if (tolerance_opt->count()) sim.tolerance = tolerance;
+  if (drive_cadence_opt->count()) drv.cadence_hz = drive_cadence;
+  if (drive_duration_opt->count()) drv.duration = drive_duration;
+  if (drive_dt_opt->count()) drv.dt_out = drive_dt;
+  try {
+    if (*simulate) return run_simulate(sim);
+    if (*extract) return run_extract(ext);
+    if (*calibrate) return run_calibrate(cal);
+    if (*validate) return run_validate(val);
+    if (*sweep) return run_sweep_command(sw);
+    if (*report) return run_report(rep);
+    if (*inspect) return run_inspect(ins);
+    if (*export_mjcf) return run_export_mjcf(mj);
+    if (*optimize) return run_optimize(opz);
+    if (*drive) return run_drive(drv);
+    if (*expand) return run_expand(exp);
+  } catch (const rdyn::models::SceneError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const rdyn::engine::EngineError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const rdyn::reduced::TableError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const ArgumentError& e) {
+    std::fprintf(stderr, "rdyn: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const rdyn::models::NumericalError& e) {
+    std::fprintf(stderr, "rdyn: numerical failure: %s\n", e.what());
+    return kExitNumerical;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "rdyn: numerical failure: out of memory\n");
+    return kExitNumerical;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rdyn: internal error: %s\n", e.what());
+    return kExitNumerical;
+  }
+  return 0;
+}

@@ -1,0 +1,485 @@
+#include "validate/harness/harness.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "engine/forward_dynamics.hpp"
+#include "engine/independent_range.hpp"
+#include "reduced/reduced_model.hpp"
+#include "reduced/simulate_reduced.hpp"
+#include "validate/analysis/build_reduced.hpp"
+#include "validate/harness/ladder_plan.hpp"
+#include "validate/harness/pareto.hpp"
+#include "validate/harness/peers.hpp"
+#include "validate/harness/thresholds.hpp"
+#include "validate/harness/timing.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Fewest steady revolutions over which a cycling run's errors are claimed: one revolution
+// cannot show that the cycle repeats (detect_steady_window compares consecutive means).
+constexpr int kMinSteadyRevolutions = 2;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void fill_stats(RunRecord& r, const models::TimeSeries& ts) {
+  r.cycles = std::abs(ts.q.back() - ts.q.front()) / (2 * M_PI);
+  const double end_residual = std::abs(ts.energy.back() - ts.energy.front() - ts.work.back());
+  r.energy_drift_per_cycle_J = r.cycles >= 1 ? end_residual / r.cycles : end_residual;
+  r.steps = ts.stats.steps_taken;
+  r.rejected = std::max(0L, ts.stats.steps_attempted - ts.stats.steps_taken);
+  r.smallest_step_s = ts.stats.smallest_step_s;
+  r.constraint_violation_m = ts.stats.max_constraint_error;
+  r.events = ts.stats.events;
+}
+
+// |E − E0 − W| relative to the energy scale (models::energy_balance: one implementation).
+double energy_residual_rel(const models::TimeSeries& ts) {
+  const auto b = models::energy_balance(ts);
+  return b.energy_scale_J > 0 ? b.max_residual_J / b.energy_scale_J : b.max_residual_J;
+}
+
+// A ladder run that stopped (a budget, an energy balance that does not close, divergence,
+// the validity domain) is recorded with its reason instead of ending the validation.
+void record_stopped(RunRecord& r, const std::string& why, ValidationResult& v) {
+  mark_stopped(r, why, v.quantities);
+  v.runs.push_back(r);
+}
+
+std::string machine_description() {
+  std::string cpu = "unknown CPU";
+  std::ifstream f("/proc/cpuinfo");
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  std::string os;
+  std::ifstream r("/etc/os-release");
+  for (std::string line; std::getline(r, line);)
+    if (line.rfind("PRETTY_NAME=", 0) == 0) os = line.substr(13, line.size() - 14);
+  return fmt::format("{}, {} hardware threads{}", cpu, std::thread::hardware_concurrency(),
+                     os.empty() ? "" : ", " + os);
+}
+
+}  // namespace
+
+void finish_run(RunRecord& r, const std::vector<double>& walls, const models::TimeSeries& ts,
+                const ValidationResult& v) {
+  r.repeats = static_cast<int>(walls.size());
+  r.wall_s = median(walls);
+  r.per_simulated_s = r.wall_s / v.duration_s;
+  fill_stats(r, ts);
+  r.energy_residual_rel = energy_residual_rel(ts);
+  r.errors = compare_series(v.reference, ts, v.window.t_start);
+}
+
+void mark_stopped(RunRecord& r, const std::string& why, const std::vector<std::string>& quantities) {
+  r.failure = why;
+  for (const auto& q : quantities) r.errors.signals.push_back({q, 0.0, INFINITY, INFINITY});
+  r.repeats = 0;
+  r.wall_s = r.per_simulated_s = INFINITY;
+}
+
+double RunRecord::error_of(const std::string& q) const {
+  const SignalError* s = errors.find(q);
+  return s && std::isfinite(s->max_rel) ? s->max_rel : INFINITY;
+}
+
+std::string RunRecord::label() const {
+  if (model == "full") return fmt::format("full {} tol {:.0e}", integrator, tolerance);
+  if (model != "reduced") return fmt::format("{} {} h={:.3g} ms", model, integrator, fixed_step_s * 1e3);
+  std::string s = fmt::format("reduced {:g}° {}{}", grid_deg, fit.empty() ? interpolation : fit,
+                              energy_consistent ? "+ec" : "");
+  if (integrator == "rk4-fixed") return s + fmt::format(" rk4 h={:g} ms", fixed_step_s * 1e3);
+  return s + fmt::format(" {} tol {:.0e}", integrator, tolerance);
+}
+
+namespace {
+
+// The domain is computed once per model, outside the timed runs.
+engine::ForwardOptions forward_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                       const engine::IndependentDomain& domain) {
+  engine::ForwardOptions fo;
+  fo.domain = domain;
+  fo.duration_s = v.duration_s;
+  fo.output_interval_s = v.output_interval_s;
+  fo.tolerance = tol;
+  fo.integrator = integrator;
+  return fo;
+}
+
+reduced::ReducedOptions reduced_options(const ValidationResult& v, const std::string& integrator, double tol,
+                                        double h) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = v.duration_s;
+  ro.output_interval_s = v.output_interval_s;
+  ro.tolerance = tol;
+  ro.integrator = integrator;
+  ro.fixed_step_s = h;
+  return ro;
+}
+
+// What is validated, from the scene alone.
+ValidationResult describe(const models::Scene& scene) {
+  ValidationResult v;
+  v.scene = scene.name;
+  v.scene_file = scene.source_file;
+  v.note = scene.validation.note;
+  v.compare = scene.validation.compare;
+  v.machine = machine_description();
+  v.duration_s = scene.validation.duration_s > 0 ? scene.validation.duration_s : scene.simulation.duration_s;
+  v.output_interval_s = scene.simulation.output_interval_s;
+  // Runs are compared row by row, and the MuJoCo peer fills every output interval with whole
+  // steps: validation spans whole output intervals (the rows up to the duration, as every run
+  // ended before `simulate` wrote a last row at the duration itself).
+  const double whole = std::floor(v.duration_s / v.output_interval_s + 1e-9);
+  if (whole >= 1) v.duration_s = std::min(v.duration_s, whole * v.output_interval_s);
+  v.headline_quantity = scene.outputs.constraint_forces.empty() ? "qdot" : scene.outputs.constraint_forces[0].name;
+  v.quantities = {"qdot"};
+  for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);
+  v.quantities.push_back("mean_qdot");
+  v.reference_tolerance = scene.validation.reference_tolerance;
+  return v;
+}
+
+// Stage 2: the full-model tolerance ladder, each run timed by repeats.
+void run_full_ladder(const std::string& name, engine::FullModel& full, const LadderPlan& plan, ValidationResult& v,
+                     Progress& progress) {
+  const long n = static_cast<long>(plan.full.size());
+  const auto domain = engine::calc_independent_domain(full);
+  for (long i = 0; i < n; ++i) {
+    progress.count(name + ": full-model tolerance ladder", i, n);
+    RunRecord r;
+    r.model = "full";
+    r.integrator = plan.full[i].first;
+    r.tolerance = plan.full[i].second;
+    models::TimeSeries ts;
+    const auto fo = forward_options(v, r.integrator, r.tolerance, domain);
+    std::vector<double> walls;
+    try {
+      if (plan.time_full_without_outputs) {
+        // Fair baseline (issue #11): Simbody interpolates outputs but still ends a step at each
+        // output time (5 ms outputs: 1020 steps over the bicycle's 5 s at 1e-4…1e-6 alike, 264–451
+        // with one output), so the timed repeats write one output at the end; the errors come
+        // from one run of the same settings on the output grid.
+        ts = engine::simulate_full(full, fo);  // checked: the branch guard at every output
+        auto fo_timed = fo;
+        fo_timed.output_interval_s = v.duration_s;
+        fo_timed.branch_guard = false;  // the same motion, already checked: Simbody's cost alone
+        models::TimeSeries timed;
+        walls = time_repeats([&] { timed = engine::simulate_full(full, fo_timed); }, plan.full_repeats);
+        r.timed_output_interval_s = fo_timed.output_interval_s;
+        r.timed_steps = timed.stats.steps_taken;
+      } else {
+        ts = engine::simulate_full(full, fo);  // checked: the branch guard at every output
+        auto fo_timed = fo;
+        fo_timed.branch_guard = false;  // the same motion, already checked: Simbody's cost alone
+        walls = time_repeats([&] { engine::simulate_full(full, fo_timed); }, plan.full_repeats);
+        r.timed_steps = ts.stats.steps_taken;
+      }
+    } catch (const models::NumericalError& e) {
+      record_stopped(r, e.what(), v);
+      continue;
+    }
+    finish_run(r, walls, ts, v);
+    v.runs.push_back(r);
+  }
+  progress.count(name + ": full-model tolerance ladder", n, n);
+}
+
+// Stage 3: the reduced ladder, grid × interpolation (× energy-consistent m2) × integrator. A run
+// that stops (divergence, validity domain) is recorded with its reason.
+void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, ValidationResult& v, Progress& progress) {
+  long done = 0;
+  const long total = plan.reduced_runs();
+  for (double grid : plan.grids_deg) {
+    Extraction e;
+    std::vector<double> ms, build_ms, assembly_ms, kinetostatics_ms;
+    for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
+      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
+      ms.push_back(e.extraction_ms);
+      build_ms.push_back(e.stages.system_build_ms);
+      assembly_ms.push_back(e.stages.assembly_ms);
+      kinetostatics_ms.push_back(e.stages.kinetostatics_ms);
+    }
+    v.extractions.push_back({grid, median(ms), e.calls, static_cast<int>(e.samples.q.size())});
+    if (grid == 10) {
+      v.extraction_ms = median(ms);
+      v.extraction_stages = {median(build_ms), median(assembly_ms), median(kinetostatics_ms)};
+      v.samples10 = e.samples;
+    }
+    for (const auto& var : plan.variants) {
+      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interpolation),
+                                                     var.energy_consistent);
+      auto add_run = [&](const std::string& integrator, double tol, double h) {
+        progress.count(scene.name + ": reduced ladder", done++, total);
+        RunRecord r;
+        r.model = "reduced";
+        r.grid_deg = grid;
+        r.interpolation = var.interpolation;
+        r.fit = model.table.fit;
+        r.energy_consistent = var.energy_consistent;
+        r.integrator = integrator;
+        r.tolerance = tol;
+        r.fixed_step_s = h;
+        auto ro = reduced_options(v, integrator, tol, h);
+        models::TimeSeries timed, rows, ts;
+        std::vector<double> walls;
+        try {
+          // Timed like the full model (plan.time_reduced_without_outputs: one output at the end;
+          // the steps do not depend on the outputs); compared on rows as accurate as the steps
+          // (one extra single step per row, untimed), so the errors are the model's and the
+          // integrator's; the Hermite rows a user gets between steps are measured apart
+          // (output_interpolation).
+          auto ro_timed = ro;
+          if (plan.time_reduced_without_outputs) ro_timed.output_interval_s = v.duration_s;
+          walls = time_repeats(
+              [&] { timed = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro_timed); },
+              plan.reduced_repeats);
+          r.timed_output_interval_s = ro_timed.output_interval_s;
+          r.timed_steps = timed.stats.steps_taken;
+          rows = plan.time_reduced_without_outputs
+                     ? reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro)
+                     : timed;
+          ro.step_outputs = true;
+          ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
+        } catch (const std::runtime_error& e) {  // TableError (validity domain) or NumericalError
+          record_stopped(r, e.what(), v);
+          return;
+        }
+        finish_run(r, walls, ts, v);
+        r.compared_run_wall_s = ts.stats.wall_time_s;
+        r.output_interpolation = compare_series(ts, rows, v.window.t_start);
+        v.runs.push_back(r);
+        if (grid == 10 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
+            tol == plan.tightest_tolerance()) {
+          v.showcase = ts;
+          v.showcase_run = static_cast<int>(v.runs.size()) - 1;
+        }
+      };
+      for (double tol : plan.rk8pd_tolerances) add_run("rk8pd", tol, 0.0);
+      if (plan.rkck) add_run("rkck", 1e-8, 0.0);
+      // Fixed-step RK4, the real-time stepper (outputs by dense interpolation).
+      for (double h : plan.fixed_steps_s) add_run("rk4-fixed", 0.0, h);
+    }
+  }
+  progress.count(scene.name + ": reduced ladder", total, total);
+}
+
+// The interpolant of the 10° table at 1° (figure 1).
+void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
+  if (v.samples10.q.empty()) return;
+  const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
+  std::vector<int> cols{m.c_m1, m.c_m2};
+  v.dense_names = {"q_deg", "m1", "m2"};
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    cols.push_back(m.c_me1[k]);
+    cols.push_back(m.c_me2[k]);
+    v.dense_names.push_back("me1_" + m.force_names[k]);
+    v.dense_names.push_back("me2_" + m.force_names[k]);
+  }
+  v.dense_params.assign(cols.size() + 1, {});
+  // A range table: 360 equal steps over its range (deg or m), not a turn.
+  const bool range = !v.samples10.periodic;
+  const double span = range ? v.samples10.q.back() - v.samples10.q0 : 2 * M_PI;
+  const double unit = v.samples10.revolute ? 180 / M_PI : 1.0;
+  if (!v.samples10.revolute) v.dense_names[0] = "q_m";
+  for (int d = 0; d <= 360; ++d) {
+    const double q = v.samples10.q0 + d * span / 360;
+    v.dense_params[0].push_back(q * unit);
+    for (size_t c = 0; c < cols.size(); ++c) v.dense_params[c + 1].push_back(m.table.eval(cols[c], q));
+  }
+}
+
+// Stage 6: the scene's thresholds; a grid outside the ladder is run now.
+void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
+  v.default_thresholds = scene.validation.thresholds.empty();
+  for (const auto& th : thresholds_of(scene)) {
+    // A reference that moves by more than a threshold when its tolerance is halved cannot
+    // judge that threshold: the error measured would be the reference's own (a chain through
+    // its flat configuration passed with a reference whose q̇ changed by 100 % of its peak).
+    if (const SignalError* ch = v.reference_change.find(th.quantity); ch && !(ch->max_rel <= th.max_error))
+      v.fail(fmt::format("the reference does not converge: halving its tolerance changes {} by {:.3g} of its peak, "
+                         "more than the threshold {:.3g} it must judge (tighten validation.reference_tolerance or "
+                         "choose another validation.reference_integrator)",
+                         th.quantity, ch->max_rel, th.max_error));
+    auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
+    if (!tr) {
+      const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
+      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
+      const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
+      RunRecord r;
+      r.model = "reduced";
+      r.grid_deg = th.grid_deg;
+      r.interpolation = interp;
+      r.fit = m.table.fit;
+      r.integrator = "rk8pd";
+      r.tolerance = v.tightest_tolerance;
+      auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);
+      ro.step_outputs = true;  // compared rows as accurate as the steps, as in the ladder
+      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
+      r.errors = compare_series(v.reference, ts, v.window.t_start);
+      tr = judge_threshold_on(th, r);
+    }
+    if (!tr->pass)
+      v.fail(fmt::format("threshold {} at {:g}°: error {:.3g} exceeds {:.3g} ({})", th.quantity, th.grid_deg, tr->error,
+                         th.max_error, tr->run));
+    v.thresholds.push_back(*tr);
+  }
+}
+
+}  // namespace
+
+void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
+  // A coordinate confined to a range (a rocker, a slider) has no revolutions to count.
+  const auto domain = engine::calc_independent_domain(full);
+  const bool rotating = scene.find_joint(scene.independent)->type == models::JointType::Revolute && domain.periodic;
+  const std::string integrator = scene.validation.reference_integrator;
+  progress.count(scene.name + ": reference (full model)", 0, 2);
+  const auto t_ref = Clock::now();
+  v.reference = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance, domain));
+  v.reference_wall_s = seconds_since(t_ref);
+  v.reference_run.model = "full";
+  v.reference_run.integrator = integrator;
+  v.reference_run.tolerance = v.reference_tolerance;
+  v.reference_run.wall_s = v.reference_wall_s;
+  v.reference_run.per_simulated_s = v.reference_wall_s / v.duration_s;
+  v.reference_run.repeats = 1;
+  fill_stats(v.reference_run, v.reference);
+  v.reference_run.energy_residual_rel = energy_residual_rel(v.reference);
+  progress.count(scene.name + ": reference (full model)", 1, 2);
+  const auto half = engine::simulate_full(full, forward_options(v, integrator, v.reference_tolerance / 2, domain));
+  progress.count(scene.name + ": reference (full model)", 2, 2);
+  v.window = detect_steady_window(v.reference, rotating);
+  v.reference_change = compare_series(v.reference, half, v.window.t_start);
+  // Errors and speedups are claimed only over enough samples (issue #9).
+  if (v.reference_change.samples < kMinComparedSamples)
+    v.fail(fmt::format("only {} output samples in the compared window ({}); at least {} are needed to claim an error: "
+                       "lengthen validation.duration_s or shorten simulation.output_interval_s",
+                       v.reference_change.samples, v.window.how, kMinComparedSamples));
+  if (const SignalError* speed = v.reference_change.find("qdot"); speed && !(speed->peak > 0))
+    v.fail("the mechanism does not move in the reference run (its speed is 0 throughout): there is nothing to "
+           "compare");
+  if (!v.window.whole_run && v.window.revolutions < kMinSteadyRevolutions)
+    v.fail(fmt::format("the run never settles into a steady cycle: only {} revolution(s) after the start-up transient "
+                       "({}); lengthen validation.duration_s",
+                       v.window.revolutions, v.window.how));
+  v.time_scale = calc_time_scale(v.reference, rotating);
+}
+
+void analyse_runs(ValidationResult& v) {
+  mark_pareto(v.runs, v.headline_quantity);
+  const auto matched = calc_matched_speedup(v.runs, v.headline_quantity, v.matched_target);
+  v.matched_full = matched.full;
+  v.matched_reduced = matched.reduced;
+  v.speedup_at_matched_error.reset();
+  // No claim from too few samples or a validation that already failed.
+  if (v.failures.empty() && v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
+  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.convergence_floor = 10 * std::max(1e-12, ref ? ref->max_rel : 0.0);
+  v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
+  analyse_peers(v);
+}
+
+void calc_first_screen(ValidationResult& v) {
+  // A scene judged on the defaults must also reach the validation's own target: a reduced
+  // setting within it on the speed and the headline quantity; none is a failure, not a pass with
+  // nothing recommended. Declared thresholds are the scene's own verdict (the hard high-saddle
+  // accepts 0.5 on its knee force).
+  if (v.recommended < 0 && v.default_thresholds)
+    v.fail(fmt::format("no reduced run reached the error target {:.3g} on qdot and {} (refine the grid or check the "
+                       "reference)",
+                       v.matched_target, v.headline_quantity));
+  const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
+  v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
+  v.baselines.clear();
+  v.budget.reset();
+  if (!rec) return;
+  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
+  const SignalError* ref = v.reference_change.find(v.headline_quantity);
+  v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
+}
+
+namespace {
+
+// A numerical failure after the reference ran is a finding of the validation, not its end: the
+// stage is recorded as failed and the report is still written (README, exit codes: "validate
+// still writes its report"). A leg press whose calibration missed exited 1 after 66 s with
+// nothing written. Bad input (scene, table, engine errors) still stops at once.
+template <class Stage>
+void run_stage(ValidationResult& v, const char* what, Stage&& stage) {
+  try {
+    stage();
+  } catch (const models::NumericalError& e) {
+    v.fail(fmt::format("{}: {}", what, e.what()));
+  }
+}
+
+}  // namespace
+
+ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress) {
+  ValidationResult v = describe(scene);
+  // The scene's operating point is checked before any work (the calibration itself runs last):
+  // an unknown load or a scene that cannot be calibrated is bad input, refused at once.
+  if (scene.validation.calibrate_cadence_Hz > 0)
+    check_calibratable(scene, calibration_options_of(scene, 0.0, 0.0, ""));
+  // 1. Reference: full model at a tight tolerance, and the change when it is halved; the
+  //    scene's time scale from it sets the fixed steps of the ladder.
+  engine::FullModel full(scene);
+  run_reference(scene, full, v, progress);
+  const LadderPlan plan = plan_ladders(v.time_scale, opt.quick);
+  v.fixed_steps = plan.fixed_steps_s;
+  v.tightest_tolerance = plan.tightest_tolerance();
+  v.full_timing = plan.time_full_without_outputs
+                      ? fmt::format("Full-model runs are timed with one output at the end of the {:g} s run, so the "
+                                    "output grid never caps Simbody's step (errors from the same settings on the {:g} s "
+                                    "output grid); each integrator (RK-Merson, RK3, CPodes) over a tolerance ladder, the "
+                                    "cheapest within the error target is the baseline.{}",
+                                    v.duration_s, v.output_interval_s,
+                                    plan.time_reduced_without_outputs && plan.time_peers_without_outputs
+                                        ? " The reduced model and the peer engines are timed the same way (one "
+                                          "output at the end; their steps do not depend on the outputs), their errors "
+                                          "also read on the output grid."
+                                        : "")
+                      : "Full-model runs are timed on the output grid.";
+  // 2–3. The ladders.
+  run_stage(v, "full-model ladder", [&] { run_full_ladder(scene.name, full, plan, v, progress); });
+  run_stage(v, "reduced ladder", [&] {
+    run_reduced_ladder(scene, plan, v, progress);
+    calc_dense_params(scene, v);
+  });
+  // 3b. Peer engines (MuJoCo) on the same scene, timed like the full model.
+  v.peer_steps = plan.peer_steps_s;
+  if (!opt.peers.empty()) run_stage(v, "peer ladders", [&] { run_peer_ladders(scene, opt.peers, plan, v, progress); });
+  // 4. Pareto front, matched-error speedup, recommended setting, convergence.
+  analyse_runs(v);
+  // 5. Calibration (scenes that declare an operating point).
+  if (scene.validation.calibrate_cadence_Hz > 0) {
+    v.calibration_options = calibration_options_of(scene, 0.0, 0.0, "");
+    progress.note(scene.name + ": calibrating the drive load");
+    run_stage(v, "calibration", [&] { v.calibration = calibrate(scene, v.calibration_options, progress); });
+  }
+  // 6–7. Thresholds, then the first screen: verdicts, baselines, error budget.
+  run_stage(v, "thresholds", [&] { judge_thresholds(scene, v); });
+  calc_first_screen(v);
+  return v;
+}
+
+std::string ValidationResult::failure_summary() const {
+  std::string s;
+  for (const auto& f : failures) s += (s.empty() ? "" : "; ") + f;
+  return s;
+}
+
+}  // namespace rdyn::validate

@@ -1,0 +1,264 @@
+#include "validate/harness/summary.hpp"
+
+#include <cmath>
+
+#include "validate/harness/time_scale.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+// JSON has no NaN or infinity: they are written as null ("not measured").
+nlohmann::json num(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+nlohmann::json comparison_json(const Comparison& c) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& s : c.signals)
+    j[s.name] = {{"max_rel", num(s.max_rel)}, {"rms_rel", num(s.rms_rel)}, {"peak", num(s.peak)}};
+  return {{"errors", j}, {"samples", c.samples}, {"excluded_between_switches", c.excluded}};
+}
+
+// Column-wise table: {"names": [...], "rows": [[...], ...]}.
+nlohmann::json table_json(const std::vector<std::string>& names,
+                          const std::vector<std::vector<double>>& cols) {
+  nlohmann::json rows = nlohmann::json::array();
+  const size_t n = cols.empty() ? 0 : cols[0].size();
+  for (size_t i = 0; i < n; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (const auto& c : cols) row.push_back(num(c[i]));
+    rows.push_back(row);
+  }
+  return {{"names", names}, {"rows", rows}};
+}
+
+// The data of the three data figures: reduced parameters (samples and interpolant) and the
+// full and default reduced runs over the last three periods of the scene's time scale.
+nlohmann::json figures_json(const ValidationResult& v) {
+  nlohmann::json f;
+  const auto& sm = v.samples10;
+  if (!sm.q.empty() && !v.dense_names.empty()) {
+    std::vector<std::vector<double>> cols(v.dense_names.size());
+    // A periodic table repeats its first point at +360°; a range table ends at its last point.
+    for (size_t i = 0; i < sm.q.size() + (sm.periodic ? 1 : 0); ++i) {
+      const size_t k = i % sm.q.size();
+      cols[0].push_back((sm.q[k] + (i == sm.q.size() ? 2 * M_PI : 0)) * (sm.revolute ? 180 / M_PI : 1.0));
+      for (size_t c = 1; c < v.dense_names.size(); ++c)
+        cols[c].push_back(sm.columns[sm.column(v.dense_names[c])][k]);
+    }
+    f["params_samples"] = table_json(v.dense_names, cols);
+    f["params_dense"] = table_json(v.dense_names, v.dense_params);
+  }
+  const auto& a = v.reference;
+  const auto& b = v.showcase;
+  if (!a.t.empty() && b.t.size() == a.t.size()) {
+    const double t0 = std::max(v.window.t_start, a.t.back() - 3 * v.time_scale.period_s);
+    std::vector<std::string> names{"t", "qdot_full", "qdot_reduced"};
+    const bool has_f = !a.forces.empty();
+    if (has_f) names.insert(names.end(), {"F_full", "F_reduced"});
+    std::vector<std::vector<double>> cols(names.size());
+    for (size_t i = 0; i < a.t.size(); ++i) {
+      if (a.t[i] < t0) continue;
+      cols[0].push_back(a.t[i]);
+      cols[1].push_back(a.qdot[i]);
+      cols[2].push_back(b.qdot[i]);
+      if (has_f) cols[3].push_back(a.forces[0][i]), cols[4].push_back(b.forces[0][i]);
+    }
+    f["timeseries"] = table_json(names, cols);
+    f["timeseries"]["force_name"] = has_f ? a.force_names[0] : "";
+    f["timeseries"]["reduced_run"] = v.showcase_run >= 0 ? v.runs[v.showcase_run].label() : "";
+  }
+  return f;
+}
+
+// The calibration result under neutral names (kCompareQuantities), with what the scene
+// compares it to.
+nlohmann::json calibration_json(const ValidationResult& v) {
+  const auto& c = *v.calibration;
+  const double power = v.calibration_options.power_w;
+  nlohmann::json j = {{"target_cadence_hz", v.calibration_options.cadence_hz},
+                      {"target_power_w", power > 0 ? num(power) : nlohmann::json(nullptr)},
+                      {"load", c.load},
+                      {"load_kind", c.load_kind},
+                      {"load_value", num(c.load_value)},
+                      {"load_unit", c.load_unit},
+                      {"drive_torque_Nm", num(c.torque_Nm)},  // null unless joint torques (N·m)
+                      {"work_per_rev_per_unit", num(c.work_per_rev_per_unit)},
+                      {"mean_cadence_hz_reduced", num(c.mean_cadence_hz_reduced)},
+                      {"mean_cadence_hz_full", num(c.mean_cadence_hz_full)},
+                      {"mean_power_W", num(c.mean_power_w)},
+                      {"force_name", c.force_name},
+                      {"peak_force_N", num(c.peak_force_N)},
+                      {"speed_fluctuation", num(c.speed_fluctuation)},
+                      {"drive_work_per_rev_per_Nm",
+                       std::isfinite(c.torque_Nm) ? num(c.work_per_rev_per_unit) : nlohmann::json(nullptr)}};
+  nlohmann::json cmp = nlohmann::json::array();
+  for (const auto& cv : v.compare)
+    cmp.push_back({{"quantity", cv.quantity},
+                   {"value", cv.value},
+                   {"unit", cv.unit},
+                   {"source", cv.source},
+                   {"explanation", cv.explanation},
+                   {"rdyn_value", j.value(cv.quantity, nlohmann::json(nullptr))}});
+  j["compare"] = cmp;
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json run_json(const RunRecord& r) {
+  nlohmann::json j = {{"label", r.label()},
+                      {"model", r.model},
+                      {"integrator", r.integrator},
+                      {"tolerance", r.tolerance},
+                      {"wall_s", num(r.wall_s)},
+                      {"wall_s_per_simulated_s", num(r.per_simulated_s)},
+                      {"repeats", r.repeats},
+                      {"steps", r.steps},
+                      {"rejected_steps", r.rejected},
+                      {"smallest_step_s", num(r.smallest_step_s)},
+                      {"events", r.events},
+                      {"energy_balance_residual_rel", num(r.energy_residual_rel)},
+                      {"cycles", num(r.cycles)},
+                      {"energy_drift_per_cycle_J", num(r.energy_drift_per_cycle_J)},
+                      {"pareto", r.pareto}};
+  if (!r.failure.empty()) j["failure"] = r.failure;
+  if (r.model == "full") j["constraint_violation_m"] = num(r.constraint_violation_m);
+  if (r.timed_output_interval_s > 0) j["timed_output_interval_s"] = r.timed_output_interval_s;
+  if (r.model == "full" || r.failure.empty()) j["timed_steps"] = r.timed_steps;
+  if (r.model != "full" && r.model != "reduced") {  // a peer engine's fixed-step run
+    j["fixed_step_s"] = r.fixed_step_s;
+    j["constraint_violation_m"] = num(r.constraint_violation_m);
+  }
+  if (r.model == "reduced") {
+    j["grid_deg"] = r.grid_deg;
+    j["interpolation"] = r.interpolation;
+    if (!r.fit.empty()) j["fit"] = r.fit;  // the interpolant built (differs from the request on range tables)
+    j["energy_consistent_m2"] = r.energy_consistent;
+    if (r.integrator == "rk4-fixed") j["fixed_step_s"] = r.fixed_step_s;
+    nlohmann::json oi = nlohmann::json::object();
+    for (const auto& e : r.output_interpolation.signals) oi[e.name] = num(e.max_rel);
+    j["output_interpolation_max_rel"] = oi;  // Hermite rows on the output grid vs the compared rows
+    j["compared_run_wall_s"] = num(r.compared_run_wall_s);
+  }
+  j.update(comparison_json(r.errors));
+  return j;
+}
+
+nlohmann::json summary_json(const ValidationResult& v) {
+  nlohmann::json j;
+  j["scene"] = v.scene;
+  j["scene_file"] = v.scene_file;
+  j["note"] = v.note;
+  j["machine"] = v.machine;
+  j["duration_s"] = v.duration_s;
+  j["output_interval_s"] = v.output_interval_s;
+  j["time_scale"] = {{"period_s", num(v.time_scale.period_s)}, {"how", v.time_scale.how}};
+  j["fixed_steps_s"] = v.fixed_steps;
+  // Costs per simulated second only when at least a second was simulated (no extrapolation).
+  j["per_second_measured"] = per_second_is_measured(v.duration_s);
+  j["reference"] = {{"integrator", v.reference_run.integrator},
+                    {"tolerance", v.reference_tolerance},
+                    {"wall_s", v.reference_wall_s},
+                    {"stability", run_json(v.reference_run)},
+                    {"change_when_tolerance_halved", comparison_json(v.reference_change)}};
+  j["steady_window"] = {{"t_start_s", v.window.t_start},
+                        {"revolutions", v.window.revolutions},
+                        {"whole_run", v.window.whole_run},
+                        {"how", v.window.how}};
+  j["extraction_ms"] = v.extraction_ms;
+  j["extraction_stages_ms"] = {{"system_build", v.extraction_stages.system_build_ms},
+                               {"assembly", v.extraction_stages.assembly_ms},
+                               {"kinetostatics", v.extraction_stages.kinetostatics_ms}};
+  nlohmann::json ex = nlohmann::json::array();
+  for (const auto& e : v.extractions)
+    ex.push_back({{"grid_deg", e.grid_deg},
+                  {"ms", e.ms},
+                  {"kinetostatic_calls", e.calls},
+                  {"points", e.points}});
+  j["extractions"] = ex;
+  j["headline_quantity"] = v.headline_quantity;
+  j["quantities"] = v.quantities;
+  j["matched_error_target"] = v.matched_target;
+  j["speedup_at_matched_error"] =
+      v.speedup_at_matched_error ? num(*v.speedup_at_matched_error) : nullptr;
+  j["matched_full"] =
+      v.matched_full >= 0 ? run_json(v.runs[v.matched_full]) : nlohmann::json(nullptr);
+  j["matched_reduced"] =
+      v.matched_reduced >= 0 ? run_json(v.runs[v.matched_reduced]) : nlohmann::json(nullptr);
+  // The settings to use for this scene, chosen from the measurements (validate/harness/pareto.hpp).
+  j["recommended_reduced"] =
+      v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
+  j["showcase_reduced"] =
+      v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
+  nlohmann::json verdicts = nlohmann::json::array();
+  for (const auto& d : v.verdicts)
+    verdicts.push_back({{"quantity", d.quantity},
+                        {"error", num(d.error)},
+                        {"limit", num(d.limit)},
+                        {"judged_on", d.judged_on},
+                        {"judged_error", num(d.judged_error)},
+                        {"pass", d.pass},
+                        {"decides", d.decides}});
+  j["verdicts"] = verdicts;
+  nlohmann::json baselines = nlohmann::json::array();
+  for (const auto& b : v.baselines)
+    baselines.push_back({{"what", b.what},
+                         {"label", b.label},
+                         {"wall_s", num(b.wall_s)},
+                         {"speedup", num(b.speedup)}});
+  j["baselines"] = baselines;
+  if (v.budget)
+    j["error_budget"] = {
+        {"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
+        {"table", num(v.budget->table)},   {"integration", num(v.budget->integration)},
+        {"total", num(v.budget->total)},   {"table_run", v.budget->table_run},
+        {"output_interpolation", num(v.budget->output_interpolation)}};
+  nlohmann::json conv = nlohmann::json::array();
+  for (const auto& s : v.convergence) {
+    nlohmann::json pts = nlohmann::json::array();
+    for (const auto& [g, e] : s.points) pts.push_back({g, num(e)});
+    conv.push_back({{"interpolation", s.interpolation}, {"points", pts}, {"order", num(s.order)}});
+  }
+  j["convergence"] = {
+      {"quantity", v.headline_quantity}, {"floor", num(v.convergence_floor)}, {"series", conv}};
+  nlohmann::json runs = nlohmann::json::array();
+  for (const auto& r : v.runs) runs.push_back(run_json(r));
+  j["runs"] = runs;
+  j["full_model_timing"] = v.full_timing;
+  // Peer engines (issue #11): each ladder's runs and the reduced model's speedup over it.
+  nlohmann::json peers = nlohmann::json::array();
+  for (const auto& p : v.peers) {
+    nlohmann::json pr = nlohmann::json::array();
+    for (const auto& r : p.runs) pr.push_back(run_json(r));
+    peers.push_back({{"engine", p.engine},
+                     {"version", p.version},
+                     {"integrator", p.integrator},
+                     {"how", p.how},
+                     {"runs", pr},
+                     {"speedup_at_matched_error",
+                      p.speedup_at_matched_error ? num(*p.speedup_at_matched_error) : nlohmann::json(nullptr)},
+                     {"matched_peer", p.matched_peer >= 0 ? run_json(p.runs[p.matched_peer]) : nlohmann::json(nullptr)},
+                     {"matched_reduced",
+                      p.matched_reduced >= 0 ? run_json(v.runs[p.matched_reduced]) : nlohmann::json(nullptr)}});
+  }
+  j["peers"] = peers;
+  if (v.calibration) j["calibration"] = calibration_json(v);
+  nlohmann::json th = nlohmann::json::array();
+  for (const auto& t : v.thresholds)
+    th.push_back({{"quantity", t.threshold.quantity},
+                  {"grid_deg", t.threshold.grid_deg},
+                  {"max_error", t.threshold.max_error},
+                  {"error", num(t.error)},
+                  {"pass", t.pass},
+                  {"run", t.run}});
+  j["thresholds"] = th;
+  j["thresholds_are_defaults"] = v.default_thresholds;
+  j["status"] = v.pass ? "pass" : "fail";
+  j["failures"] = v.failures;
+  j["figures"] = figures_json(v);
+  return j;
+}
+
+}  // namespace rdyn::validate

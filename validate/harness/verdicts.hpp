@@ -1,0 +1,57 @@
+// The first screen of a report: for each compared quantity, the error at the recommended
+// reduced setting, the limit it is held to, pass or fail; the recommended run's speed against
+// each full-model baseline; and where its error comes from.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "validate/harness/run_record.hpp"
+
+namespace rdyn::validate {
+
+struct Verdict {
+  std::string quantity;
+  double error = 0.0;     // at the recommended setting (+∞ without one)
+  double limit = 0.0;     // the scene's threshold for the quantity, else the matched-error target
+  std::string judged_on;  // the run the pass/fail is decided on
+  double judged_error = 0.0;
+  bool pass = false;
+  bool decides = false;  // a scene threshold: its failure fails the validation
+};
+
+// Thresholds decide for their quantity (the tightest when several); other quantities are
+// compared with `target` at the recommended setting for information (decides = false), so the
+// table never contradicts the validation's status.
+std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities,
+                                   const RunRecord* recommended,
+                                   const std::vector<ThresholdResult>& thresholds, double target);
+
+struct Baseline {
+  std::string what;   // "reference", "matched-error full run", "cheapest full run"
+  std::string label;  // the full run
+  double wall_s = 0.0;
+  double speedup = 0.0;  // baseline wall / recommended wall
+};
+
+// Baselines: the reference, the matched-error full run (index, −1: none) and the cheapest
+// completed full run of the ladder.
+std::vector<Baseline> calc_baselines(const RunRecord& recommended, const RunRecord& reference,
+                                     const std::vector<RunRecord>& runs, int matched_full);
+
+// Where the error of `quantity` at a reduced setting comes from (each relative to the peak):
+// the reference's own accuracy (its change when its tolerance is halved), the table (the same
+// grid and interpolation integrated at the tightest tolerance), the integration (what the
+// setting's integrator adds to that: |its error − the table's|), all measured on rows as
+// accurate as the integrator's steps; and the output interpolation (what quintic-Hermite rows
+// between steps, as a timed run writes them, add: their largest difference from those rows).
+struct ErrorBudget {
+  double reference = 0.0, table = 0.0, integration = 0.0, total = 0.0;
+  double output_interpolation = 0.0;  // NaN when the run has no Hermite rows measured
+  std::string table_run;  // empty when the ladder has no tight run at that grid
+};
+ErrorBudget calc_error_budget(const RunRecord& run, const std::vector<RunRecord>& runs,
+                              double reference_change, const std::string& quantity,
+                              double tightest_tolerance);
+
+}  // namespace rdyn::validate

@@ -1,0 +1,675 @@
+#include "validate/report/report.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "validate/io/escape.hpp"
+#include "validate/io/output_dir.hpp"
+#include "validate/io/run_program.hpp"
+
+namespace rdyn::validate {
+
+namespace {
+
+using json = nlohmann::json;
+
+// A number of the summary; NaN for null or a missing key ("not measured").
+double d(const json& j, const char* key) {
+  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return NAN;
+  return j[key].get<double>();
+}
+std::string str(const json& j, const char* key) {
+  return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>()
+                                                                : std::string();
+}
+double error_of(const json& run, const std::string& q) {
+  if (!run.is_object() || !run.contains("errors") || !run.at("errors").contains(q)) return NAN;
+  return d(run.at("errors")[q], "max_rel");
+}
+
+// Scene-given text in HTML.
+std::string H(const std::string& s) { return html_escape(s); }
+
+// A number in `spec`, or "n/a" when the summary has none (never "nan" in an output).
+std::string num(double x, const char* spec = "{:g}") {
+  return std::isfinite(x) ? fmt::format(fmt::runtime(spec), x) : "n/a";
+}
+
+std::string pct(double x) { return std::isfinite(x) ? fmt::format("{:.3g} %", 100 * x) : "n/a"; }
+std::string secs(double s) {
+  if (!std::isfinite(s)) return "n/a";
+  if (s >= 1) return fmt::format("{:.3g} s", s);
+  if (s >= 1e-3) return fmt::format("{:.3g} ms", s * 1e3);
+  return fmt::format("{:.3g} µs", s * 1e6);
+}
+
+// A cost for the run as simulated, and per simulated second only when at least a second was
+// simulated (summary "per_second_measured").
+std::string cost(const json& s, double wall_s) {
+  std::string c = fmt::format("{} for the {} s run", secs(wall_s), num(d(s, "duration_s")));
+  if (s.value("per_second_measured", false))
+    c += fmt::format(" ({} per simulated second)", secs(wall_s / d(s, "duration_s")));
+  return c;
+}
+
+std::string quantity_words(const std::string& q) {
+  if (q == "qdot") return "speed of the independent coordinate";
+  if (q == "mean_qdot") return "mean speed of the independent coordinate";
+  return q + " force";
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// A {"names", "rows"} table of the summary as CSV.
+std::string table_csv(const json& t) {
+  std::string s;
+  for (size_t c = 0; c < t.at("names").size(); ++c)
+    s += (c ? "," : "") + csv_field(t.at("names")[c].get<std::string>());
+  s += "\n";
+  for (const auto& row : t.at("rows")) {
+    for (size_t c = 0; c < row.size(); ++c)
+      s += (c ? "," : "") +
+           (row[c].is_number() ? fmt::format("{:.10g}", row[c].get<double>()) : std::string());
+    s += "\n";
+  }
+  return s;
+}
+
+const char* kSvgHead =
+    "set terminal svg size 960,{} dynamic enhanced font 'sans,11' background rgb 'white'\n";
+
+// Figure 1: reduced parameters — samples and interpolant.
+std::string params_gp(const json& fig) {
+  const auto& names = fig.at("params_samples").at("names");
+  const size_t nf = names.size() > 3 ? (names.size() - 3) / 2 : 0;
+  std::string gp =
+      "# Reduced parameters vs the independent coordinate. Restyle freely; data: params.csv "
+      "(table\n"
+      "# samples), params_dense.csv (the interpolant at 1°).\n";
+  gp += fmt::format(fmt::runtime(kSvgHead), nf ? 640 : 330);
+  gp += fmt::format(
+      "set output 'params.svg'\nset datafile separator ','\nset grid\nset key bottom right\n"
+      "set xlabel '{}'\n{}set multiplot layout {},2 title 'Reduced parameters "
+      "(points: samples from kinetostatic calls; lines: interpolant)'\n",
+      names[0] == "q_m" ? "q [m]" : "q [deg]", names[0] == "q_m" ? "" : "set xtics 60\n", nf ? 2 : 1);
+  for (size_t c = 1; c < names.size(); ++c) {
+    const std::string unit = c <= 2 ? "kg·m^2" : "kg·m";
+    gp += fmt::format(
+        "set title {} noenhanced\nplot 'params_dense.csv' skip 1 using 1:{} with lines lw 2 lc rgb "
+        "'#1f77b4' "
+        "title 'interpolant', 'params.csv' skip 1 using 1:{} with points pt 7 ps 0.6 lc rgb "
+        "'#d62728' title "
+        "'samples'\n",
+        gnuplot_quoted(names[c].get<std::string>() + " [" + unit + "]"), c + 1, c + 1);
+  }
+  return gp + "unset multiplot\n";
+}
+
+// Figure 2: the speed and the first constraint force, full and reduced, over the last periods.
+std::string timeseries_gp(const json& ts) {
+  const bool has_f = ts.at("names").size() >= 5;
+  std::string gp =
+      "# Full model and reduced model over the last periods of the scene's time scale. Data: "
+      "compare.csv.\n";
+  gp += fmt::format(fmt::runtime(kSvgHead), 640);
+  gp +=
+      "set output 'timeseries.svg'\nset datafile separator ','\nset grid\nset xlabel 't [s]'\n"
+      "set multiplot layout 2,2 title " +
+      gnuplot_quoted("Full model (Simbody) and reduced model (" +
+                     ts.value("reduced_run", std::string()) + ")") +
+      " noenhanced\n"
+      "set title 'speed of the independent coordinate [rad/s]'\nplot 'compare.csv' skip 1 using "
+      "1:2 with lines lw 3 "
+      "lc rgb '#aaaaaa' title 'full', '' skip 1 using 1:3 with lines lw 1 lc rgb '#d62728' title "
+      "'reduced'\n"
+      "set title 'reduced − full [rad/s]'\nplot 'compare.csv' skip 1 using 1:($3-$2) with lines lc "
+      "rgb '#1f77b4' "
+      "notitle\n";
+  if (has_f)
+    gp += fmt::format(
+        "set title {0} noenhanced\nplot 'compare.csv' skip 1 using 1:4 with lines lw 3 lc rgb "
+        "'#aaaaaa' "
+        "title 'full', '' skip 1 using 1:5 with lines lw 1 lc rgb '#d62728' title 'reduced'\n"
+        "set title 'reduced − full [N]'\nplot 'compare.csv' skip 1 using 1:($5-$4) with lines lc "
+        "rgb '#1f77b4' notitle\n",
+        gnuplot_quoted(ts.value("force_name", std::string()) + " force [N]"));
+  return gp + "unset multiplot\n";
+}
+
+// Figure 3 data and script: error of the headline quantity against cost, every run.
+void write_pareto(const json& s, const std::string& dir) {
+  const std::string Q = str(s, "headline_quantity");
+  std::string red = "wall_s,error,label\n", front = red, full = red;
+  std::vector<std::pair<double, std::string>> fr;
+  for (const auto& r : s.at("runs")) {
+    const double w = d(r, "wall_s"), e = error_of(r, Q);
+    if (!std::isfinite(w) || !std::isfinite(e)) continue;  // stopped runs have no error to plot
+    const std::string line =
+        fmt::format("{:.6g},{:.6g},{}\n", w, std::max(e, 1e-12), csv_field(str(r, "label")));
+    (str(r, "model") == "full" ? full : red) += line;
+    if (str(r, "model") == "reduced" && r.value("pareto", false)) fr.push_back({w, line});
+  }
+  std::sort(fr.begin(), fr.end());
+  for (const auto& p : fr) front += p.second;
+  write_text_file(dir + "/pareto_reduced.csv", red);
+  write_text_file(dir + "/pareto_front.csv", front);
+  write_text_file(dir + "/pareto_full.csv", full);
+  // Peer engines' ladders (summary.json "peers"), one series each, files by index.
+  std::string peer_plots;
+  const json peers = s.value("peers", json::array());
+  for (size_t i = 0; i < peers.size(); ++i) {
+    std::string csv = "wall_s,error,label\n";
+    for (const auto& r : peers[i].value("runs", json::array())) {
+      const double w = d(r, "wall_s"), e = error_of(r, Q);
+      if (std::isfinite(w) && std::isfinite(e))
+        csv += fmt::format("{:.6g},{:.6g},{}\n", w, std::max(e, 1e-12), csv_field(str(r, "label")));
+    }
+    write_text_file(dir + fmt::format("/pareto_peer{}.csv", i), csv);
+    peer_plots += fmt::format(", 'pareto_peer{}.csv' skip 1 using 1:2 with linespoints pt {} lw 2 title {}", i, 8 + i,
+                              gnuplot_quoted(str(peers[i], "engine") + " " + str(peers[i], "integrator") +
+                                             " (fixed steps)"));
+  }
+  write_text_file(
+      dir + "/pareto.gp",
+      fmt::format("# Error of {0} (max over the compared window, relative to its peak) against "
+                  "computing time\n"
+                  "# for the run as simulated. Data: pareto_reduced.csv, pareto_front.csv, "
+                  "pareto_full.csv.\n",
+                  Q) +
+          fmt::format(fmt::runtime(kSvgHead), 560) +
+          fmt::format(
+              "set output 'pareto.svg'\nset datafile separator ','\nset grid\nset logscale xy\n"
+              "set format x '10^{{%L}}'\nset format y '10^{{%L}}'\n"
+              "set xlabel {2} noenhanced\nset ylabel {1} noenhanced\n"
+              "set title 'Accuracy against cost: every reduced run, its Pareto front, and the "
+              "full-model "
+              "tolerance ladder'\nset key outside right\n"
+              "plot 'pareto_reduced.csv' skip 1 using 1:2 with points pt 6 ps 0.6 lc rgb '#999999' "
+              "title "
+              "'reduced runs', 'pareto_front.csv' skip 1 using 1:2 with linespoints pt 7 lw 2 lc "
+              "rgb '#d62728' "
+              "title 'reduced Pareto front', 'pareto_full.csv' skip 1 using 1:2 with linespoints "
+              "pt 5 lw 2 lc "
+              "rgb '#1f77b4' title 'full model (tolerance ladder)'{3}, {0:g} with lines dt 2 lc rgb "
+              "'#555555' "
+              "title 'matched-error target'\n",
+              // A hand-edited summary without it: the harness's default (ValidationResult).
+              std::isfinite(d(s, "matched_error_target")) ? d(s, "matched_error_target") : 1e-3,
+              gnuplot_quoted(Q + " error / peak"),
+              gnuplot_quoted(
+                  fmt::format("computing time for the {} s run [s]", num(d(s, "duration_s")))),
+              peer_plots));
+}
+
+// How the baselines were run (fair timing) and the peers' speedups, under figure 3.
+std::string baselines_note(const json& s) {
+  std::string h;
+  if (s.contains("full_model_timing")) h += "<p>" + H(str(s, "full_model_timing")) + "</p>";
+  for (const auto& p : s.value("peers", json::array())) {
+    h += "<p>" + H(str(p, "how")) + " ";
+    const json& sp = p.contains("speedup_at_matched_error") ? p.at("speedup_at_matched_error") : json(nullptr);
+    if (sp.is_number() && p.at("matched_peer").is_object() && p.at("matched_reduced").is_object()) {
+      h += fmt::format("At matched {} error the reduced model ({}) is {:.3g}× faster than {} ({}), counting "
+                       "integration only",
+                       H(str(s, "headline_quantity")), H(str(p.at("matched_reduced"), "label")), sp.get<double>(),
+                       H(str(p, "engine")), H(str(p.at("matched_peer"), "label")));
+      // Its table is extracted once per mechanism: say what that costs beside one run.
+      for (const auto& e : s.value("extractions", json::array()))
+        if (d(e, "grid_deg") == d(p.at("matched_reduced"), "grid_deg"))
+          h += fmt::format("; its {}° table costs {} ms to extract once", num(d(e, "grid_deg")), num(d(e, "ms")));
+      h += ".";
+    } else {
+      h += "No speedup is claimed over this ladder (no run within the matched-error target, or no reduced run as "
+           "accurate).";
+    }
+    h += "</p>";
+  }
+  return h;
+}
+
+// Figure 4 data and script: error against grid step per interpolation.
+void write_convergence(const json& s, const std::string& dir) {
+  const auto& conv = s.at("convergence");
+  std::vector<double> grids;
+  for (const auto& e : s.at("extractions"))
+    if (std::isfinite(d(e, "grid_deg"))) grids.push_back(d(e, "grid_deg"));
+  std::string csv = "grid_deg";
+  for (const auto& ser : conv.at("series")) csv += "," + csv_field(str(ser, "interpolation"));
+  csv += "\n";
+  for (double g : grids) {
+    csv += fmt::format("{:g}", g);
+    for (const auto& ser : conv.at("series")) {
+      std::string cell;
+      for (const auto& p : ser.at("points"))
+        if (p.is_array() && p.size() == 2 && p[0].is_number() &&
+            std::abs(p[0].get<double>() - g) < 1e-9 && p[1].is_number())
+          cell = fmt::format("{:.6g}", std::max(p[1].get<double>(), 1e-12));
+      csv += "," + cell;
+    }
+    csv += "\n";
+  }
+  write_text_file(dir + "/convergence.csv", csv);
+  const std::string Q = str(conv, "quantity");
+  std::string gp =
+      "# Error against grid step (rk8pd at the ladder's tightest tolerance). Data: "
+      "convergence.csv.\n" +
+      fmt::format(fmt::runtime(kSvgHead), 560) +
+      "set output 'convergence.svg'\nset datafile separator ','\nset grid\nset logscale xy\n"
+      "set format y '10^{%L}'\nset xlabel 'grid step [deg]'\nset ylabel " +
+      gnuplot_quoted(Q + " error / peak") +
+      " noenhanced\nset key outside right\nset title 'Convergence with the grid (slopes: observed "
+      "order, fitted above 10× the reference floor)'\n";
+  const char* colors[] = {"#1f77b4", "#2ca02c", "#9467bd", "#d62728", "#ff7f0e", "#8c564b"};
+  std::string plot;
+  for (size_t k = 0; k < conv.at("series").size(); ++k) {
+    const auto& ser = conv.at("series")[k];
+    const double o = d(ser, "order");
+    plot += fmt::format(
+        "{}'convergence.csv' skip 1 using 1:{} with linespoints pt 7 lw 2 lc rgb '{}' title {}",
+        k ? ", " : "", k + 2, colors[k % 6],
+        gnuplot_quoted(str(ser, "interpolation") + " (order " +
+                       (std::isfinite(o) ? fmt::format("{:.1f}", o) : "n/a") + ")"));
+  }
+  if (!plot.empty()) gp += "plot " + plot + "\n";
+  write_text_file(dir + "/convergence.gp", gp);
+}
+
+void write_runs_csv(const json& s, const std::string& dir) {
+  std::string csv =
+      "model,label,grid_deg,interpolation,energy_consistent,integrator,tolerance,fixed_step_s,wall_"
+      "s,"
+      "repeats,steps,energy_residual_rel,pareto,excluded_samples,failure";
+  for (const auto& q : s.at("quantities"))
+    csv += "," + csv_field("max_rel_" + q.get<std::string>()) + "," +
+           csv_field("rms_rel_" + q.get<std::string>());
+  csv += "\n";
+  auto cell = [](double x) { return std::isfinite(x) ? fmt::format("{:.6g}", x) : std::string(); };
+  for (const auto& r : s.at("runs")) {
+    csv += fmt::format(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", csv_field(str(r, "model")),
+        csv_field(str(r, "label")), cell(d(r, "grid_deg")), csv_field(str(r, "interpolation")),
+        r.value("energy_consistent_m2", false) ? 1 : 0, csv_field(str(r, "integrator")),
+        cell(d(r, "tolerance")), cell(d(r, "fixed_step_s")), cell(d(r, "wall_s")),
+        r.value("repeats", 0), r.value("steps", 0L), cell(d(r, "energy_balance_residual_rel")),
+        r.value("pareto", false) ? 1 : 0, r.value("excluded_between_switches", 0L),
+        csv_field(str(r, "failure")));
+    for (const auto& q : s.at("quantities")) {
+      const std::string name = q.get<std::string>();
+      const json e = r.contains("errors") && r.at("errors").contains(name) ? r.at("errors")[name]
+                                                                           : json::object();
+      csv += "," + cell(d(e, "max_rel")) + "," + cell(d(e, "rms_rel"));
+    }
+    csv += "\n";
+  }
+  write_text_file(dir + "/runs.csv", csv);
+}
+
+std::string svg_or_note(const std::map<std::string, std::string>& figures,
+                        const std::string& name) {
+  const auto it = figures.find(name);
+  const auto at = it == figures.end() ? std::string::npos : it->second.find("<svg");
+  if (at == std::string::npos)
+    return fmt::format("<p class=warn>Figure {}.svg could not be rendered (see gnuplot.log).</p>",
+                       name);
+  return it->second.substr(at);
+}
+
+// What the errors were taken over, in words: the steady revolutions, or the whole run when
+// the reference has no steady cycles (a transient, a rocking mechanism).
+std::string compared_over(const json& s) {
+  const auto& w = s.at("steady_window");
+  if (w.value("whole_run", false)) return "over the whole run";
+  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
+                     num(d(w, "t_start_s"), "{:.3g}"));
+}
+
+// The cost of the accurate rows the errors are read from: an untimed second run of the
+// recommended setting (one extra single step of its method per output row).
+std::string row_cost(const json& s) {
+  const json& rec = s.at("recommended_reduced");
+  const double timed = d(rec, "wall_s"), rows = d(rec, "compared_run_wall_s");
+  if (!(timed > 0) || !(rows > 0)) return "";
+  return fmt::format(
+      "The accurate rows come from an untimed second run of that setting (one extra single step "
+      "per output row): {} against {} for the timed run, {}× (one run, noisy).",
+      secs(rows), secs(timed), num(rows / timed, "{:.2g}"));
+}
+
+// The first screen: one row per quantity.
+std::string verdict_table(const json& s) {
+  const json& rec = s.at("recommended_reduced");
+  std::string h = "<h2>Verdict</h2>";
+  if (rec.is_object())
+    h += "<p>Recommended reduced setting: <b>" + H(str(rec, "label")) + "</b>, " +
+         H(cost(s, d(rec, "wall_s"))) + ".</p>";
+  else
+    h += fmt::format(
+        "<p class=warn>No reduced run reached the target of {} on the speed and on {}.</p>",
+        pct(d(s, "matched_error_target")), H(str(s, "headline_quantity")));
+  h += "<table><tr><th>quantity</th><th>max error " + H(compared_over(s)) +
+       " at the recommended setting</th><th>limit</th><th>judged on</th><th>error there</th><th></th></tr>";
+  for (const auto& v : s.at("verdicts")) {
+    const bool pass = v.value("pass", false), decides = v.value("decides", false);
+    // Only the scene's thresholds pass or fail; the target is shown for information.
+    const std::string mark = decides
+                                 ? (pass ? "<td class=pass>pass</td>" : "<td class=fail>FAIL</td>")
+                                 : (pass ? "<td>within target</td>" : "<td>above target</td>");
+    h += fmt::format(
+        "<tr><td class=l>{}</td><td>{}</td><td>{}{}</td><td class=l>{}</td><td>{}</td>{}</tr>",
+        H(str(v, "quantity")), pct(d(v, "error")), pct(d(v, "limit")), decides ? "" : " (target)",
+        H(str(v, "judged_on")), pct(d(v, "judged_error")), mark);
+  }
+  h += "</table>";
+  if (!s.at("baselines").empty()) {
+    h += "<table><tr><th>baseline (full model)</th><th>run</th><th>its cost</th><th>recommended "
+         "setting is</th></tr>";
+    for (const auto& b : s.at("baselines"))
+      h += fmt::format(
+          "<tr><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}× faster</td></tr>",
+          H(str(b, "what")), H(str(b, "label")), H(cost(s, d(b, "wall_s"))),
+          num(d(b, "speedup"), "{:.3g}"));
+    h += "</table>";
+  }
+  if (s.contains("error_budget")) {
+    const auto& b = s.at("error_budget");
+    h += fmt::format(
+        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak, on output rows "
+        "computed as accurately as the integrator's steps): reference {} (its change when its "
+        "tolerance is halved), table {} ({}: grid and interpolation, integrated at the tightest "
+        "tolerance), integration {} (what the setting's integrator adds). Output interpolation {}: "
+        "what quintic-Hermite rows between steps, as the timed run writes them, differ from "
+        "those rows (not in the total). Contributions are maxima, so they bound rather than "
+        "sum. {}</p>",
+        H(str(b, "quantity")), pct(d(b, "total")), pct(d(b, "reference")), pct(d(b, "table")),
+        H(str(b, "table_run").empty() ? "no tight run at that grid" : str(b, "table_run")),
+        pct(d(b, "integration")), pct(d(b, "output_interpolation")), row_cost(s));
+  }
+  return h;
+}
+
+// Published values the scene compares with (validation.compare), beside rdyn's calibration.
+std::string calibration_section(const json& s) {
+  const auto& c = s.at("calibration");
+  std::string h = "<h2>Calibration</h2>";
+  const bool with_power = c.contains("target_power_w") && c.at("target_power_w").is_number();
+  const std::string unit = c.value("load_unit", std::string("N·m"));
+  const std::string load = c.value("load", std::string());
+  const double value = c.contains("load_value") ? d(c, "load_value") : d(c, "drive_torque_Nm");
+  const double per_unit =
+      c.contains("work_per_rev_per_unit") ? d(c, "work_per_rev_per_unit") : d(c, "drive_work_per_rev_per_Nm");
+  h += fmt::format(
+      "<p>{}, the drive load {}({}) that holds a mean steady rate of {} Hz is <b>{} {}</b> (reduced model: {} Hz; "
+      "confirmed with the full model: {} Hz). Its mean power {} W, speed fluctuation {}{}. ",
+      with_power ? fmt::format("With the resistance dissipating {} W at {} Hz", num(d(c, "target_power_w")),
+                               num(d(c, "target_cadence_hz")))
+                 : std::string("With the resistances as the scene gives them"),
+      load.empty() ? std::string() : "<b>" + H(load) + "</b> ", H(c.value("load_kind", std::string("joint_torques"))),
+      num(d(c, "target_cadence_hz")), num(value, "{:.4g}"), H(unit), num(d(c, "mean_cadence_hz_reduced"), "{:.6f}"),
+      num(d(c, "mean_cadence_hz_full"), "{:.6f}"), num(d(c, "mean_power_W"), "{:.4g}"),
+      pct(d(c, "speed_fluctuation")),
+      str(c, "force_name").empty() ? std::string()
+                                   : fmt::format(", peak {} force {} N", H(str(c, "force_name")),
+                                                 num(d(c, "peak_force_N"), "{:.4g}")));
+  if (with_power)
+    h += fmt::format("At steady state the drive's work per revolution equals the dissipated energy, {} J; ",
+                     num(d(c, "target_power_w") / d(c, "target_cadence_hz"), "{:.4g}"));
+  h += fmt::format("at the target rate the load does {} J per revolution per {}.</p>", num(per_unit, "{:.4g}"),
+                   H(unit));
+  for (const auto& cv : c.value("compare", json::array())) {
+    const double ours = d(cv, "rdyn_value"), theirs = d(cv, "value");
+    h += fmt::format("<p><b>{}</b>: rdyn {} {}, {} {} {}", H(str(cv, "quantity")),
+                     num(ours, "{:.4g}"), H(str(cv, "unit")),
+                     H(str(cv, "source").empty() ? "published" : str(cv, "source")),
+                     num(theirs, "{:.4g}"), H(str(cv, "unit")));
+    if (std::isfinite(ours) && std::isfinite(theirs) && theirs != 0)
+      h += fmt::format(" ({:+.3g} %)", 100 * (ours - theirs) / theirs);
+    if (str(cv, "quantity") == "drive_torque_Nm" && theirs > 0 && with_power)
+      h += "; the published value would do " +
+           num(d(c, "target_power_w") / d(c, "target_cadence_hz") / theirs, "{:.4g}") +
+           " J per revolution per N·m to balance the same energy";
+    h += ".</p>";
+    if (!str(cv, "explanation").empty()) h += "<p>" + H(str(cv, "explanation")) + "</p>";
+  }
+  return h;
+}
+
+}  // namespace
+
+std::string headline(const json& s) {
+  std::string out;
+  const std::string Q = str(s, "headline_quantity");
+  const std::string qw = quantity_words(Q);
+  const json& mf = s.at("matched_full");
+  const json& mr = s.at("matched_reduced");
+  if (s.at("speedup_at_matched_error").is_number() && mf.is_object() && mr.is_object()) {
+    out += fmt::format(
+        "On this machine ({}), the reduced model of '{}' ({}) takes {} against {} for Simbody "
+        "forward dynamics ({}), at "
+        "equal or better error of the {} ({} vs {} of its peak): {}× faster. ",
+        str(s, "machine"), str(s, "scene"), str(mr, "label"), cost(s, d(mr, "wall_s")),
+        secs(d(mf, "wall_s")), str(mf, "label"), qw, pct(error_of(mr, Q)), pct(error_of(mf, Q)),
+        num(d(s, "speedup_at_matched_error"), "{:.3g}"));
+    for (const auto& e : s.at("extractions"))
+      if (std::abs(d(e, "grid_deg") - d(mr, "grid_deg")) < 1e-9) {
+        out += fmt::format("Its {}° table costs {} ms to extract once", num(d(e, "grid_deg")),
+                           num(d(e, "ms"), "{:.3g}"));
+        if (s.value("per_second_measured", false))
+          out += fmt::format(" (as long as {} s of simulated motion with that full run)",
+                             num(d(e, "ms") * 1e-3 / d(mf, "wall_s_per_simulated_s"), "{:.3g}"));
+        out += ". ";
+      }
+  } else {
+    out += fmt::format(
+        "No run of the full-model tolerance ladder of '{}' reached the target of {} of the peak of "
+        "the {}, "
+        "or no reduced run matched it: no matched-error speedup is claimed. ",
+        str(s, "scene"), pct(d(s, "matched_error_target")), qw);
+  }
+  const json& sc = s.at("showcase_reduced");
+  if (sc.is_object()) {
+    out += fmt::format("At the 10° grid ({}), the errors are {} for the speed", str(sc, "label"),
+                       pct(error_of(sc, "qdot")));
+    for (const auto& q : s.at("quantities"))
+      if (q != "qdot" && q != "mean_qdot")
+        out += fmt::format(" and {} for {}", pct(error_of(sc, q)), q.get<std::string>());
+    out += ". ";
+  }
+  const auto& ref = s.at("reference");
+  out += fmt::format(
+      "Reference: the full model (Simbody, {}) at tolerance {}; halving that tolerance changed",
+      str(ref, "integrator") == "rkmerson" ? "Runge–Kutta–Merson" : str(ref, "integrator"),
+      num(d(ref, "tolerance"), "{:.0e}"));
+  const auto& ch = ref.at("change_when_tolerance_halved").at("errors");
+  bool first = true;
+  for (const auto& q : s.at("quantities")) {
+    const std::string name = q.get<std::string>();
+    if (name == "mean_qdot" || !ch.contains(name)) continue;
+    out += fmt::format("{} {} by {}", first ? "" : " and", name == "qdot" ? "the speed" : name,
+                       pct(d(ch[name], "max_rel")));
+    first = false;
+  }
+  out += " of their peaks. ";
+  const auto& w = s.at("steady_window");
+  // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
+  const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
+  out += !w.value("whole_run", false) ? "Errors are maxima " + compared_over(s) + " (after the start-up transient)."
+         : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
+                                      : "The run has no steady cycles: errors are maxima over the whole run.";
+  return out;
+}
+
+std::string render_html(const json& s, const std::map<std::string, std::string>& figures) {
+  std::string h;
+  h += "<!DOCTYPE html><html lang=en><head><meta charset='utf-8'><title>rdyn validation: " +
+       H(str(s, "scene")) + "</title>";
+  h += "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 "
+       "1em;line-height:1.45;color:#222}"
+       "h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ccc}"
+       "table{border-collapse:collapse;font-size:.85em;margin:.5em 0}td,th{border:1px solid "
+       "#ccc;padding:2px 6px;"
+       "text-align:right}th{background:#f3f3f3}td.l{text-align:left}.lead{font-size:1.02em;"
+       "background:#f6f9ff;"
+       "padding:.8em;border-left:4px solid "
+       "#1f77b4}.warn{color:#a00}.pass{color:#070;font-weight:bold}.fail{color:#a00;"
+       "font-weight:bold}svg{max-width:100%;height:auto}code{background:#f3f3f3;padding:0 "
+       "3px}summary{cursor:pointer;"
+       "font-weight:bold}</style></head><body>";
+  const bool pass = str(s, "status") == "pass";
+  h += "<h1>rdyn validation: " + H(str(s, "scene")) +
+       " — <span class=" + (pass ? "pass>pass" : "fail>FAIL") + "</span></h1>";
+  if (!s.at("failures").empty()) {
+    h += "<ul>";
+    for (const auto& f : s.at("failures"))
+      h += "<li class=warn>" + H(f.get<std::string>()) + "</li>";
+    h += "</ul>";
+  }
+  h += verdict_table(s);
+  h += "<p class=lead>" + H(headline(s)) + "</p>";
+  if (!str(s, "note").empty())
+    h += "<p><b>What this scene tests:</b> " + H(str(s, "note")) + "</p>";
+  const auto& w = s.at("steady_window");
+  h += fmt::format(
+      "<p>Scene file: <code>{}</code>. Simulated {} s, output every {} s. Time scale: {}. Compared "
+      "window: {}. Samples lying between the two models' instants of a load switch (where the "
+      "force "
+      "jumps) are excluded from the error maxima and counted in <code>runs.csv</code>.</p>",
+      H(str(s, "scene_file")), num(d(s, "duration_s")), num(d(s, "output_interval_s")),
+      H(str(s.at("time_scale"), "how")), H(str(w, "how")));
+  h += s.value("per_second_measured", false)
+           ? "<p>Costs are given for the run as simulated and per simulated second (the run lasted "
+             "at least a second).</p>"
+           : "<p>Costs are given for the run as simulated only: it lasted less than a second, so a "
+             "per-second figure "
+             "would be an extrapolation.</p>";
+  h += "<h2>1. Reduced parameters</h2><p>m1, m2 of Eksergian's equation <code>m1 q̈ + m2 q̇² = "
+       "F*</code> and me1, me2 of "
+       "each constraint line <code>me1 q̈ + me2 q̇² = F_E + Q_x</code>, from kinetostatic calls of "
+       "the full model at 10°."
+       "</p>" +
+       (s.contains("figures") && s.at("figures").contains("params_samples")
+            ? svg_or_note(figures, "params")
+            : "<p>No table in this summary.</p>");
+  h += std::string(s.at("steady_window").value("whole_run", false)
+                       ? "<h2>2. Full and reduced model toward the end of the run</h2>"
+                       : "<h2>2. Full and reduced model over the last periods</h2>") +
+       svg_or_note(figures, "timeseries");
+  h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto") + baselines_note(s);
+  h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");
+  h += "<p>Observed orders (fitted above 10× the reference's own change, " +
+       pct(d(s.at("convergence"), "floor")) + "):";
+  for (const auto& ser : s.at("convergence").at("series")) {
+    const double o = d(ser, "order");
+    h += fmt::format(" {} {};", H(str(ser, "interpolation")),
+                     std::isfinite(o) ? fmt::format("{:.2f}", o) : "n/a");
+  }
+  h += " Below that floor an error measures the reference, not the table.</p>";
+  if (s.contains("calibration")) h += calibration_section(s);
+  if (!s.at("thresholds").empty()) {
+    h += "<h2>Acceptance thresholds</h2>";
+    if (s.value("thresholds_are_defaults", false))
+      h += "<p>The scene declares no thresholds: it is judged against the defaults (models/README.md, "
+           "\"Validation settings\").</p>";
+    h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
+         "th><th>run</th>"
+         "<th></th></tr>";
+    for (const auto& t : s.at("thresholds")) {
+      const bool p = t.value("pass", false);
+      h += fmt::format(
+          "<tr><td class=l>{}</td><td>{}°</td><td>{}</td><td>{}</td><td class=l>{}</td><td "
+          "class={}>{}</td>"
+          "</tr>",
+          H(str(t, "quantity")), num(d(t, "grid_deg")), pct(d(t, "max_error")), pct(d(t, "error")),
+          H(str(t, "run")), p ? "pass" : "fail", p ? "pass" : "FAIL");
+    }
+    h += "</table>";
+  }
+  h += fmt::format(
+      "<details><summary>All {} runs</summary><p>Median wall time of repeated runs (repeated until "
+      "a minimum "
+      "wall time) for the run as simulated; errors are maxima over the compared window relative to "
+      "the "
+      "reference's peak (RMS in <code>runs.csv</code>). ★: on the Pareto front of its model.</p>"
+      "<table><tr><th>run</th><th>wall time</th><th>repeats</th><th>steps</th><th>energy "
+      "residual</th>",
+      s.at("runs").size());
+  for (const auto& q : s.at("quantities")) h += "<th>" + H(q.get<std::string>()) + "</th>";
+  h += "</tr>";
+  for (const auto& r : s.at("runs")) {
+    if (!str(r, "failure").empty()) {
+      h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>",
+                       H(str(r, "label")), 4 + s.at("quantities").size(), H(str(r, "failure")));
+      continue;
+    }
+    h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
+                     r.value("pareto", false) ? "★ " : "", H(str(r, "label")), secs(d(r, "wall_s")),
+                     r.value("repeats", 0), r.value("steps", 0L),
+                     num(d(r, "energy_balance_residual_rel"), "{:.1e}"));
+    for (const auto& q : s.at("quantities"))
+      h += "<td>" + num(error_of(r, q.get<std::string>()), "{:.2e}") + "</td>";
+    h += "</tr>";
+  }
+  h += "</table></details><h2>Extraction "
+       "cost</h2><table><tr><th>grid</th><th>points</th><th>kinetostatic calls</th>"
+       "<th>time</th></tr>";
+  for (const auto& e : s.at("extractions"))
+    h += fmt::format("<tr><td>{}°</td><td>{}</td><td>{}</td><td>{} ms</td></tr>",
+                     num(d(e, "grid_deg")), e.value("points", 0), e.value("kinetostatic_calls", 0L),
+                     num(d(e, "ms"), "{:.3g}"));
+  h += "</table>";
+  h += "<h2>Files</h2><p><code>summary.json</code> (every number above and the data of every "
+       "figure; the report is "
+       "rendered from it alone), <code>runs.csv</code>, and for each figure its data "
+       "(<code>*.csv</code>) and gnuplot "
+       "script (<code>*.gp</code>): edit a script and run <code>gnuplot NAME.gp</code> in this "
+       "folder to restyle it.</p>"
+       "<p>Machine: " +
+       H(str(s, "machine")) + ".</p></body></html>\n";
+  return h;
+}
+
+void render_report(const json& s, const std::string& dir) {
+  write_text_file(dir + "/summary.json", s.dump(2) + "\n");
+  write_runs_csv(s, dir);
+  std::vector<std::string> names;
+  const json& fig = s.value("figures", json::object());
+  if (fig.contains("params_samples")) {
+    write_text_file(dir + "/params.csv", table_csv(fig.at("params_samples")));
+    write_text_file(dir + "/params_dense.csv", table_csv(fig.at("params_dense")));
+    write_text_file(dir + "/params.gp", params_gp(fig));
+    names.push_back("params");
+  }
+  if (fig.contains("timeseries")) {
+    write_text_file(dir + "/compare.csv", table_csv(fig.at("timeseries")));
+    write_text_file(dir + "/timeseries.gp", timeseries_gp(fig.at("timeseries")));
+    names.push_back("timeseries");
+  }
+  write_pareto(s, dir);
+  write_convergence(s, dir);
+  names.insert(names.end(), {"pareto", "convergence"});
+  // No shell: gnuplot gets an argument vector and runs in the report's folder (60 s each).
+  std::map<std::string, std::string> figures;
+  bool gnuplot_ok = true;
+  for (const auto& name : names) {
+    const auto run = run_program({"gnuplot", name + ".gp"}, dir, dir + "/gnuplot.log", 60.0);
+    gnuplot_ok &= run.ok();
+    figures[name] = read_text(dir + "/" + name + ".svg");
+  }
+  std::string html = render_html(s, figures);
+  if (!gnuplot_ok) {
+    const auto at = html.find("<h2>1.");
+    html.insert(at == std::string::npos ? 0 : at,
+                "<p class=warn>gnuplot reported errors; see gnuplot.log beside this report.</p>");
+  }
+  write_text_file(dir + "/report.html", html);
+}
+
+}  // namespace rdyn::validate
