@@ -100,7 +100,9 @@ bool newton_project(const FullModel::Impl& m, State& s) {
 // Position projection with the independent coordinate prescribed: the chord Newton iteration,
 // else Simbody's projectQ at 1e-12, else at 1e-9 (a singular configuration, counted). Throws
 // what projectQ throws when none succeeds (the callers name the coordinate).
-void project_prescribed(const FullModel::Impl& m, State& s) {
+void project_prescribed(FullWorkspace::Impl& w) {
+  const auto& m = w.model;
+  State& s = w.state;
   m.system.realize(s, Stage::Time);
   m.system.prescribeQ(s);
   if (newton_project(m, s)) return;
@@ -108,7 +110,7 @@ void project_prescribed(const FullModel::Impl& m, State& s) {
     m.system.projectQ(s, 1e-12);
   } catch (const std::exception&) {
     m.system.projectQ(s, 1e-9);  // singular configuration: as project()
-    ++m.near_singular_projections;
+    ++w.near_singular_projections;
   }
 }
 

@@ -28,9 +28,9 @@ double joint_part(const FullModel::Impl& m, const SimTK::State& s, const SimTK::
 
 // Position projection with the independent coordinate prescribed: a chord Newton iteration with
 // the predicted configuration's Jacobian, else Simbody's projectQ at 1e-12, else at 1e-9 (a
-// singular configuration, counted). Throws what projectQ throws when none succeeds (the callers
-// name the coordinate).
-void project_prescribed(const FullModel::Impl& m, SimTK::State& s);
+// singular configuration, counted in the workspace). Throws what projectQ throws when none
+// succeeds (the callers name the coordinate).
+void project_prescribed(FullWorkspace::Impl& w);
 
 // Near a singular configuration the rates carry the loop residual magnified by the
 // conditioning κ: positions by 1/κ, velocity ratios by 1/κ², m2 (second-order terms) by 1/κ³;

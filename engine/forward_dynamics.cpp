@@ -37,14 +37,14 @@ void initialize_gates(const FullModel::Impl& m, State& s) {
     m.system.realize(s, Stage::Velocity);
     const double rate = m.joint_u(s, j);
     if (std::abs(rate) > 1e-12) {
-      m.set_gate(s, static_cast<int>(i), gate->sign * rate > 0.0);
+      m.set_gate(s, static_cast<int>(i), models::gate_open(gate->sign, rate));
       continue;
     }
     m.set_gate(s, static_cast<int>(i), true);
     m.system.realize(s, Stage::Acceleration);
     const auto& mb = m.joint_mobod[j];
     const double acc = m.joint_fold[j] ? 0.0 : mb.getOneUDot(s, MobilizerUIndex(0));
-    m.set_gate(s, static_cast<int>(i), gate->sign * acc > 0.0);
+    m.set_gate(s, static_cast<int>(i), models::gate_open(gate->sign, acc));
   }
 }
 
@@ -85,7 +85,8 @@ State free_state(const FullModel& model, BranchGuard& guard, const PassagePoint&
   m.system.realizeModel(s);
   s.setTime(p.t);
   m.set_load_mode(s, kLoadsEvents);
-  m.forces.updZ(s)[m.work_index] = p.work;
+  m.set_work(s, p.work);
+  Value<long>::updDowncast(m.forces.updDiscreteVariable(s, m.indices->events)) = 0;
   initialize_gates(m, s);
   return s;
 }
@@ -122,7 +123,7 @@ double record_passage(const FullModel& model, BranchGuard& guard, const Independ
     const auto fm = calc_free_motion(model, guard, q, p.qdot, LimitStencil{});
     set_passage_state(model, guard, q, p.qdot, fm.qddot);
     State& st = guard.ws.impl().state;  // its time stays 0: the prescribed law is q + q̇ t + ½ q̈ t²
-    m.forces.updZ(st)[m.work_index] = p.work;
+    m.set_work(st, p.work);
     initialize_gates(m, st);
     record(m, st, ts);
     ts.t.back() = p.t;
@@ -259,7 +260,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
     throw models::NumericalError(std::string("cannot start the full model: ") + describe_simbody_exception(e));
   }
 
-  m.events_handled = 0;
+  long events_before_restarts = 0;  // gate switches counted in the States of earlier Simbody segments
   TimeSeries ts;
   for (const auto& c : m.scene.outputs.constraint_forces) ts.force_names.push_back(c.name);
   ts.forces.resize(ts.force_names.size());
@@ -324,6 +325,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
       if (i > n) break;
       // Simbody again, from the end of the passage.
       const long taken_before = integ->getNumStepsTaken(), attempted_before = integ->getNumStepsAttempted();
+      events_before_restarts += m.events(integ->getState());
       try {
         stepper.initialize(free_state(model, guard, end));  // EngineError too: caught below
         if (integ->getNumStepsAttempted() < attempted_before) {  // the statistics restarted too
@@ -418,7 +420,7 @@ TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
   ts.stats.steps_taken = steps_before_restarts + integ->getNumStepsTaken() + passage_steps;
   ts.stats.steps_attempted = attempts_before_restarts + integ->getNumStepsAttempted() + passage_steps;
   ts.stats.singular_passages = passages;
-  ts.stats.events = m.events_handled;
+  ts.stats.events = events_before_restarts + m.events(integ->getState());
   ts.stats.smallest_step_s = std::isfinite(smallest) ? smallest : 0.0;
   ts.stats.wall_time_s = wall();
 

@@ -35,7 +35,7 @@ class LawMotion : public Motion::Custom::Implementation {
   LawMotion(const FullModel::Impl& impl, int slot) : impl_(impl), slot_(slot) {}
   Motion::Level getLevel(const State&) const override { return Motion::Position; }
   void realizeTopology(State& s) const override {
-    auto& idx = impl_.law_index;
+    auto& idx = impl_.indices->law;
     if (static_cast<int>(idx.size()) <= slot_) idx.resize(slot_ + 1);
     idx[slot_] = impl_.matter.allocateDiscreteVariable(s, Stage::Time, new Value<Law>(Law(0)));
   }
@@ -51,7 +51,7 @@ class LawMotion : public Motion::Custom::Implementation {
 
  private:
   double eval(const State& s, int order) const {
-    const Law& c = Value<Law>::downcast(impl_.matter.getDiscreteVariable(s, impl_.law_index[slot_]));
+    const Law& c = Value<Law>::downcast(impl_.matter.getDiscreteVariable(s, impl_.indices->law[slot_]));
     const double t = s.getTime();
     if (c[0] == 0) {  // c1 + c2 t + ½ c3 t²
       return order == 0 ? c[1] + c[2] * t + 0.5 * c[3] * t * t : order == 1 ? c[2] + c[3] * t : c[3];
@@ -468,22 +468,26 @@ double FullModel::Impl::body_rate(const State& s, int b) const {
 }
 
 void FullModel::Impl::set_law(State& s, int which, const Law& law) const {
-  Value<Law>::updDowncast(matter.updDiscreteVariable(s, law_index[which])) = law;
+  Value<Law>::updDowncast(matter.updDiscreteVariable(s, indices->law[which])) = law;
 }
 
 void FullModel::Impl::set_load_mode(State& s, LoadMode mode) const {
-  Value<int>::updDowncast(forces.updDiscreteVariable(s, load_mode_index)) = mode;
+  Value<int>::updDowncast(forces.updDiscreteVariable(s, indices->load_mode)) = mode;
 }
 
 void FullModel::Impl::set_gate(State& s, int torque, bool on) const {
-  Value<bool>::updDowncast(forces.updDiscreteVariable(s, gate_index[torque])) = on;
+  Value<bool>::updDowncast(forces.updDiscreteVariable(s, indices->gate[torque])) = on;
 }
 
 bool FullModel::Impl::gate(const State& s, int torque) const {
-  return Value<bool>::downcast(forces.getDiscreteVariable(s, gate_index[torque]));
+  return Value<bool>::downcast(forces.getDiscreteVariable(s, indices->gate[torque]));
 }
 
-double FullModel::Impl::work(const State& s) const { return forces.getZ(s)[work_index]; }
+double FullModel::Impl::work(const State& s) const { return forces.getZ(s)[indices->work]; }
+void FullModel::Impl::set_work(State& s, double work_J) const { forces.updZ(s)[indices->work] = work_J; }
+long FullModel::Impl::events(const State& s) const {
+  return Value<long>::downcast(forces.getDiscreteVariable(s, indices->events));
+}
 
 std::vector<double> FullModel::Impl::constraint_forces(const State& s) const {
   const auto& req = scene.outputs.constraint_forces;

@@ -3,6 +3,7 @@
 
 #include <Simbody.h>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -52,14 +53,20 @@ struct FullModel::Impl {
   std::vector<std::pair<std::string, SimTK::Constraint>> constraints;
   int independent = -1;  // scene joint index
 
-  // Indices allocated at realizeTopology (mutable: set by the const realize callbacks).
-  mutable std::vector<SimTK::DiscreteVariableIndex> law_index;  // [0] independent, [1+k] slider k
-  mutable SimTK::DiscreteVariableIndex load_mode_index;
-  // Per load slot (joint torques, then point forces: load_gate): its gate flag.
-  mutable std::vector<SimTK::DiscreteVariableIndex> gate_index;
-  mutable SimTK::ZIndex work_index;
-  mutable long events_handled = 0;  // gate switches handled (forward dynamics statistics)
-  mutable long near_singular_projections = 0;  // kinetostatic projections that needed 1e-9
+  // Where this system's state variables live. Simbody allocates them in its const
+  // realizeTopology callbacks (LawMotion, SceneLoads), once per topology realization of this
+  // model's own system: a property of the built system, read by every run, never run state
+  // (each run's laws, load mode, gates, work and event count are values in its State).
+  struct StateIndices {
+    std::vector<SimTK::DiscreteVariableIndex> law;  // [0] independent, [1+k] slider k
+    SimTK::DiscreteVariableIndex load_mode;
+    // Per load slot (joint torques, then point forces: load_gate): its gate flag.
+    std::vector<SimTK::DiscreteVariableIndex> gate;
+    SimTK::DiscreteVariableIndex events;  // gate switches handled in this State's run
+    SimTK::ZIndex work;
+  };
+  // Owned here, filled by the callbacks through the pointer (the model stays const to runs).
+  std::unique_ptr<StateIndices> indices = std::make_unique<StateIndices>();
 
   SimTK::State default_state;
 
@@ -78,6 +85,8 @@ struct FullModel::Impl {
   void set_gate(SimTK::State& s, int torque, bool on) const;
   bool gate(const SimTK::State& s, int torque) const;
   double work(const SimTK::State& s) const;
+  void set_work(SimTK::State& s, double work_J) const;
+  long events(const SimTK::State& s) const;  // gate switches handled since the State's start
 
   // Requested constraint forces at a state realized to Acceleration [N].
   std::vector<double> constraint_forces(const SimTK::State& s) const;
@@ -98,6 +107,9 @@ struct FullWorkspace::Impl {
   bool anchor_set = false;
   double anchor_x = 0.0;
   SimTK::Vector anchor_q, anchor_dq, anchor_ddq;
+  // Projections of this workspace that needed the 1e-9 fallback (a singular configuration): the
+  // extraction flags a sample singular when its call raised this.
+  long near_singular_projections = 0;
   explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
 };
 

@@ -54,9 +54,11 @@ void remember(FullWorkspace::Impl& w, double q) {
   w.hist_n = std::min(w.hist_n + 1, 2);
 }
 
-// Applies the prescribed laws (already stored in the state) and projects q and u onto the
-// constraint manifold, starting from the predicted configuration.
-void project(const FullModel::Impl& m, State& s, double q_for_message) {
+// Applies the prescribed laws (already stored in the workspace's state) and projects q and u onto
+// the constraint manifold, starting from the predicted configuration; counts the fallbacks.
+void project(FullWorkspace::Impl& w, double q_for_message) {
+  const auto& m = w.model;
+  State& s = w.state;
   try {
     m.system.realize(s, Stage::Time);
     try {
@@ -65,7 +67,7 @@ void project(const FullModel::Impl& m, State& s, double q_for_message) {
       // At a singular configuration (e.g. a parallelogram's aligned position) the constraint
       // Jacobian loses rank and the projection stalls a little above 1e-12; accept 1e-9 there.
       m.system.project(s, 1e-9);
-      ++m.near_singular_projections;
+      ++w.near_singular_projections;
     }
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
@@ -149,7 +151,7 @@ KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, 
   m.set_law(s, 0, poly_law(q, qdot, qddot));
   for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
   m.set_load_mode(s, mode_of(loads));
-  project(m, s, q);
+  project(ws.impl(), q);
   return collect(m, s);
 }
 
@@ -194,7 +196,7 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
   if (with_q) {
     m.set_law(s, 0, poly_law(q, 1.0, 0.0));
     for (size_t k = 0; k < nx; ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
-    project(m, s, q);
+    project(ws.impl(), q);
     out.wrt_q = rates();
     m.system.realize(s, Stage::Velocity);
     out.length_wrt_q = point_force_rates(m, s);
@@ -202,7 +204,7 @@ VelocityRatios calc_velocity_ratios(const FullModel& model, FullWorkspace& ws, d
   for (size_t k = 0; k < nx && with_x; ++k) {
     m.set_law(s, 0, poly_law(q, 0.0, 0.0));
     for (size_t i = 0; i < nx; ++i) m.set_law(s, 1 + static_cast<int>(i), poly_law(0, i == k ? 1.0 : 0.0, 0));
-    project(m, s, q);
+    project(ws.impl(), q);
     out.wrt_x.push_back(rates());
     m.system.realize(s, Stage::Velocity);
     out.length_wrt_x.push_back(point_force_rates(m, s));
@@ -250,7 +252,7 @@ void follow_branch(const FullModel& model, FullWorkspace& ws, double q, double m
       m.set_law(s, 0, poly_law(x_new, 0.0, 0.0));
       bool converged = true;
       try {
-        project_prescribed(m, s);
+        project_prescribed(w);
       } catch (const std::exception&) {
         converged = false;
       }
@@ -316,11 +318,11 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
     const double d = revolute ? std::remainder(q - w.anchor_x, 2 * M_PI) : q - w.anchor_x;
     if (std::abs(d) <= max_extrapolation) s.updQ() = w.anchor_q + w.anchor_dq * d + w.anchor_ddq * (0.5 * d * d);
   }
-  const long singular_before = m.near_singular_projections;
+  const long singular_before = w.near_singular_projections;
   // Position: the Newton projection of the loops, the only iterative step. Velocities and
   // accelerations follow from linear solves with the Jacobian at the converged configuration.
   try {
-    project_prescribed(m, s);
+    project_prescribed(w);
   } catch (const std::exception& e) {
     throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
                                   "(dead point or a loop that cannot close): {}",
@@ -330,7 +332,7 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
   const int nu = s.getNU();
   KinetostaticSample out;
-  out.near_singular = m.near_singular_projections > singular_before;
+  out.near_singular = w.near_singular_projections > singular_before;
   // r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its accelerations),
   // from the Jacobian of this configuration (calc_branch_rates); the state is left at u = r.
   BranchRates first, polished;
@@ -463,7 +465,7 @@ KinetostaticResult calc_harmonic_sweep_point(const FullModel& model, FullWorkspa
   for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
   m.set_load_mode(s, mode_of(loads));
   s.setTime(t);
-  project(m, s, c[0] + c[1] * t + c[2] * std::cos(c[3] * t + c[4]));
+  project(ws.impl(), c[0] + c[1] * t + c[2] * std::cos(c[3] * t + c[4]));
   return collect(m, s);
 }
 

@@ -202,7 +202,7 @@ struct Run {
     std::fill(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody, 0.0);
     double P = 0.0;
     for (const auto& t : sc.joint_torques) {
-      if (t.active_when && !(t.active_when->sign * joint_u(sc.joint_index(t.active_when->joint)) > 0.0)) continue;
+      if (t.active_when && !models::gate_open(t.active_when->sign, joint_u(sc.joint_index(t.active_when->joint)))) continue;
       const int j = sc.joint_index(t.joint);
       // value·τ(θ_of) for a profiled load (models::calc_joint_torque), value otherwise.
       const double tau = models::calc_joint_torque(t, t.profile ? joint_q(sc.joint_index(t.profile->of)) : 0.0);
@@ -211,7 +211,7 @@ struct Run {
     }
     for (const auto& mo : sc.motors) {
       const int j = sc.joint_index(mo.joint);
-      const double u = joint_u(j), tau = mo.stall_torque * (1.0 - u / mo.no_load_speed);
+      const double u = joint_u(j), tau = models::motor_torque(mo.stall_torque, mo.no_load_speed, u);
       add_joint_force(j, tau);
       P += tau * u;
     }
@@ -227,7 +227,7 @@ struct Run {
     }
     // Point forces (engine/scene_loads.cpp): tension T·e on A, −T·e on B (e from A to B); power −T·L̇.
     for (const auto& f : sc.point_forces) {
-      if (f.active_when && !(f.active_when->sign * joint_u(sc.joint_index(f.active_when->joint)) > 0.0)) continue;
+      if (f.active_when && !models::gate_open(f.active_when->sign, joint_u(sc.joint_index(f.active_when->joint)))) continue;
       const int a = model.body_of(f.body_a), b = model.body_of(f.body_b);
       const auto pa = world_point(a, f.point_a), pb = world_point(b, f.point_b);
       const double dx = pb.x - pa.x, dy = pb.y - pa.y, L = std::hypot(dx, dy);
@@ -412,12 +412,12 @@ models::TimeSeries simulate_mujoco(const MujocoModel& model, const MujocoRunOpti
     int g = 0;
     for (const auto& t : im.scene.joint_torques) {
       if (!t.active_when) continue;
-      if (g < 32 && t.active_when->sign * run.joint_u(im.scene.joint_index(t.active_when->joint)) > 0.0) mask |= 1u << g;
+      if (g < 32 && models::gate_open(t.active_when->sign, run.joint_u(im.scene.joint_index(t.active_when->joint)))) mask |= 1u << g;
       ++g;
     }
     for (const auto& f : im.scene.point_forces) {  // after the torques, as the full model's slots
       if (!f.active_when) continue;
-      if (g < 32 && f.active_when->sign * run.joint_u(im.scene.joint_index(f.active_when->joint)) > 0.0) mask |= 1u << g;
+      if (g < 32 && models::gate_open(f.active_when->sign, run.joint_u(im.scene.joint_index(f.active_when->joint)))) mask |= 1u << g;
       ++g;
     }
     ts.gates.push_back(mask);

@@ -112,7 +112,7 @@ reduced::GridSample FullKinetostaticSource::sample(double q, bool with_conservat
 }
 
 reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_conservative) {
-  const long singular_before = model_.impl().near_singular_projections;
+  const long singular_before = ws_.impl().near_singular_projections;
   const auto k = calc_kinetostatic_sample(model_, ws_, q, extrapolation_, SampleParts::All);
   reduced::GridSample g;
   g.velocity = {k.m2, k.me2, k.ratio_q};
@@ -126,12 +126,12 @@ reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_cons
     g.conservative.forces.constraint_forces.assign(num_constraint_forces(), 0.0);
   }
   // Singular configuration: as sample_here.
-  g.singular = model_.impl().near_singular_projections > singular_before || k.conditioning < kSingularConditioning;
+  g.singular = ws_.impl().near_singular_projections > singular_before || k.conditioning < kSingularConditioning;
   return g;
 }
 
 reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_conservative) {
-  const long singular_before = model_.impl().near_singular_projections;
+  const long singular_before = ws_.impl().near_singular_projections;
   reduced::GridSample g;
   // (i) q̇ = 1, q̈ = 0: its joint rates are the velocity ratios wrt q (x fixed).
   const auto vel = calc_kinetostatic(model_, ws_, q, 1.0, 0.0, Loads::Off);
@@ -153,7 +153,7 @@ reduced::GridSample FullKinetostaticSource::sample_here(double q, bool with_cons
   g.ratios.joint_q = vel.joint_q;
   // Singular configuration: the loop Jacobian lost rank (or the projection needed its
   // fallback tolerance). The constraints do not determine the velocities there.
-  g.singular = model_.impl().near_singular_projections > singular_before ||
+  g.singular = ws_.impl().near_singular_projections > singular_before ||
                calc_loop_conditioning(model_, ws_) < kSingularConditioning;
   return g;
 }

@@ -15,7 +15,7 @@ namespace {
 Vec3 v3(models::Vec2 p) { return Vec3(p.x, p.y, 0); }
 
 int load_mode(const FullModel::Impl& m, const State& s) {
-  return Value<int>::downcast(m.forces.getDiscreteVariable(s, m.load_mode_index));
+  return Value<int>::downcast(m.forces.getDiscreteVariable(s, m.indices->load_mode));
 }
 
 // Whether load slot k (joint torques, then point forces) acts now.
@@ -24,7 +24,7 @@ bool load_active(const FullModel::Impl& m, const State& s, size_t k, int mode) {
   if (!g) return true;
   if (mode == kLoadsEvents) return m.gate(s, static_cast<int>(k));
   const double rate = m.joint_u(s, m.scene.joint_index(g->joint));
-  return g->sign * rate > 0.0;
+  return models::gate_open(g->sign, rate);
 }
 bool torque_active(const FullModel::Impl& m, const State& s, int i, int mode) {
   return load_active(m, s, static_cast<size_t>(i), mode);
@@ -58,17 +58,19 @@ class SceneLoads : public Force::Custom::Implementation {
   explicit SceneLoads(const FullModel::Impl& m) : m_(m) {}
 
   void realizeTopology(State& s) const override {
-    auto& mm = const_cast<FullModel::Impl&>(m_);
-    mm.load_mode_index = m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<int>(kLoadsEvents));
-    mm.gate_index.clear();
+    auto& idx = *m_.indices;
+    idx.load_mode = m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<int>(kLoadsEvents));
+    idx.gate.clear();
     for (size_t i = 0; i < num_load_slots(m_.scene); ++i)
-      mm.gate_index.push_back(m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<bool>(true)));
-    mm.work_index = m_.forces.allocateZ(s, Vector(1, 0.0));
+      idx.gate.push_back(m_.forces.allocateDiscreteVariable(s, Stage::Dynamics, new Value<bool>(true)));
+    // A statistic: changing it invalidates nothing the dynamics uses (Stage::Report).
+    idx.events = m_.forces.allocateDiscreteVariable(s, Stage::Report, new Value<long>(0));
+    idx.work = m_.forces.allocateZ(s, Vector(1, 0.0));
   }
 
   void realizeAcceleration(const State& s) const override {
     // dW/dt = power of the non-conservative loads (forward dynamics' work integral).
-    s.updZDot(m_.forces.getMySubsystemIndex())[m_.work_index] = non_conservative_power(m_, s);
+    s.updZDot(m_.forces.getMySubsystemIndex())[m_.indices->work] = non_conservative_power(m_, s);
   }
 
   void calcForce(const State& s, Vector_<SpatialVec>& body_forces, Vector_<Vec3>&,
@@ -112,7 +114,7 @@ class SceneLoads : public Force::Custom::Implementation {
     }
     for (const auto& mo : sc.motors) {
       const int j = sc.joint_index(mo.joint);
-      add_joint_force(m_, s, j, mo.stall_torque * (1.0 - m_.joint_u(s, j) / mo.no_load_speed), mobility);
+      add_joint_force(m_, s, j, models::motor_torque(mo.stall_torque, mo.no_load_speed, m_.joint_u(s, j)), mobility);
     }
     for (const auto& r : sc.resistances) {
       const int b = sc.body_index(r.body);
@@ -175,9 +177,9 @@ class GateSwitch : public TriggeredEventHandler {
     const auto& gate = *load_gate(m_.scene, static_cast<size_t>(torque_));
     const double rate = getValue(s);
     // The state handed over is just past the crossing; at an exact zero keep toggling.
-    const bool on = rate != 0.0 ? gate.sign * rate > 0.0 : !m_.gate(s, torque_);
+    const bool on = rate != 0.0 ? models::gate_open(gate.sign, rate) : !m_.gate(s, torque_);
     m_.set_gate(s, torque_, on);
-    ++m_.events_handled;
+    ++Value<long>::updDowncast(m_.forces.updDiscreteVariable(s, m_.indices->events));
   }
 
  private:
@@ -203,7 +205,7 @@ double non_conservative_power(const FullModel::Impl& m, const State& s) {
   }
   for (const auto& mo : sc.motors) {
     const double u = m.joint_u(s, sc.joint_index(mo.joint));
-    P += mo.stall_torque * (1.0 - u / mo.no_load_speed) * u;
+    P += models::motor_torque(mo.stall_torque, mo.no_load_speed, u) * u;
   }
   for (const auto& r : sc.resistances) {
     const double w = m.body_rate(s, sc.body_index(r.body));

@@ -386,6 +386,15 @@ inline double resistance_torque(ResistanceLaw law, double c, double w) {
   }
   return 0.0;
 }
+
+// A motor's torque–speed line at its joint's rate u [N·m at rad/s, or N at m/s]: τ_stall (1 − u/u₀),
+// u₀ the no-load speed (sign included). The one formula of the full model, the MuJoCo peer and
+// the reduced model.
+inline double motor_torque(double stall, double no_load_speed, double u) { return stall * (1.0 - u / no_load_speed); }
+
+// A rate gate is open while sign·rate > 0 (RateGate: sign +1 for `rate: positive`, −1 for
+// `negative`); at rest it is closed, and the integrators decide the start from the acceleration.
+inline bool gate_open(double sign, double rate) { return sign * rate > 0.0; }
 // Exponent n of the dissipated power P = c·ωⁿ (1 constant, 2 viscous, 3 quadratic).
 int dissipation_exponent(ResistanceLaw law);
 

@@ -168,7 +168,7 @@ void acceleration_from(const ReducedModel& m, const ReducedWorkspace& ws, const 
   }
   for (const auto& mo : m.motors) {
     const double u = *r * qdot;  // joint rate
-    F_nc += mo.stall * (1.0 - u / mo.no_load_speed) * *r;
+    F_nc += models::motor_torque(mo.stall, mo.no_load_speed, u) * *r;
     ++r;
   }
   for (const auto& b : m.brakes) {
@@ -325,7 +325,7 @@ double outputs_from(const ReducedModel& m, const ReducedWorkspace& ws, const dou
       c += t.c_tau >= 0 ? 2 : 1;
     }
     for (const auto& mo : m.motors) {
-      Qx += mo.stall * (1.0 - c[0] * qdot / mo.no_load_speed) * c[1];
+      Qx += models::motor_torque(mo.stall, mo.no_load_speed, c[0] * qdot) * c[1];
       c += 2;
     }
     for (const auto& b : m.brakes) {

@@ -190,13 +190,15 @@ TEST(SceneYaml, MissingSceneFileIsNamed) {
 TEST(SceneYaml, EveryShippedSceneAndTheGeneratorPassTheChecks) {
   // Names, ranges and duplicate keys are checked: every scene shipped must still load.
   int n = 0;
-  for (const char* dir : {RDYN_SCENES, RDYN_SCENES "/hard"})
+  for (const char* dir : {RDYN_SCENES, RDYN_SCENES "/hard", RDYN_SCENES "/chains"})
     for (const auto& f : std::filesystem::directory_iterator(dir))
       if (f.path().extension() == ".yaml") {
         EXPECT_NO_THROW(load_scene(f.path().string())) << f.path();
         ++n;
       }
-  EXPECT_EQ(n, 16);  // 8 scenes (bicycle-profile and bicycle-muscle included) + 8 hard ones
+  // 8 scenes (bicycle-profile and bicycle-muscle included) + 10 hard ones (chain-1 and chain-3
+  // among them) + 4 chains.
+  EXPECT_EQ(n, 22);
 }
 
 TEST(SceneYaml, DuplicateKeysAreRefusedWithTheirLineAndPath) {

@@ -461,7 +461,7 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
       for (size_t k = 0; k < m.motors.size(); ++k) {
         const auto& mo = m.motors[k];
         const double r_j = m.table.eval(mo.c_r, q);
-        const double w = mo.stall * (1.0 - r_j * qd / mo.no_load_speed) * r_j * dq;
+        const double w = models::motor_torque(mo.stall, mo.no_load_speed, r_j * qd) * r_j * dq;
         if (selected_motor[k]) {
           W_unit += w;
           W_scale += std::abs(r_j) * dq;
@@ -660,7 +660,7 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scen
     for (size_t i = 0; i + 1 < cyc.t.size(); ++i) {
       auto p = [&](size_t k) {
         const double u = m.table.eval(mo.c_r, cyc.q[k]) * cyc.qdot[k];
-        return mo.stall * (1.0 - u / mo.no_load_speed) * u;
+        return models::motor_torque(mo.stall, mo.no_load_speed, u) * u;
       };
       E += 0.5 * (p(i) + p(i + 1)) * (cyc.t[i + 1] - cyc.t[i]);
     }
