@@ -223,218 +223,279 @@ void check_branch(const FullModel& model, BranchGuard& guard, const State& s, do
 
 }  // namespace
 
-TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
-  const auto& m = model.impl();
-  check_options(opt);
-  const auto start = std::chrono::steady_clock::now();
-  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+namespace {
 
-  // The validity domain of the independent coordinate: a run that leaves it stops (exit 1),
-  // as the reduced model stops at its table's edge (reduced/simulate_reduced.cpp).
-  const IndependentDomain domain = opt.domain ? *opt.domain : calc_independent_domain(model);
+// One forward-dynamics run: Simbody's integrator between singular passages, the passages in the
+// partitioned formulation, the output rows, the budgets and the statistics. The run's own
+// workspace (the model stays const); simulate_full drives it stage by stage.
+class FullRun {
+ public:
+  FullRun(const FullModel& model, const ForwardOptions& opt)
+      : model_(model), m_(model.impl()), opt_(opt), start_(std::chrono::steady_clock::now()),
+        // The validity domain of the independent coordinate: a run that leaves it stops (exit
+        // 1), as the reduced model stops at its table's edge (reduced/simulate_reduced.cpp).
+        domain_(opt.domain ? *opt.domain : calc_independent_domain(model)), guard_(model),
+        singular_(opt.singular_passages ? domain_.singular : std::vector<SingularPoint>{}),
+        integ_(make_integrator(m_, opt.integrator)), stepper_(m_.system, *integ_),
+        n_(models::calc_output_rows(opt.duration_s, opt.output_interval_s)) {}
 
-  // Consistent initial state: a kinetostatic projection at (q0, q̇0), then the independent
-  // coordinate is released.
-  // The workspace then stays with the branch guard, which continues it along the starting branch.
-  BranchGuard guard(model);
-  State s = free_state(model, guard, {0.0, m.scene.initial.q, m.scene.initial.qdot, 0.0});
+  // The consistent initial state (a kinetostatic projection at (q0, q̇0) in the branch guard's
+  // workspace, which then continues along the starting branch), the integrator and row 0.
+  void start();
+  // Rows until the run's end: Simbody up to each output time, a passage where a step touches a
+  // window around a configuration of rank loss.
+  void run();
+  // Statistics and the run's own energy-balance check.
+  TimeSeries finish();
 
-  auto integ = make_integrator(m, opt.integrator);
-  integ->setAccuracy(opt.tolerance);
-  integ->setConstraintTolerance(std::min(1e-10, opt.tolerance));
-  // Return after every internal step: to track the smallest step, and so that the step and
-  // wall-time budgets are checked between steps, not only between outputs.
-  integ->setReturnEveryInternalStep(true);
-  // Step freely and interpolate (then project) the states at output times, rather than
-  // shortening steps to land on them: the full model's cheapest honest setting.
-  integ->setAllowInterpolation(true);
-  integ->setProjectInterpolatedStates(true);
-  TimeStepper stepper(m.system, *integ);
-  // TimeStepper::stepTo otherwise swallows the integrator's per-step returns and comes back
-  // only at the output time (Simbody 3.7 TimeStepperRep::stepTo loops until then), so a
-  // single output interval of microscopic steps would never reach the budget checks below.
-  stepper.setReportAllSignificantStates(true);
-  try {
-    stepper.initialize(s);
-  } catch (const std::exception& e) {
-    throw models::NumericalError(std::string("cannot start the full model: ") + describe_simbody_exception(e));
-  }
+ private:
+  double wall() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  double output_time(long i) const { return models::calc_output_time(i, n_, opt_.duration_s, opt_.output_interval_s); }
+  // Simbody's steps to output time t; false when a step touched a window (passage_ is then set to
+  // the state before it, which was taken back).
+  bool step_to(double t);
+  void check_domain(double t_before, double q_before);
+  void check_budgets(double h);
+  void record_row();
+  // The partitioned formulation from passage_ until out of the windows; Simbody restarts there.
+  void cross_passage();
+  void restart(const PassagePoint& end);
 
-  long events_before_restarts = 0;  // gate switches counted in the States of earlier Simbody segments
-  TimeSeries ts;
-  for (const auto& c : m.scene.outputs.constraint_forces) ts.force_names.push_back(c.name);
-  ts.forces.resize(ts.force_names.size());
-  ts.column_names = reduced::joint_output_names(m.scene);
-  ts.columns.resize(ts.column_names.size());
-  const long n = models::calc_output_rows(opt.duration_s, opt.output_interval_s);  // the last at t = duration
-  record(m, integ->getState(), ts);
-  check_finite_row(ts);
+  const FullModel& model_;
+  const FullModel::Impl& m_;
+  const ForwardOptions& opt_;
+  const std::chrono::steady_clock::time_point start_;
+  const IndependentDomain domain_;
+  BranchGuard guard_;
+  const std::vector<SingularPoint> singular_;
+  std::unique_ptr<Integrator> integ_;
+  TimeStepper stepper_;
+  const long n_;  // output rows after t = 0, the last at t = duration
+  long i_ = 1;    // the next output row
+  TimeSeries ts_;
   // Largest kinetic energy and |W| seen [J]: with max|E| the scale of the energy-balance test.
   // max|E| alone fails where E ≡ 0 by the choice of datum (a pendulum released from the
   // horizontal through its pivot's height): the residual is then rounding over ~0.
-  double motion_scale_J = m.system.calcKineticEnergy(integ->getState());
-  double smallest = INFINITY;
-  long calls = 0;  // stepTo calls: bounded even if a call were to return without a step
+  double motion_scale_J_ = 0.0;
+  double smallest_ = INFINITY;
+  long calls_ = 0;  // stepTo calls: bounded even if a call were to return without a step
+  double window_t0_ = 0.0;
+  std::vector<Vec3> line_dir_;  // point forces' directions after the last step
+  std::optional<PassagePoint> passage_;  // set: start the partitioned formulation here
+  // Counts of the Simbody segments before the last restart, and of the passages.
+  long passage_steps_ = 0, passages_ = 0, steps_before_ = 0, attempts_before_ = 0, events_before_ = 0;
+};
+
+void FullRun::start() {
+  const State s = free_state(model_, guard_, {0.0, m_.scene.initial.q, m_.scene.initial.qdot, 0.0});
+  integ_->setAccuracy(opt_.tolerance);
+  integ_->setConstraintTolerance(std::min(1e-10, opt_.tolerance));
+  // Return after every internal step: to track the smallest step, and so that the step and
+  // wall-time budgets are checked between steps, not only between outputs.
+  integ_->setReturnEveryInternalStep(true);
+  // Step freely and interpolate (then project) the states at output times, rather than
+  // shortening steps to land on them: the full model's cheapest honest setting.
+  integ_->setAllowInterpolation(true);
+  integ_->setProjectInterpolatedStates(true);
+  // TimeStepper::stepTo otherwise swallows the integrator's per-step returns and comes back
+  // only at the output time (Simbody 3.7 TimeStepperRep::stepTo loops until then), so a
+  // single output interval of microscopic steps would never reach the budget checks below.
+  stepper_.setReportAllSignificantStates(true);
+  try {
+    stepper_.initialize(s);
+  } catch (const std::exception& e) {
+    throw models::NumericalError(std::string("cannot start the full model: ") + describe_simbody_exception(e));
+  }
+  for (const auto& c : m_.scene.outputs.constraint_forces) ts_.force_names.push_back(c.name);
+  ts_.forces.resize(ts_.force_names.size());
+  ts_.column_names = reduced::joint_output_names(m_.scene);
+  ts_.columns.resize(ts_.column_names.size());
+  record(m_, integ_->getState(), ts_);
+  check_finite_row(ts_);
+  motion_scale_J_ = m_.system.calcKineticEnergy(integ_->getState());
+  m_.system.realize(integ_->getState(), Stage::Position);
+  check_point_force_lines(m_, integ_->getState(), line_dir_);
+  // Started inside a window (near, not at, a configuration of rank loss).
+  if (!singular_.empty() && !outside_windows(singular_, domain_.periodic, m_.scene.initial.q))
+    passage_ = PassagePoint{0.0, m_.scene.initial.q, m_.scene.initial.qdot, 0.0};
+}
+
+void FullRun::run() {
+  while (i_ <= n_) {
+    if (passage_) {
+      cross_passage();
+      continue;
+    }
+    if (!step_to(output_time(i_))) continue;
+    record_row();
+    ++i_;
+  }
+}
+
+bool FullRun::step_to(double t) {
+  try {
+    while (integ_->getTime() < t - 1e-14) {
+      const double t_before = integ_->getTime(), q_before = m_.joint_q(integ_->getState(), m_.independent);
+      std::optional<State> before;
+      if (!singular_.empty()) before = integ_->getState();
+      stepper_.stepTo(t);
+      if (before) {
+        const double q_adv = m_.joint_q(integ_->getAdvancedState(), m_.independent);
+        if (find_window(singular_, domain_.periodic, q_before, q_adv) >= 0) {
+          passage_ = PassagePoint{t_before, q_before, m_.joint_u(*before, m_.independent), m_.work(*before)};
+          return false;
+        }
+      }
+      const double h = integ_->getPreviousStepSizeTaken();
+      if (!line_dir_.empty()) check_point_force_lines(m_, integ_->getState(), line_dir_);
+      check_domain(t_before, q_before);
+      if (h > 0) smallest_ = std::min(smallest_, h);
+      check_budgets(h);
+    }
+  } catch (const models::NumericalError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // Simbody turns a force's refusal (a point force at zero length) into failed steps: name
+    // the point force when that is where the integrator got stuck.
+    if (!line_dir_.empty()) {
+      State last = integ_->getState();
+      m_.system.realize(last, Stage::Position);
+      check_point_force_lines(m_, last, line_dir_);
+    }
+    throw models::NumericalError(fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}",
+                                             integ_->getTime(), integ_->getPreviousStepSizeTaken(),
+                                             describe_simbody_exception(e)));
+  }
+  return true;
+}
+
+void FullRun::check_domain(double t_before, double q_before) {
+  if (domain_.periodic) return;
+  const double q_now = m_.joint_q(integ_->getState(), m_.independent);
+  if (!(q_now < domain_.min || q_now > domain_.max)) return;
+  // Crossing time by linear interpolation inside the step (for the message only).
+  const bool low = q_now < domain_.min;
+  const double edge = low ? domain_.min : domain_.max;
+  const double t_cross = t_before + (integ_->getTime() - t_before) * (edge - q_before) / (q_now - q_before);
+  throw models::NumericalError(fmt::format("full model left the validity domain at {} ({}) at t = {:.6g} s",
+                                           format_coordinate(edge, domain_.revolute),
+                                           low ? domain_.min_edge : domain_.max_edge, t_cross));
+}
+
+void FullRun::check_budgets(double h) {
   // Hopeless runs fail early: every kWindow steps, the steps still needed at the window's
   // mean step size; more than kHopeless budgets (a margin for start-up transients and event
   // localization, which shrink steps for a while) will not finish, so stop now instead of
   // after the wall-time budget (a c1 = 1e9 N·m·s resistance: 600 s → < 1 s, measured).
   constexpr long kWindow = 1000;
   constexpr double kHopeless = 100.0;
-  double window_t0 = 0.0;
-  std::vector<Vec3> line_dir;  // point forces' directions after the last step
-  m.system.realize(integ->getState(), Stage::Position);
-  check_point_force_lines(m, integ->getState(), line_dir);
-  // Singular passages (engine/singular_passage.hpp): a step that touches a window around a
-  // configuration of rank loss is taken back and the window is crossed in the partitioned
-  // formulation; Simbody restarts beyond it.
-  const bool periodic = domain.periodic;
-  static const std::vector<SingularPoint> kNone;
-  const auto& singular = opt.singular_passages ? domain.singular : kNone;
-  std::optional<PassagePoint> passage;  // set: start the partitioned formulation here
-  if (!singular.empty() && !outside_windows(singular, periodic, m.scene.initial.q))
-    passage = PassagePoint{0.0, m.scene.initial.q, m.scene.initial.qdot, 0.0};
-  long passage_steps = 0, passages = 0, steps_before_restarts = 0, attempts_before_restarts = 0;
-  for (long i = 1; i <= n;) {
-    if (passage) {
-      PassageOptions po;
-      po.tolerance = opt.tolerance;
-      po.t_end = opt.duration_s;
-      po.max_steps = std::max(1L, opt.max_steps - passage_steps - steps_before_restarts - integ->getNumStepsAttempted());
-      po.max_wall_s = std::max(0.0, opt.max_wall_s - wall());
-      long taken = 0;
-      PassagePoint end;
-      try {
-        end = integrate_passage(
-          model, guard, singular, periodic, *passage, po,
-          [&] { return i <= n ? models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s) : INFINITY; },
-          [&](const PassagePoint& p) {
-            const double kinetic_J = record_passage(model, guard, domain, p, ts);
-            check_finite_row(ts);
-            motion_scale_J = std::max({motion_scale_J, kinetic_J, std::abs(ts.work.back())});
-            ++i;
-          },
-          taken);
-      } catch (const EngineError& e) {  // the continuation failed: numerical, not the input
-        throw models::NumericalError(fmt::format("full model's singular passage from t = {:.6g} s failed: {}",
-                                                 passage->t, e.what()));
-      }
-      passage_steps += taken;
-      ++passages;
-      passage.reset();
-      if (i > n) break;
-      // Simbody again, from the end of the passage.
-      const long taken_before = integ->getNumStepsTaken(), attempted_before = integ->getNumStepsAttempted();
-      events_before_restarts += m.events(integ->getState());
-      try {
-        stepper.initialize(free_state(model, guard, end));  // EngineError too: caught below
-        if (integ->getNumStepsAttempted() < attempted_before) {  // the statistics restarted too
-          steps_before_restarts += taken_before;
-          attempts_before_restarts += attempted_before;
-        }
-      } catch (const std::exception& e) {
-        throw models::NumericalError(fmt::format("full model could not restart after the singular passage at t = "
-                                                 "{:.6g} s: {}",
-                                                 end.t, describe_simbody_exception(e)));
-      }
-      line_dir.clear();
-      m.system.realize(integ->getState(), Stage::Position);
-      check_point_force_lines(m, integ->getState(), line_dir);
-      continue;
-    }
-    const double t = models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s);
-    try {
-      while (integ->getTime() < t - 1e-14) {
-        const double t_before = integ->getTime(), q_before = m.joint_q(integ->getState(), m.independent);
-        std::optional<State> before;
-        if (!singular.empty()) before = integ->getState();
-        stepper.stepTo(t);
-        if (before) {
-          const double q_adv = m.joint_q(integ->getAdvancedState(), m.independent);
-          if (find_window(singular, periodic, q_before, q_adv) >= 0) {
-            passage = PassagePoint{t_before, q_before, m.joint_u(*before, m.independent), m.work(*before)};
-            break;
-          }
-        }
-        const double h = integ->getPreviousStepSizeTaken();
-        if (!line_dir.empty()) check_point_force_lines(m, integ->getState(), line_dir);
-        if (!domain.periodic) {
-          const double q_now = m.joint_q(integ->getState(), m.independent);
-          if (q_now < domain.min || q_now > domain.max) {
-            // Crossing time by linear interpolation inside the step (for the message only).
-            const bool low = q_now < domain.min;
-            const double edge = low ? domain.min : domain.max;
-            const double t_cross = t_before + (integ->getTime() - t_before) * (edge - q_before) / (q_now - q_before);
-            throw models::NumericalError(fmt::format(
-                "full model left the validity domain at {} ({}) at t = {:.6g} s", format_coordinate(edge, domain.revolute),
-                low ? domain.min_edge : domain.max_edge, t_cross));
-          }
-        }
-        if (h > 0) smallest = std::min(smallest, h);
-        const long steps =
-            std::max<long>(++calls, attempts_before_restarts + integ->getNumStepsAttempted()) + passage_steps;
-        const double w = wall();
-        if (calls % kWindow == 0) {
-          const double now = integ->getTime(), mean_h = (now - window_t0) / kWindow;
-          const double needed = steps + (opt.duration_s - now) / std::max(mean_h, 1e-300);
-          window_t0 = now;
-          if (needed > kHopeless * static_cast<double>(opt.max_steps))
-            throw models::NumericalError(fmt::format(
-                "full model stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) "
-                "it would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or "
-                "too fast for '{}' at tolerance {:g}",
-                now, opt.duration_s, kWindow, mean_h, needed, kHopeless, opt.max_steps, opt.integrator,
-                opt.tolerance));
-        }
-        if (steps > opt.max_steps || w > opt.max_wall_s || !std::isfinite(integ->getTime()))
-          throw models::NumericalError(fmt::format(
-              "full model stopped at t = {:.6g} s of {:.6g} s: {} (last step {:.3g} s, smallest {:.3g} s): the "
-              "motion is too stiff or too fast for '{}' at tolerance {:g}",
-              integ->getTime(), opt.duration_s,
-              steps > opt.max_steps ? fmt::format("step budget of {} steps exhausted", opt.max_steps)
-                                    : fmt::format("wall-time budget of {:g} s exhausted", opt.max_wall_s),
-              h, std::isfinite(smallest) ? smallest : 0.0, opt.integrator, opt.tolerance));
-      }
-    } catch (const models::NumericalError&) {
-      throw;
-    } catch (const std::exception& e) {
-      // Simbody turns a force's refusal (a point force at zero length) into failed steps: name
-      // the point force when that is where the integrator got stuck.
-      if (!line_dir.empty()) {
-        State last = integ->getState();
-        m.system.realize(last, Stage::Position);
-        check_point_force_lines(m, last, line_dir);
-      }
-      throw models::NumericalError(
-          fmt::format("full model failed at t = {:.6g} s (last step {:.3g} s): {}", integ->getTime(),
-                      integ->getPreviousStepSizeTaken(), describe_simbody_exception(e)));
-    }
-    if (passage) continue;
-    record(m, integ->getState(), ts);
-    check_finite_row(ts);
-    if (opt.branch_guard) check_branch(model, guard, integ->getState(), ts.t[ts.t.size() - 2]);
-    motion_scale_J = std::max(
-        {motion_scale_J, m.system.calcKineticEnergy(integ->getState()), std::abs(ts.work.back())});
-    ++i;
+  const long steps = std::max<long>(++calls_, attempts_before_ + integ_->getNumStepsAttempted()) + passage_steps_;
+  const double w = wall();
+  if (calls_ % kWindow == 0) {
+    const double now = integ_->getTime(), mean_h = (now - window_t0_) / kWindow;
+    const double needed = steps + (opt_.duration_s - now) / std::max(mean_h, 1e-300);
+    window_t0_ = now;
+    if (needed > kHopeless * static_cast<double>(opt_.max_steps))
+      throw models::NumericalError(fmt::format(
+          "full model stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) it "
+          "would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or too fast for "
+          "'{}' at tolerance {:g}",
+          now, opt_.duration_s, kWindow, mean_h, needed, kHopeless, opt_.max_steps, opt_.integrator, opt_.tolerance));
   }
-  ts.stats.steps_taken = steps_before_restarts + integ->getNumStepsTaken() + passage_steps;
-  ts.stats.steps_attempted = attempts_before_restarts + integ->getNumStepsAttempted() + passage_steps;
-  ts.stats.singular_passages = passages;
-  ts.stats.events = events_before_restarts + m.events(integ->getState());
-  ts.stats.smallest_step_s = std::isfinite(smallest) ? smallest : 0.0;
-  ts.stats.wall_time_s = wall();
+  if (steps > opt_.max_steps || w > opt_.max_wall_s || !std::isfinite(integ_->getTime()))
+    throw models::NumericalError(fmt::format(
+        "full model stopped at t = {:.6g} s of {:.6g} s: {} (last step {:.3g} s, smallest {:.3g} s): the motion is "
+        "too stiff or too fast for '{}' at tolerance {:g}",
+        integ_->getTime(), opt_.duration_s,
+        steps > opt_.max_steps ? fmt::format("step budget of {} steps exhausted", opt_.max_steps)
+                               : fmt::format("wall-time budget of {:g} s exhausted", opt_.max_wall_s),
+        h, std::isfinite(smallest_) ? smallest_ : 0.0, opt_.integrator, opt_.tolerance));
+}
 
+void FullRun::record_row() {
+  record(m_, integ_->getState(), ts_);
+  check_finite_row(ts_);
+  if (opt_.branch_guard) check_branch(model_, guard_, integ_->getState(), ts_.t[ts_.t.size() - 2]);
+  motion_scale_J_ = std::max(
+      {motion_scale_J_, m_.system.calcKineticEnergy(integ_->getState()), std::abs(ts_.work.back())});
+}
+
+void FullRun::cross_passage() {
+  PassageOptions po;
+  po.tolerance = opt_.tolerance;
+  po.t_end = opt_.duration_s;
+  po.max_steps = std::max(1L, opt_.max_steps - passage_steps_ - attempts_before_ - integ_->getNumStepsAttempted());
+  po.max_wall_s = std::max(0.0, opt_.max_wall_s - wall());
+  long taken = 0;
+  PassagePoint end;
+  try {
+    end = integrate_passage(
+        model_, guard_, singular_, domain_.periodic, *passage_, po,
+        [&] { return i_ <= n_ ? output_time(i_) : INFINITY; },
+        [&](const PassagePoint& p) {
+          const double kinetic_J = record_passage(model_, guard_, domain_, p, ts_);
+          check_finite_row(ts_);
+          motion_scale_J_ = std::max({motion_scale_J_, kinetic_J, std::abs(ts_.work.back())});
+          ++i_;
+        },
+        taken);
+  } catch (const EngineError& e) {  // the continuation failed: numerical, not the input
+    throw models::NumericalError(
+        fmt::format("full model's singular passage from t = {:.6g} s failed: {}", passage_->t, e.what()));
+  }
+  passage_steps_ += taken;
+  ++passages_;
+  passage_.reset();
+  if (i_ <= n_) restart(end);
+}
+
+void FullRun::restart(const PassagePoint& end) {
+  const long taken_before = integ_->getNumStepsTaken(), attempted_before = integ_->getNumStepsAttempted();
+  events_before_ += m_.events(integ_->getState());
+  try {
+    stepper_.initialize(free_state(model_, guard_, end));  // EngineError too: caught below
+    if (integ_->getNumStepsAttempted() < attempted_before) {  // the statistics restarted too
+      steps_before_ += taken_before;
+      attempts_before_ += attempted_before;
+    }
+  } catch (const std::exception& e) {
+    throw models::NumericalError(fmt::format("full model could not restart after the singular passage at t = "
+                                             "{:.6g} s: {}",
+                                             end.t, describe_simbody_exception(e)));
+  }
+  line_dir_.clear();
+  m_.system.realize(integ_->getState(), Stage::Position);
+  check_point_force_lines(m_, integ_->getState(), line_dir_);
+}
+
+TimeSeries FullRun::finish() {
+  ts_.stats.steps_taken = steps_before_ + integ_->getNumStepsTaken() + passage_steps_;
+  ts_.stats.steps_attempted = attempts_before_ + integ_->getNumStepsAttempted() + passage_steps_;
+  ts_.stats.singular_passages = passages_;
+  ts_.stats.events = events_before_ + m_.events(integ_->getState());
+  ts_.stats.smallest_step_s = std::isfinite(smallest_) ? smallest_ : 0.0;
+  ts_.stats.wall_time_s = wall();
   // The run checks itself: E(t) − E(0) = W(t) must hold to a fraction of the energy.
-  const auto eb = models::energy_balance(ts);
-  const double scale_J = std::max(eb.energy_scale_J, motion_scale_J);
-  if (!(eb.max_residual_J <= opt.energy_tolerance * scale_J + kEnergyFloor_J))
+  const auto eb = models::energy_balance(ts_);
+  const double scale_J = std::max(eb.energy_scale_J, motion_scale_J_);
+  if (!(eb.max_residual_J <= opt_.energy_tolerance * scale_J + kEnergyFloor_J))
     throw models::NumericalError(fmt::format(
         "full model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
         "energy scale {:.3g} J (largest |E|, kinetic energy or |W|; limit {:g} %): the integration lost or invented "
         "energy ('{}' at tolerance {:g}; try a tighter tolerance or cpodes)",
         eb.max_residual_J, eb.worst_time_s, 100 * eb.max_residual_J / std::max(scale_J, kEnergyFloor_J), scale_J,
-        100 * opt.energy_tolerance, opt.integrator, opt.tolerance));
-  return ts;
+        100 * opt_.energy_tolerance, opt_.integrator, opt_.tolerance));
+  return std::move(ts_);
+}
+
+}  // namespace
+
+TimeSeries simulate_full(const FullModel& model, const ForwardOptions& opt) {
+  check_options(opt);
+  FullRun run(model, opt);
+  run.start();
+  run.run();
+  return run.finish();
 }
 
 }  // namespace rdyn::engine
