@@ -250,4 +250,22 @@ DriveStats calc_drive_stats(const DriveRecord& r) {
   return s;
 }
 
+MotorCheck calc_motor_check(const DriveRecord& r, double stall, double no_load_speed) {
+  MotorCheck c;
+  c.stall = stall, c.no_load_speed = no_load_speed;
+  const double sign = stall > 0 ? 1.0 : -1.0;
+  c.min_margin = INFINITY;
+  for (size_t i = 0; i < r.drive.size(); ++i) {
+    const double line = models::motor_torque(stall, no_load_speed, r.qdot[i]);
+    const double margin = sign * (line - r.drive[i]);
+    if (margin < c.min_margin) {
+      c.min_margin = margin, c.at_t = r.t[i], c.at_q = r.q[i];
+      c.drive_there = r.drive[i], c.line_there = line;
+    }
+  }
+  c.covers = c.min_margin >= 0;
+  c.min_margin_fraction = c.min_margin / std::abs(stall);
+  return c;
+}
+
 }  // namespace rdyn::validate

@@ -65,4 +65,20 @@ struct DriveStats {
 };
 DriveStats calc_drive_stats(const DriveRecord& r);
 
+// Whether a motor on the independent coordinate, with the torque–speed line
+// τ_line(q̇) = stall·(1 − q̇/no_load_speed) (models::motor_torque; stall and no-load speed of one
+// sign, as a scene's motor), can give the drive along the motion: at full command it gives the
+// line, so it covers a row when the drive lies on the line's side of zero and within it —
+// sgn(stall)·(τ_line − drive) ≥ 0 — the catalogue question "is the operating point under the
+// torque–speed curve". Margins from the statistics rows (≤ 1° apart), not the output rows.
+struct MotorCheck {
+  double stall = 0.0, no_load_speed = 0.0;  // [N·m or N], [rad/s or m/s]
+  bool covers = false;
+  double min_margin = 0.0;                  // smallest sgn(stall)·(τ_line − drive) [N·m or N]
+  double at_t = 0.0, at_q = 0.0;            // where it is smallest [s], [rad or m]
+  double drive_there = 0.0, line_there = 0.0;  // the drive and the line's torque there
+  double min_margin_fraction = 0.0;         // min_margin / |stall|
+};
+MotorCheck calc_motor_check(const DriveRecord& r, double stall, double no_load_speed);
+
 }  // namespace rdyn::validate

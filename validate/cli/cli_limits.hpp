@@ -11,6 +11,8 @@
 // qualified (cli_limits::kMaxDuration_s), so the reader sees which table a bound comes from.
 #pragma once
 
+#include "models/scene.hpp"
+
 namespace rdyn::validate::cli_limits {
 
 inline constexpr double kMaxDuration_s = 1e5;
@@ -22,5 +24,8 @@ inline constexpr double kMaxFixedSteps = 1e8;  // ~20 s of RK4 steps
 inline constexpr double kMinGrid_deg = 0.01, kMaxGrid_deg = 90.0;  // 36000 grid points at most
 inline constexpr int kMaxThreads = 256;
 inline constexpr double kMaxCadence_Hz = 1000.0, kMaxPower_W = 1e7;
+// drive --motor: the scene's own bounds for a motor (models::limits::kMaxForce, kMaxRate), so a
+// line checked here can be written into a scene.
+inline constexpr double kMaxMotorStall = models::limits::kMaxForce, kMaxMotorSpeed = models::limits::kMaxRate;
 
 }  // namespace rdyn::validate::cli_limits

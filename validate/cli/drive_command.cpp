@@ -12,11 +12,16 @@
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/cli/cli_limits.hpp"
 #include "validate/analysis/drive.hpp"
+#include "validate/cli/decimal_number.hpp"
 #include "validate/io/output_dir.hpp"
 
 namespace rdyn::validate {
 
 namespace {
+
+std::string engine_free_coordinate(double q, bool revolute) {
+  return revolute ? fmt::format("q = {:.6g}°", q * 180 / M_PI) : fmt::format("q = {:.6g} m", q);
+}
 
 // The output rows: every k-th row of the fine record and its last (the duration itself).
 DriveRecord every_kth_row(const DriveRecord& r, long k) {
@@ -75,6 +80,27 @@ int run_drive(const DriveArgs& a) {
   if (!(a.grid_deg >= 0.05 && a.grid_deg <= 90) || std::abs(360 / a.grid_deg - std::round(360 / a.grid_deg)) > 1e-9 * 360 / a.grid_deg)
     bad("--grid-deg", fmt::format("must be in [0.05, 90] deg and divide 360° (got {:g})", a.grid_deg));
   if (a.model != "full" && a.model != "reduced") bad("--model", "full or reduced");
+  // --motor STALL,NO_LOAD in the scene's units for a motor (N·m and rad/s on a revolute
+  // coordinate, N and m/s on a prismatic one), one sign for both (docs/scene-format.md, motor).
+  std::optional<std::pair<double, double>> motor;
+  if (!a.motor.empty()) {
+    const auto comma = a.motor.find(',');
+    const std::string units = revolute ? "N·m,rad/s" : "N,m/s";
+    if (comma == std::string::npos || a.motor.find(',', comma + 1) != std::string::npos)
+      bad("--motor", "give STALL,NO_LOAD (" + units + "), e.g. 40,12 (got '" + a.motor + "')");
+    double v[2];
+    for (int i = 0; i < 2; ++i) {
+      const std::string part = i == 0 ? a.motor.substr(0, comma) : a.motor.substr(comma + 1);
+      if (const auto why = check_decimal_number(part); !why.empty()) bad("--motor", why + " in '" + a.motor + "'");
+      v[i] = read_decimal_number(part);
+    }
+    if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && v[0] != 0 && v[1] != 0 && (v[0] > 0) == (v[1] > 0) &&
+          std::abs(v[0]) <= cli_limits::kMaxMotorStall && std::abs(v[1]) <= cli_limits::kMaxMotorSpeed))
+      bad("--motor", fmt::format("stall and no-load speed must be non-zero, finite, of one sign (the speed the motor "
+                                 "drives toward), |stall| ≤ {:g} and |no-load speed| ≤ {:g} ({}; got {})",
+                                 cli_limits::kMaxMotorStall, cli_limits::kMaxMotorSpeed, units, a.motor));
+    motor = std::make_pair(v[0], v[1]);
+  }
 
   // The motion is computed on a grid fine enough for its statistics — at most 1° of q between
   // rows (0.001 m for a slider), and the output grid itself — and the output keeps every k-th row
@@ -140,12 +166,31 @@ int run_drive(const DriveArgs& a) {
   for (size_t c = 0; c < r.force_names.size(); ++c) peaks[r.force_names[c]] = st.force_peaks[c];
   run["constraint_force_peaks_N"] = peaks;
   run["statistics_rows"] = r.t.size();
+  std::optional<MotorCheck> mc;
+  if (motor) {
+    mc = calc_motor_check(r, motor->first, motor->second);
+    run["motor_check"] = {{"stall", mc->stall},
+                          {"no_load_speed", mc->no_load_speed},
+                          {"covers", mc->covers},
+                          {"min_margin", mc->min_margin},
+                          {"min_margin_fraction_of_stall", mc->min_margin_fraction},
+                          {"at_t_s", mc->at_t},
+                          {"at_q", revolute ? mc->at_q * 180 / M_PI : mc->at_q},
+                          {"at_q_unit", revolute ? "deg" : "m"},
+                          {"drive_there", mc->drive_there},
+                          {"line_there", mc->line_there}};
+  }
   write_drive_csv(out.file("timeseries.csv"), every_kth_row(r, k), revolute);
   write_text_file(out.file("run.json"), run.dump(2) + "\n");
   out.commit();
   std::fprintf(stderr, "rdyn: %s (%s model) driven by %s: drive RMS %.4g %s, peak %.4g %s, mean power %.4g W; wrote %s\n",
                scene.name.c_str(), a.model.c_str(), motion.how.c_str(), st.rms, unit, st.peak, unit, st.mean_power_W,
                (a.out + "/timeseries.csv").c_str());
+  if (mc)
+    std::fprintf(stderr, "rdyn: motor %s: %s (smallest margin %.4g %s, %.3g %% of stall, at t = %.6g s, %s)\n",
+                 a.motor.c_str(), mc->covers ? "covers the drive at every row" : "does NOT cover the drive",
+                 mc->min_margin, unit, 100 * mc->min_margin_fraction, mc->at_t,
+                 engine_free_coordinate(mc->at_q, revolute).c_str());
   return 0;
 }
 

@@ -18,6 +18,7 @@ struct DriveArgs {
   double grid_deg = 10.0;
   std::string interpolation = "fourier";
   std::vector<std::string> sets;
+  std::string motor;  // "STALL,NO_LOAD": check a torque–speed line against the drive (empty: none)
   std::string out;
   bool force = false;
 };

@@ -234,6 +234,9 @@ int main(int argc, char** argv) {
   auto* drive_duration_opt =
       drive->add_option("--duration", drive_duration, "Time [s] (default: one revolution, or the profile's span)");
   auto* drive_dt_opt = drive->add_option("--dt-out", drive_dt, "Output interval [s] (default: the scene's)");
+  drive->add_option("--motor", drv.motor,
+                    "STALL,NO_LOAD: check that a motor on the independent coordinate with this torque-speed line "
+                    "(N*m,rad/s; N,m/s on a slider) covers the drive at every angle; run.json gets motor_check");
   add_reduced_table_options(*drive, drv.grid_deg, drv.interpolation);
   add_scene_overrides(*drive, drv.sets);
   add_output_folder(*drive, drv.out, drv.force);

@@ -52,6 +52,31 @@ TEST(Drive, ParallelogramAtConstantRateHoldsGravityOnly) {
   EXPECT_NEAR(st.peak, k, 1e-3 * k);  // rows 3.6° apart: the sampled peak is within 1 − cos 1.8°
 }
 
+// A motor line against the parallelogram's drive k cos q at a constant rate ω: the line gives
+// stall·(1 − ω/ω0) at every row, so the smallest margin is that minus the largest drive, at
+// the crank's +x position (q = 0 mod 2π); a weaker motor misses by the same algebra. Turning
+// backwards with a reversed motor (negative stall and speed) the margin is drive − line.
+TEST(Drive, AMotorLineCoversTheDriveWithTheClosedFormMargin) {
+  const auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  const double k = 9.81 * (0.5 * 0.05 + 0.7 * 0.05 + 1.2 * 0.1), w = 2 * M_PI;
+  const auto forward = calc_drive_full(scene, constant_rate_motion(scene.initial.q, w, 1.0, 0.001));
+  const double peak = *std::max_element(forward.drive.begin(), forward.drive.end());
+  EXPECT_NEAR(peak, k, 1e-5 * k);
+  for (const double stall : {5.0, 1.0}) {
+    const auto c = calc_motor_check(forward, stall, 20.0);
+    const double line = stall * (1 - w / 20.0);
+    EXPECT_NEAR(c.min_margin, line - peak, 1e-12) << stall;
+    EXPECT_EQ(c.covers, line > k) << stall;  // 3.43 N·m covers k = 1.77; 0.69 does not
+    EXPECT_NEAR(std::remainder(c.at_q, 2 * M_PI), 0.0, 0.5 * w * 0.001 + 1e-9) << stall;  // the row nearest 0
+    EXPECT_DOUBLE_EQ(c.line_there, line);
+  }
+  const auto backward = calc_drive_full(scene, constant_rate_motion(scene.initial.q, -w, 1.0, 0.001));
+  const double low = *std::min_element(backward.drive.begin(), backward.drive.end());
+  const auto c = calc_motor_check(backward, -5.0, -20.0);
+  EXPECT_NEAR(c.min_margin, low - (-5.0 * (1 - w / 20.0)), 1e-12);
+  EXPECT_TRUE(c.covers);
+}
+
 // A row exactly at an aligned (singular) position: the constraint split there is least squares,
 // so the full model takes the drive's limit along the branch from both sides (it gave 0.31 k).
 // The chain of 3 parallelograms the same at its flat rows: k = g [(N+1)/2 + N].
@@ -150,6 +175,15 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
   EXPECT_TRUE(j["constraint_force_peaks_N"].contains("rocker_axial"));
   const std::string csv = test::slurp(dir / "out" / "timeseries.csv");
   EXPECT_EQ(csv.rfind("t,q,qdot,qddot,drive_Nm,drive_W,F_rocker_axial\n", 0), 0u);
+  EXPECT_FALSE(j.contains("motor_check"));
+  // --motor: run.json says whether the line covers the drive, and by how much (the margin's
+  // closed form is the test above); the message says it in words.
+  r = run({"drive", RDYN_SCENES "/hard/parallelogram.yaml", "--cadence-hz", "1", "--motor", "1,20", "--out", "weak"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto weak = nlohmann::json::parse(test::slurp(dir / "weak" / "run.json"))["motor_check"];
+  EXPECT_FALSE(weak["covers"].get<bool>());
+  EXPECT_NEAR(weak["min_margin"].get<double>(), 1 - 2 * M_PI / 20 - kp, 1e-3 * kp);
+  EXPECT_NE(r.err.find("does NOT cover the drive"), std::string::npos) << r.err;
   // Bad input is exit 2 before any output: neither or both motions, a zero or infinite rate,
   // a constant rate for a slider, a missing profile.
   for (const auto& args : std::vector<std::vector<std::string>>{
@@ -161,7 +195,11 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
            {"drive", "fourbar", "--profile", "missing.csv", "--out", "o2"},
            {"drive", "fourbar", "--profile", "/dev/zero", "--out", "o2"},  // never ends: refused unread
            {"drive", "fourbar", "--cadence-hz", "1", "--duration", "0.5", "--dt-out", "1", "--out", "o2"},
-           {"drive", "fourbar", "--cadence-hz", "1000", "--duration", "10", "--out", "o2"}}) {  // hours of moves
+           {"drive", "fourbar", "--cadence-hz", "1000", "--duration", "10", "--out", "o2"},  // hours of moves
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5", "--out", "o2"},       // one number
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5,-20", "--out", "o2"},   // two signs
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "0x5,20", "--out", "o2"},  // not decimal
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5,0", "--out", "o2"}}) {
     r = run(args);
     EXPECT_EQ(r.status, 2) << args[2] << " " << r.err;
     EXPECT_FALSE(fs::exists(dir / "o2")) << args[2];
