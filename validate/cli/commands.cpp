@@ -124,7 +124,10 @@ int run_simulate(const SimulateArgs& a) {
                 {"integrator", a.integrator},
                 {"constraint_force_route", a.route},
                 {"simbody_bodies", model.num_simbody_bodies()},
-                {"max_loop_gap_m", ts.stats.max_constraint_error}});
+                {"max_loop_gap_m", ts.stats.max_constraint_error},
+                // Windows of rank loss crossed in the partitioned formulation (docs/theory.md §7a).
+                {"singular_passages", ts.stats.singular_passages},
+                {"events", ts.stats.events}});
   } else {
     // Joint outputs: the table and the model carry one constraint line per reaction component.
     const models::Scene rscene = reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene;
