@@ -623,4 +623,20 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
   return ts;
 }
 
+void check_energy_balance(const models::TimeSeries& ts, double tolerance, const std::string& how) {
+  if (ts.t.empty()) return;
+  const auto eb = models::energy_balance(ts);
+  double scale_J = eb.energy_scale_J;
+  const auto [lo, hi] = std::minmax_element(ts.energy.begin(), ts.energy.end());
+  scale_J = std::max(scale_J, *hi - *lo);
+  for (double w : ts.work) scale_J = std::max(scale_J, std::abs(w));
+  if (eb.max_residual_J <= tolerance * scale_J + 1e-12) return;
+  throw models::NumericalError(fmt::format(
+      "reduced model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
+      "energy scale {:.3g} J (largest |E|, |W| or range of E; limit {:g} %): the integration lost or invented energy "
+      "({}; try a shorter fixed step or an adaptive integrator)",
+      eb.max_residual_J, eb.worst_time_s, 100 * eb.max_residual_J / std::max(scale_J, 1e-300), scale_J,
+      100 * tolerance, how));
+}
+
 }  // namespace rdyn::reduced

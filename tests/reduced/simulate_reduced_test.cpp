@@ -179,6 +179,29 @@ TEST(SimulateReduced, AdaptiveStepsAreGslEvolveApplyStepForStep) {
   }
 }
 
+TEST(SimulateReduced, AnEnergyBalanceOffByMoreThanOnePercentFailsTheRun) {
+  // E − E0 − W over two rows against the scale max(|E|, |W|, range of E): 0.5 J of 10.5 J fails,
+  // 0.05 J passes; a pendulum whose datum makes E ≡ 0 closes to rounding and passes.
+  auto ts_of = [](std::vector<double> E, std::vector<double> W) {
+    models::TimeSeries ts;
+    ts.t = {0.0, 1.0};
+    ts.energy = std::move(E);
+    ts.work = std::move(W);
+    return ts;
+  };
+  try {
+    check_energy_balance(ts_of({10.0, 10.5}, {0.0, 0.0}), 0.01, "rk4-fixed at 0.2 s steps");
+    FAIL() << "0.5 J of 10.5 J passed";
+  } catch (const models::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("4.76 % of the energy scale 10.5 J"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at t = 1 s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("rk4-fixed at 0.2 s steps"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(check_energy_balance(ts_of({10.0, 10.05}, {0.0, 0.0}), 0.01, ""));
+  EXPECT_NO_THROW(check_energy_balance(ts_of({10.0, 8.0}, {0.0, -2.0}), 0.01, ""));  // braked: W balances
+  EXPECT_NO_THROW(check_energy_balance(ts_of({0.0, 1e-15}, {0.0, 0.0}), 0.01, ""));
+}
+
 TEST(SimulateReduced, NonFiniteOutputFailsTheRun) {
   // m2 = 1e300 with q̇ = 1e10: m2 q̇² overflows, so q̈ is −∞ from the first sample.
   test::AnalyticSource src;

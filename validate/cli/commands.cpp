@@ -154,6 +154,10 @@ int run_simulate(const SimulateArgs& a) {
                                                    a.energy_consistent);
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
+    reduced::check_energy_balance(
+        ts, 0.01,
+        a.reduced_integrator == "rk4-fixed" ? fmt::format("rk4-fixed at {:g} s steps", opt.fixed_step_s)
+                                            : fmt::format("{} at tolerance {:g}", a.reduced_integrator, a.reduced_tolerance));
     if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(scene, model, ts);
     // The interpolant the table was built with (a range table's not-a-knot spline stands in for
     // fourier), not the option's name.
