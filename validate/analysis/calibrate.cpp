@@ -391,8 +391,12 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
   return with_load(scene, select_load(scene, opt), 1.0, calc_resistance_coefficient(scene, opt));
 }
 
-CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
+CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress) {
+  // The searches below set load values and the resistance coefficient on the calibration's own
+  // copy: the caller's model is never left at some shape's values (issue #23: a model shared by
+  // two strategies kept the last one's coefficient). The result carries the values found.
+  reduced::ReducedModel m = model;
   auto fail = [&](const std::string& field, const std::string& msg) {
     throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
   };
@@ -704,7 +708,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& 
   const auto start = std::chrono::steady_clock::now();
   check_calibration_input(scene, opt);
   const Selection sel = select_load(scene, opt);
-  auto m = reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table);
+  const auto m = reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table);
   CalibrationResult r = calibrate_reduced(m, scene, opt, progress);
 
   // Confirmation with the full model from the same point of the steady cycle.

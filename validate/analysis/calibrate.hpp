@@ -115,10 +115,12 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 // calibrate()'s reduced part on a model already built from the scene's table and
 // with_unit_load(scene, opt): the first guess from the energy balance per revolution, the
 // refusals that need the table (SceneError), the operating point (Newton on the first integral,
-// or the nested searches), the steady cycle there (extremes and peak forces). Leaves `m` at the calibrated value; the full-model fields are NaN.
+// or the nested searches), the steady cycle there (extremes and peak forces). `m` is not
+// changed: the searches run on a copy, and the values found (load_value, resistance_coefficient)
+// are the result's, to be passed on; the full-model fields are NaN.
 // Does not call check_calibratable (the caller has). Throws NumericalError when no value
 // reaches F to 1e-6. A search over load shapes calls it once per shape on the same table.
-CalibrationResult calibrate_reduced(reduced::ReducedModel& m, const models::Scene& scene,
+CalibrationResult calibrate_reduced(const reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress);
 
 // The calibration's table: the kinetostatic extraction at opt.grid_deg and its interpolant

@@ -186,13 +186,14 @@ struct Evaluation {
   CalibrationResult cal;
 };
 
-// Per-run state of the search: the model whose tau columns each candidate refits.
+// The search's inputs (read only: every candidate builds its own model from them) and its
+// per-run state (the last evaluation, the counters).
 struct Workspace {
   const models::Scene* scene = nullptr;  // with the added torques, design loads profiled
   const Design* design = nullptr;
   CalibrationOptions copt;
-  reduced::Samples samples;
-  reduced::ReducedModel model;
+  const reduced::Samples* samples = nullptr;    // the one extraction
+  const reduced::ReducedModel* base = nullptr;  // built from it at unit load; each shape refits a copy
   reduced::Interpolation interp = reduced::Interpolation::Fourier;
   int force = 0;
   bool pnorm = false;
@@ -203,6 +204,42 @@ struct Workspace {
   Progress* progress = nullptr;
   int max_evaluations = 0;
 };
+
+// One shape's table: the extraction's samples with the tau columns of `shaped` (its design loads
+// profiled; load values as they are) and a copy of the base model with those columns refit
+// (reduced/profile_columns.hpp: never re-extracted). A fresh copy per shape, so no shape's
+// columns, load values or resistance coefficient are left behind for the next.
+struct ShapeModel {
+  reduced::Samples samples;
+  reduced::ReducedModel model;
+};
+ShapeModel calc_shape_model(const Workspace& w, const models::Scene& shaped) {
+  ShapeModel sm{reduced::with_profile_columns(*w.samples, shaped), *w.base};
+  reduced::refit_profile_columns(sm.model, sm.samples, w.interp);
+  return sm;
+}
+
+// The scene of a calibrated shape: the design loads profiled at x, each at the calibrated
+// amplitude (its sign in the scene kept), the resistance coefficient its own calibration found
+// (power mode), a point of its steady cycle as initial state. A strategy's reduced curves, its
+// p-norm and its full-model run are all built from this one scene.
+models::Scene calibrated_scene(const models::Scene& scene, const Design& d, const double* x,
+                               const CalibrationResult& cal) {
+  models::Scene sx = shaped_scene(scene, d, x);
+  for (const auto& dl : d.loads) {
+    auto& t = sx.joint_torques[dl.torque];
+    t.value = (scene.joint_torques[dl.torque].value < 0 ? -1.0 : 1.0) * std::abs(cal.load_value);
+  }
+  if (std::isfinite(cal.resistance_coefficient)) sx.resistances[0].coefficient = cal.resistance_coefficient;
+  sx.initial.q = cal.steady_q;
+  sx.initial.qdot = cal.steady_qdot;
+  return sx;
+}
+
+// The reduced model of a calibrated scene on its shape's table (its own loads, the table shared).
+reduced::ReducedModel calc_calibrated_model(const ShapeModel& sm, const models::Scene& calibrated) {
+  return reduced::make_reduced_model(sm.samples, calibrated, sm.model.table);
+}
 
 // (mean |F|^p)^(1/p) over one steady cycle, sampled at 720 equal time steps.
 double calc_pnorm(const reduced::ReducedModel& m, double q, double qdot, double period, double tol, int k, double p) {
@@ -234,14 +271,13 @@ const Evaluation& evaluate(Workspace& w, const double* x) {
   }
   ++w.evaluations;
   try {
-    const models::Scene sx = shaped_scene(*w.scene, d, x);
-    const auto sx_unit = with_unit_load(sx, w.copt);
-    w.samples = reduced::with_profile_columns(std::move(w.samples), sx_unit);
-    reduced::refit_profile_columns(w.model, w.samples, w.interp);
+    const auto sx_unit = with_unit_load(shaped_scene(*w.scene, d, x), w.copt);
+    const ShapeModel sm = calc_shape_model(w, sx_unit);
     Progress silent(false);
-    e.cal = calibrate_reduced(w.model, sx_unit, w.copt, silent);
+    e.cal = calibrate_reduced(sm.model, sx_unit, w.copt, silent);
     e.peak = e.cal.peak_forces_N.at(w.force);
-    e.objective = w.pnorm ? calc_pnorm(w.model, e.cal.steady_q, e.cal.steady_qdot, 1.0 / e.cal.mean_cadence_hz_reduced,
+    e.objective = w.pnorm ? calc_pnorm(calc_calibrated_model(sm, calibrated_scene(*w.scene, d, x, e.cal)),
+                                       e.cal.steady_q, e.cal.steady_qdot, 1.0 / e.cal.mean_cadence_hz_reduced,
                                        w.copt.tolerance, w.force, w.p)
                           : e.peak;
     e.ok = std::isfinite(e.objective) && std::isfinite(e.cal.load_value);
@@ -303,6 +339,83 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
   for (int g = 0; g < static_cast<int>(d.groups.size()); ++g)
     result[i++] = e.ok ? (std::abs(e.cal.load_value) * e.max_tau[g] - d.groups[g].bound) / d.groups[g].bound : 1.0;
   (void)m;
+}
+
+// A strategy's curves over the independent coordinate's angle on the reduced model of its own
+// calibrated scene `sx`: the applied design loads (value·τ·gate) at 0°, 1°, … 359°, and the
+// force over one steady period from the steady point. That period must close the cycle (q
+// advances by the table's period, q̇ returns): a model at other load values or another resistance
+// coefficient than the calibration's would not, and its curve would not be the record's.
+void calc_reduced_curves(const reduced::ReducedModel& m, const models::Scene& sx, const Design& d, int force,
+                         double period_s, const std::string& label, StrategyCurves& c) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = period_s;
+  ro.output_interval_s = period_s / 1440;
+  ro.tolerance = 1e-10;
+  const auto cyc = reduced::simulate_reduced(m, sx.initial.q, sx.initial.qdot, ro);
+  const double turn = std::abs(cyc.q.back() - cyc.q.front()), speed = std::abs(sx.initial.qdot);
+  const double P = m.table.period;  // 2π: optimize's coordinate turns fully
+  if (!(std::abs(turn - P) <= 1e-6 * P && std::abs(std::abs(cyc.qdot.back()) - speed) <= 1e-6 * speed))
+    throw models::NumericalError(fmt::format(
+        "optimize: the {} strategy's reduced model does not repeat its steady cycle (one period {:.6g} s turns q by "
+        "{:.6g} rad, q̇ {:.6g} → {:.6g} rad/s): its curves would not be its summary's",
+        label, period_s, turn, sx.initial.qdot, cyc.qdot.back()));
+  c.torque_Nm.assign(d.loads.size(), std::vector<double>(360));
+  for (int a = 0; a < 360; ++a) {
+    const double q = a * M_PI / 180;
+    c.angle_deg.push_back(a);
+    for (size_t l = 0; l < d.loads.size(); ++l) {
+      const auto& mt = m.torques[d.loads[l].torque];
+      const bool on = mt.gate < 0 || reduced::calc_switching(m, mt.gate, q, sx.initial.qdot) > 0;
+      // The tau column is τ(θ_of(q)) whichever joint the shape reads.
+      c.torque_Nm[l][a] = on ? mt.value * m.table.eval(mt.c_tau, q) : 0.0;
+    }
+  }
+  // Force over the angle: the cycle's rows by angle.
+  std::vector<std::pair<double, double>> pts;
+  for (size_t i = 0; i < cyc.t.size(); ++i) pts.push_back({cyc.q[i], cyc.forces[force][i]});
+  c.force_reduced_N = calc_by_angle(std::move(pts));
+}
+
+// One strategy's record, computed once: the search's numbers for its shape xs (evaluation e),
+// its coefficients, and its curves and full-model run, both from the one calibrated scene
+// (returned beside the record).
+std::pair<StrategyResult, models::Scene> calc_strategy(const Workspace& w, const Design& d,
+                                                       const std::vector<double>& xs, const Evaluation& e,
+                                                       const OptimizeOptions& opt, const std::string& label) {
+  StrategyResult sr;
+  sr.amplitude = std::abs(e.cal.load_value);
+  sr.resistance_coefficient = e.cal.resistance_coefficient;
+  sr.peak_reduced_N = e.peak;
+  sr.objective_reduced = e.objective;
+  sr.cadence_reduced_hz = e.cal.mean_cadence_hz_reduced;
+  sr.mean_power_w = e.cal.mean_power_w;
+  sr.steady_q = e.cal.steady_q;
+  sr.steady_qdot = e.cal.steady_qdot;
+  const models::Scene sx = calibrated_scene(*w.scene, d, xs.data(), e.cal);
+  for (const auto& dl : d.loads) {
+    const auto& t = sx.joint_torques[dl.torque];
+    sr.a0.push_back(t.profile->a0);
+    sr.a.push_back(t.profile->a);
+    sr.b.push_back(t.profile->b);
+    double mx = 0;
+    for (int i = 0; i < kBoundSamples; ++i)
+      mx = std::max(mx, std::abs(models::calc_joint_torque(t, kTwoPi * i / kBoundSamples)));
+    sr.max_torque_Nm = std::max(sr.max_torque_Nm, mx);
+  }
+  // Reduced: the shape's table (as its calibration had it) with the calibrated scene's loads.
+  const ShapeModel sm = calc_shape_model(w, with_unit_load(sx, w.copt));
+  calc_reduced_curves(calc_calibrated_model(sm, sx), sx, d, w.force, 1.0 / sr.cadence_reduced_hz, label, sr.curves);
+  // Full: mean cadence over whole revolutions after full_skip_s, the force's peak and last revolution.
+  FullConfirmOptions fc;
+  fc.duration_s = opt.full_duration_s;
+  fc.skip_s = opt.full_skip_s;
+  fc.force = w.force;
+  const FullConfirmation fw = confirm_full(sx, fc);
+  sr.cadence_full_hz = fw.cadence_hz;
+  sr.peak_full_N = fw.peak_force_N;
+  sr.curves.force_full_N = fw.force_1deg;
+  return {sr, sx};
 }
 
 }  // namespace
@@ -485,8 +598,10 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   w.design = &design;
   w.copt = copt;
   w.interp = reduced::parse_interpolation(opt.interpolation);
-  w.samples = extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
-  w.model = reduced::make_reduced_model(w.samples, with_unit_load(s0, copt), w.interp);
+  const reduced::Samples samples = extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
+  const reduced::ReducedModel base = reduced::make_reduced_model(samples, with_unit_load(s0, copt), w.interp);
+  w.samples = &samples;
+  w.base = &base;
   w.scene = &scene;
   w.force = force;
   w.pnorm = r.objective == "pnorm";
@@ -497,7 +612,7 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   {
     const auto s0u = with_unit_load(s0, copt);
     Progress silent(false);
-    const auto cal = calibrate_reduced(w.model, s0u, copt, silent);
+    const auto cal = calibrate_reduced(base, s0u, copt, silent);
     (void)cal;
   }
   const Evaluation e0 = evaluate(w, x0.data());
@@ -561,75 +676,11 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
     best = e0;
   }
 
-  // Both strategies: curves over the angle and the full model from their steady points.
-  auto strategy = [&](const std::vector<double>& xs, const Evaluation& e, const std::string& label) {
-    StrategyResult sr;
-    sr.amplitude = std::abs(e.cal.load_value);
-    sr.peak_reduced_N = e.peak;
-    sr.objective_reduced = e.objective;
-    sr.cadence_reduced_hz = e.cal.mean_cadence_hz_reduced;
-    sr.mean_power_w = e.cal.mean_power_w;
-    sr.steady_q = e.cal.steady_q;
-    sr.steady_qdot = e.cal.steady_qdot;
-    models::Scene sx = shaped_scene(scene, bounded, xs.data());
-    for (const auto& dl : bounded.loads) {
-      auto& t = sx.joint_torques[dl.torque];
-      t.value = (scene.joint_torques[dl.torque].value < 0 ? -1.0 : 1.0) * sr.amplitude;
-      sr.a0.push_back(t.profile->a0);
-      sr.a.push_back(t.profile->a);
-      sr.b.push_back(t.profile->b);
-      double mx = 0;
-      for (int i = 0; i < kBoundSamples; ++i)
-        mx = std::max(mx, std::abs(models::calc_joint_torque(t, kTwoPi * i / kBoundSamples)));
-      sr.max_torque_Nm = std::max(sr.max_torque_Nm, mx);
-    }
-    // Each strategy's own coefficient: the one its steady cycle dissipates P with (calibrate_reduced).
-    if (std::isfinite(e.cal.resistance_coefficient)) sx.resistances[0].coefficient = e.cal.resistance_coefficient;
-    sx.initial.q = sr.steady_q;
-    sx.initial.qdot = sr.steady_qdot;
-    // Reduced curves: the shape's model at the calibrated value over one cycle.
-    const auto sxu = with_unit_load(sx, copt);
-    w.samples = reduced::with_profile_columns(std::move(w.samples), sxu);
-    reduced::refit_profile_columns(w.model, w.samples, w.interp);
-    for (auto& t : w.model.torques) t.value = t.value < 0 ? -sr.amplitude : sr.amplitude;
-    const double period = 1.0 / sr.cadence_reduced_hz;
-    reduced::ReducedOptions ro;
-    ro.duration_s = period;
-    ro.output_interval_s = period / 1440;
-    ro.tolerance = 1e-10;
-    const auto cyc = reduced::simulate_reduced(w.model, sr.steady_q, sr.steady_qdot, ro);
-    auto& c = sr.curves;
-    c.torque_Nm.assign(bounded.loads.size(), std::vector<double>(360));
-    for (int a = 0; a < 360; ++a) {
-      const double q = a * M_PI / 180;
-      c.angle_deg.push_back(a);
-      for (size_t l = 0; l < bounded.loads.size(); ++l) {
-        const auto& t = sx.joint_torques[bounded.loads[l].torque];
-        const auto& mt = w.model.torques[bounded.loads[l].torque];
-        const bool on = mt.gate < 0 || reduced::calc_switching(w.model, mt.gate, q, sr.steady_qdot) > 0;
-        // The tau column is τ(θ_of(q)) whichever joint the shape reads.
-        c.torque_Nm[l][a] = on ? t.value * w.model.table.eval(mt.c_tau, q) : 0.0;
-      }
-    }
-    // Force over the angle: the cycle's rows by angle.
-    std::vector<std::pair<double, double>> pts;
-    for (size_t i = 0; i < cyc.t.size(); ++i) pts.push_back({cyc.q[i], cyc.forces[force][i]});
-    c.force_reduced_N = calc_by_angle(std::move(pts));
-    progress.note("optimize: full model, " + label + " strategy");
-    // Mean cadence over whole revolutions after full_skip_s, the force's peak and last revolution.
-    FullConfirmOptions fc;
-    fc.duration_s = opt.full_duration_s;
-    fc.skip_s = opt.full_skip_s;
-    fc.force = force;
-    const FullConfirmation fw = confirm_full(sx, fc);
-    sr.cadence_full_hz = fw.cadence_hz;
-    sr.peak_full_N = fw.peak_force_N;
-    c.force_full_N = fw.force_1deg;
-    return std::make_pair(sr, sx);
-  };
-  auto [c0, scene0] = strategy(x0, e0, "constant");
-  auto [c1, scene1] = strategy(x, best, "optimised");
-  (void)scene0;
+  // Both strategies, each from its own calibrated scene: curves over the angle and the full model.
+  progress.note("optimize: full model, constant strategy");
+  const auto c0 = calc_strategy(w, bounded, x0, e0, opt, "constant").first;
+  progress.note("optimize: full model, optimised strategy");
+  auto [c1, scene1] = calc_strategy(w, bounded, x, best, opt, "optimised");
   r.constant = c0;
   r.optimised = c1;
   // The optimised scene's coefficient (each strategy dissipates P on its own steady cycle).

@@ -10,6 +10,7 @@
 // then each simulated with the full model (docs/theory.md, "Pedalling optimisation").
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -48,7 +49,9 @@ struct OptimizeOptions {
   double full_skip_s = 2.0;       // the window starts after this [s] (whole revolutions from there)
 };
 
-// One strategy over the crank (independent coordinate) angle, for the profile CSV and report.
+// One strategy over the crank (independent coordinate) angle, for the profile CSV and report:
+// computed from the same calibrated scene (load values, resistance coefficient, table) as the
+// strategy's numbers.
 struct StrategyCurves {
   std::vector<double> angle_deg;               // q mod 360° of the samples [deg]
   std::vector<std::vector<double>> torque_Nm;  // per design load: applied value·τ(θ)·gate [N·m or N]
@@ -58,6 +61,9 @@ struct StrategyCurves {
 
 struct StrategyResult {
   double amplitude = 0.0;          // calibrated common value of the design loads [N·m or N]
+  // The resistance's coefficient this strategy's steady cycle dissipates P with (calibrated with
+  // its amplitude; NaN in mean-speed mode): its curves and full run use this one.
+  double resistance_coefficient = NAN;
   double peak_reduced_N = 0.0;     // max |F| over the reduced steady cycle
   double objective_reduced = 0.0;  // peak or p-norm over the reduced cycle [N]
   double cadence_reduced_hz = 0.0;

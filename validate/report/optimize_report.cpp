@@ -21,6 +21,7 @@ json strategy_json(const StrategyResult& s) {
   for (size_t i = 0; i < s.a0.size(); ++i) loads.push_back({{"a0", s.a0[i]}, {"a", s.a[i]}, {"b", s.b[i]}});
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return {{"amplitude", s.amplitude},
+          {"resistance_coefficient", num(s.resistance_coefficient)},
           {"peak_force_reduced_N", s.peak_reduced_N},
           {"peak_force_full_N", num(s.peak_full_N)},
           {"objective_reduced", s.objective_reduced},
