@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <fmt/format.h>
@@ -116,26 +118,17 @@ TEST(SingularPassage, ADampedChainClosesItsEnergyBalanceThroughThePassages) {
   // A gated friction torque on the second crank (on while it turns forwards): the passages
   // integrate its work W' = P(q, q̇) beside q and q̇, so E − E0 − W stays at integration accuracy
   // (1e-6 of the energy), not at the 1 % the run checks; W = −0.2 N·m × the angle turned.
-  const auto yaml = std::string(R"(
-name: damped-chain
-ground_points: {P0: [0, 0], P1: [1, 0]}
-bodies:
-  - {name: crank0, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.08333333333333333, points: {T: [1, 0]}}
-  - {name: crank1, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.08333333333333333, points: {T: [1, 0]}}
-  - {name: coupler0, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.08333333333333333, points: {E: [1, 0]}}
-joints:
-  - {name: crank0, type: revolute, parent: ground, parent_point: P0, child: crank0, guess_deg: 90}
-  - {name: crank1, type: revolute, parent: ground, parent_point: P1, child: crank1, guess_deg: 90}
-  - {name: coupler0, type: revolute, parent: crank0, parent_point: T, child: coupler0, guess_deg: -90}
-loops:
-  - {name: L0, body_a: coupler0, point_a: E, body_b: crank1, point_b: T}
-independent: crank0
-gravity: {enabled: true, g_m_s2: [0, -9.81]}
-loads:
-  - {type: joint_torque, name: friction, joint: crank1, torque_Nm: -0.2, active_when: {joint: crank1, rate: positive}}
-initial: {q_deg: 90, qdot: 3.0}
-simulation: {duration_s: 6, output_interval_s: 0.01}
-)");
+  // The shipped one-loop chain, the load added and a faster start (it turns over ~5 times).
+  std::ifstream in(std::string(RDYN_SCENES) + "/chains/chain-1.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string initial = "initial: {q_deg: 90, qdot: 1.0}";
+  const auto at = yaml.find(initial);
+  ASSERT_NE(at, std::string::npos);
+  yaml.replace(at, initial.size(),
+               "loads:\n  - {type: joint_torque, name: friction, joint: crank1, torque_Nm: -0.2, active_when: "
+               "{joint: crank1, rate: positive}}\ninitial: {q_deg: 90, qdot: 3.0}");
   const FullModel model(models::parse_scene(yaml, "damped.yaml"));
   ForwardOptions opt;
   opt.duration_s = 6.0;
