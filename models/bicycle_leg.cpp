@@ -103,22 +103,12 @@ Vec2 pedal_position(const BicycleLegParams& p, double crank_angle_from_tdc) {
   return {p.crank_length_m * std::cos(a), p.crank_length_m * std::sin(a)};
 }
 
-}  // namespace
-
-double bicycle_knee_flexion(const BicycleLegParams& p, const Scene& scene, double crank_q) {
-  const Fit fit = make_fit(p);
-  LegPose pose{};
-  if (!leg_pose(scene.ground_points.at("hip"), pedal_position(p, crank_q), fit.L_t, fit.L_kp,
-                fit.delta, pose))
-    return NAN;
-  return std::abs(wrap(pose.shank_angle - pose.thigh_angle));
+[[noreturn]] void fail_leg(const Scene& s, const std::string& field, const std::string& msg) {
+  throw SceneError(s.source_file, 0, "bicycle_leg." + field, msg);
 }
 
-void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
-  auto fail = [&](const std::string& field, const std::string& msg) {
-    throw SceneError(s.source_file, 0, "bicycle_leg." + field, msg);
-  };
-  // Every input in a range a human on a bicycle can have; nothing is silently replaced.
+// Every input in a range a human on a bicycle can have; nothing is silently replaced.
+void check_leg_params(const BicycleLegParams& p, const Scene& s) {
   struct Range {
     const char* field;
     double value, lo, hi;
@@ -157,23 +147,19 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
     const bool ok =
         std::isfinite(r.value) && (r.lo_open ? r.value > r.lo : r.value >= r.lo) && r.value <= r.hi;
     if (!ok)
-      fail(r.field, fmt::format("must be in {}{:g}, {:g}]{}{} (got {:g})", r.lo_open ? "(" : "[",
-                                r.lo, r.hi, *r.unit ? " " : "", r.unit, r.value));
+      fail_leg(s, r.field, fmt::format("must be in {}{:g}, {:g}]{}{} (got {:g})", r.lo_open ? "(" : "[",
+                                       r.lo, r.hi, *r.unit ? " " : "", r.unit, r.value));
   }
-  if (p.legs != 1 && p.legs != 2) fail("legs", "must be 1 or 2");
+  if (p.legs != 1 && p.legs != 2) fail_leg(s, "legs", "must be 1 or 2");
   if (!std::isfinite(s.initial.q) || std::abs(s.initial.q) > limits::kMaxAngle_rad)
     throw SceneError(s.source_file, 0, "initial.q",
                      fmt::format("must be finite with |q| ≤ {:g} rad", limits::kMaxAngle_rad));
-  Fit fit;
-  try {
-    fit = make_fit(p);
-  } catch (const std::invalid_argument& e) {
-    fail("subject.sex", e.what());
-  }
+}
 
-  // Saddle height: the most extended pose has the pedal farthest from the hip, at
-  // d = D + L_c on the seat-tube line. Bisection on d for the requested knee flexion
-  // (flexion falls monotonically as d grows).
+// Saddle height: the most extended pose has the pedal farthest from the hip, at
+// d = D + L_c on the seat-tube line. Bisection on d for the requested knee flexion
+// (flexion falls monotonically as d grows). Returns the hip's position from the bottom bracket.
+Vec2 calc_hip_position(const BicycleLegParams& p, const Fit& fit, const Scene& s) {
   const double target = p.knee_flexion_at_extension_deg * kPi / 180.0;
   const double sta = p.seat_tube_angle_deg * kPi / 180.0;
   const Vec2 seat_dir{std::cos(sta), std::sin(sta)};
@@ -184,20 +170,19 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
   };
   double lo = std::abs(fit.L_t - fit.L_kp) + 1e-9, hi = fit.L_t + fit.L_kp - 1e-12;
   if (!(flexion_at(lo) > target && flexion_at(hi) < target))
-    fail("knee_flexion_at_extension_deg", "no saddle height gives this knee flexion");
+    fail_leg(s, "knee_flexion_at_extension_deg", "no saddle height gives this knee flexion");
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
     (flexion_at(mid) > target ? lo : hi) = mid;
   }
   const double D = 0.5 * (lo + hi) - p.crank_length_m;
   if (D <= p.crank_length_m)
-    fail("knee_flexion_at_extension_deg", "the hip would sit inside the crank circle");
-  const Vec2 hip = mul(D, seat_dir);
+    fail_leg(s, "knee_flexion_at_extension_deg", "the hip would sit inside the crank circle");
+  return mul(D, seat_dir);
+}
 
-  s.ground_points["bottom_bracket"] = {0.0, 0.0};
-  s.ground_points["hip"] = hip;
-  s.ground_points["flywheel_axle"] = {0.40, 0.0};
-
+// The crank, the flywheel and the chain that gears them.
+void add_crank_and_flywheel(const BicycleLegParams& p, Scene& s) {
   // Crank (arms + chainring): assumed uniform arms, inertia m L²/3 about the spindle.
   Body crank{
       "crank", p.crank_mass_kg, {0, 0}, p.crank_mass_kg * std::pow(p.crank_length_m, 2) / 3.0, {}};
@@ -228,58 +213,87 @@ void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
                       0.0,
                       p.gear_ratio * s.initial.q});
   s.gears.push_back({"chain", "crank", "flywheel", p.gear_ratio});
+}
 
+// One leg (`leg` 0: right, 1: left, half a turn behind): thigh and shank posed to reach the
+// pedal at the initial crank angle, hip and knee joints, the pedal loop and the hip torque.
+void add_leg(const BicycleLegParams& p, const Fit& fit, Vec2 hip, int leg, Scene& s) {
   const double m_t = fit.f.thigh.mass * p.mass_kg;
-  for (int leg = 0; leg < p.legs; ++leg) {
-    const std::string side = leg == 0 ? "r" : "l";
-    const double q_leg = s.initial.q + (leg == 0 ? 0.0 : kPi);
-    LegPose pose{};
-    if (!leg_pose(hip, pedal_position(p, q_leg), fit.L_t, fit.L_kp, fit.delta, pose))
-      fail("legs", "the leg cannot reach the pedal at the initial crank angle");
-    Body thigh{"thigh_" + side,
-               m_t,
-               {fit.f.thigh.com * fit.L_t, 0},
-               m_t * std::pow(fit.f.thigh.gyration * fit.L_t, 2),
-               {}};
-    thigh.points["hip"] = {0, 0};
-    thigh.points["knee"] = {fit.L_t, 0};
-    Body shank{"shank_" + side, fit.sf.mass_kg, fit.sf.com, fit.sf.inertia_kgm2, {}};
-    shank.points["knee"] = {0, 0};
-    shank.points["ankle"] = fit.sf.ankle;
-    shank.points["pedal"] = fit.sf.pedal;
-    s.bodies.push_back(thigh);
-    s.bodies.push_back(shank);
-    s.joints.push_back({"hip_" + side,
-                        JointType::Revolute,
-                        kGround,
-                        thigh.name,
-                        hip,
-                        {0, 0},
-                        {1, 0},
-                        0.0,
-                        pose.thigh_angle});
-    s.joints.push_back({"knee_" + side,
-                        JointType::Revolute,
-                        thigh.name,
-                        shank.name,
-                        {fit.L_t, 0},
-                        {0, 0},
-                        {1, 0},
-                        0.0,
-                        wrap(pose.shank_angle - pose.thigh_angle)});
-    s.loops.push_back(
-        {"pedal_" + side, shank.name, fit.sf.pedal, "crank", crank.points["pedal_" + side], std::nullopt});
-    // Hip torque pushes the thigh down (counter-clockwise: the knee is in front, at −x),
-    // and acts only while the thigh descends, i.e. while its angle increases.
-    if (p.hip_torque_Nm != 0.0)
-      s.joint_torques.push_back(
-          {"hip_torque_" + side, "hip_" + side, p.hip_torque_Nm, RateGate{"hip_" + side, +1}});
+  const std::string side = leg == 0 ? "r" : "l";
+  const double q_leg = s.initial.q + (leg == 0 ? 0.0 : kPi);
+  LegPose pose{};
+  if (!leg_pose(hip, pedal_position(p, q_leg), fit.L_t, fit.L_kp, fit.delta, pose))
+    fail_leg(s, "legs", "the leg cannot reach the pedal at the initial crank angle");
+  Body thigh{"thigh_" + side,
+             m_t,
+             {fit.f.thigh.com * fit.L_t, 0},
+             m_t * std::pow(fit.f.thigh.gyration * fit.L_t, 2),
+             {}};
+  thigh.points["hip"] = {0, 0};
+  thigh.points["knee"] = {fit.L_t, 0};
+  Body shank{"shank_" + side, fit.sf.mass_kg, fit.sf.com, fit.sf.inertia_kgm2, {}};
+  shank.points["knee"] = {0, 0};
+  shank.points["ankle"] = fit.sf.ankle;
+  shank.points["pedal"] = fit.sf.pedal;
+  s.bodies.push_back(thigh);
+  s.bodies.push_back(shank);
+  s.joints.push_back({"hip_" + side,
+                      JointType::Revolute,
+                      kGround,
+                      thigh.name,
+                      hip,
+                      {0, 0},
+                      {1, 0},
+                      0.0,
+                      pose.thigh_angle});
+  s.joints.push_back({"knee_" + side,
+                      JointType::Revolute,
+                      thigh.name,
+                      shank.name,
+                      {fit.L_t, 0},
+                      {0, 0},
+                      {1, 0},
+                      0.0,
+                      wrap(pose.shank_angle - pose.thigh_angle)});
+  s.loops.push_back({"pedal_" + side, shank.name, fit.sf.pedal, "crank",
+                     s.find_body("crank")->points.at("pedal_" + side), std::nullopt});
+  // Hip torque pushes the thigh down (counter-clockwise: the knee is in front, at −x),
+  // and acts only while the thigh descends, i.e. while its angle increases.
+  if (p.hip_torque_Nm != 0.0)
+    s.joint_torques.push_back(
+        {"hip_torque_" + side, "hip_" + side, p.hip_torque_Nm, RateGate{"hip_" + side, +1}});
+}
+
+}  // namespace
+
+double bicycle_knee_flexion(const BicycleLegParams& p, const Scene& scene, double crank_q) {
+  const Fit fit = make_fit(p);
+  LegPose pose{};
+  if (!leg_pose(scene.ground_points.at("hip"), pedal_position(p, crank_q), fit.L_t, fit.L_kp,
+                fit.delta, pose))
+    return NAN;
+  return std::abs(wrap(pose.shank_angle - pose.thigh_angle));
+}
+
+void make_bicycle_leg(const BicycleLegParams& p, Scene& s) {
+  check_leg_params(p, s);
+  Fit fit;
+  try {
+    fit = make_fit(p);
+  } catch (const std::invalid_argument& e) {
+    fail_leg(s, "subject.sex", e.what());
   }
+  const Vec2 hip = calc_hip_position(p, fit, s);
+  s.ground_points["bottom_bracket"] = {0.0, 0.0};
+  s.ground_points["hip"] = hip;
+  s.ground_points["flywheel_axle"] = {0.40, 0.0};
+  add_crank_and_flywheel(p, s);
+  for (int leg = 0; leg < p.legs; ++leg) add_leg(p, fit, hip, leg, s);
 
   // Resistance on the flywheel dissipating P at the cadence f of the crank.
   const double omega = p.gear_ratio * 2.0 * kPi * p.resistance_cadence_Hz;  // flywheel [rad/s]
   if (p.resistance_power_W > 0.0) {
-    if (!(omega > 0.0)) fail("resistance.cadence_Hz", "must be positive");
+    if (!(omega > 0.0)) fail_leg(s, "resistance.cadence_Hz", "must be positive");
     s.resistances.push_back(
         {"flywheel_resistance", "flywheel", p.resistance_law,
          p.resistance_power_W / std::pow(omega, dissipation_exponent(p.resistance_law))});

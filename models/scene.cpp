@@ -247,18 +247,19 @@ void check_table_column_names(const Checker& c, const Scene& s) {
   }
 }
 
-}  // namespace
+bool is_body_or_ground(const Scene& s, const std::string& n) { return n == kGround || s.find_body(n); }
 
-void check_scene(const Scene& s) {
-  const Checker c{s};
-  auto fail = [&](const std::string& field, const std::string& msg) { c.fail(field, msg); };
-  auto is_body_or_ground = [&](const std::string& n) { return n == kGround || s.find_body(n); };
+void check_joint_ref(const Checker& c, const std::string& field, const std::string& j) {
+  if (!c.s.find_joint(j)) c.fail(field, "unknown joint '" + printable(j) + "'");
+}
 
-  if (!is_valid_name(s.name)) fail("name", invalid_name_message(s.name));
+// The scene's name and texts, and the size of every list before any list is walked.
+void check_header_and_counts(const Checker& c, const Scene& s) {
+  if (!is_valid_name(s.name)) c.fail("name", invalid_name_message(s.name));
   if (s.description.size() > limits::kMaxTextLength)
-    fail("description", fmt::format("longer than {} characters", limits::kMaxTextLength));
+    c.fail("description", fmt::format("longer than {} characters", limits::kMaxTextLength));
   if (s.validation.note.size() > limits::kMaxTextLength)
-    fail("validation.note", fmt::format("longer than {} characters", limits::kMaxTextLength));
+    c.fail("validation.note", fmt::format("longer than {} characters", limits::kMaxTextLength));
   c.count("bodies", s.bodies.size());
   c.count("joints", s.joints.size());
   c.count("loops", s.loops.size());
@@ -270,12 +271,15 @@ void check_scene(const Scene& s) {
   c.count("outputs.bodies", s.outputs.bodies.size());
   c.count("validation.thresholds", s.validation.thresholds.size());
   c.points("ground_points", s.ground_points);
+}
 
-  // Names first, so that the fields below can name items by name.
+// Names first, so that the fields checked after them can name items by name: valid, and unique
+// within each kind.
+void check_names(const Checker& c, const Scene& s) {
   std::set<std::string> names;
   for (size_t i = 0; i < s.bodies.size(); ++i) {
     if (s.bodies[i].name == kGround)
-      fail(fmt::format("bodies[{}].name", i), "'ground' is reserved");
+      c.fail(fmt::format("bodies[{}].name", i), "'ground' is reserved");
     c.name("bodies", i, s.bodies[i].name, names);
   }
   names.clear();
@@ -297,7 +301,9 @@ void check_scene(const Scene& s) {
   names.clear();
   for (size_t i = 0; i < s.outputs.constraint_forces.size(); ++i)
     c.name("outputs.constraint_forces", i, s.outputs.constraint_forces[i].name, names);
+}
 
+void check_bodies(const Checker& c, const Scene& s) {
   for (const auto& b : s.bodies) {
     const std::string f = "bodies." + b.name;
     c.in_range(f + ".mass_kg", b.mass_kg, limits::kMinMass_kg, limits::kMaxMass_kg, "kg");
@@ -306,20 +312,22 @@ void check_scene(const Scene& s) {
     c.point(f + ".com_m", b.com_m);
     c.points(f + ".points", b.points);
   }
-  if (s.bodies.empty()) fail("bodies", "the scene has no bodies");
+  if (s.bodies.empty()) c.fail("bodies", "the scene has no bodies");
+}
 
-  // Tree: every body is the child of exactly one joint, and walking parents reaches ground.
+// Tree: every body is the child of exactly one joint, and walking parents reaches ground.
+void check_joint_tree(const Checker& c, const Scene& s) {
   std::map<std::string, std::string> parent_of;
   for (const auto& j : s.joints) {
     const std::string f = "joints." + j.name;
-    if (!is_body_or_ground(j.parent))
-      fail(f + ".parent", "unknown body '" + printable(j.parent) + "'");
-    if (!s.find_body(j.child)) fail(f + ".child", "unknown body '" + printable(j.child) + "'");
-    if (j.parent == j.child) fail(f + ".child", "a joint cannot join a body to itself");
+    if (!is_body_or_ground(s, j.parent))
+      c.fail(f + ".parent", "unknown body '" + printable(j.parent) + "'");
+    if (!s.find_body(j.child)) c.fail(f + ".child", "unknown body '" + printable(j.child) + "'");
+    if (j.parent == j.child) c.fail(f + ".child", "a joint cannot join a body to itself");
     if (parent_of.count(j.child))
-      fail(f + ".child", "body '" + j.child +
-                             "' is already the child of another joint; "
-                             "close loops with 'loops', not with a second joint");
+      c.fail(f + ".child", "body '" + j.child +
+                               "' is already the child of another joint; "
+                               "close loops with 'loops', not with a second joint");
     parent_of[j.child] = j.parent;
     c.point(f + ".parent_point", j.parent_point);
     c.point(f + ".child_point", j.child_point);
@@ -333,149 +341,173 @@ void check_scene(const Scene& s) {
   }
   for (const auto& b : s.bodies) {
     if (!parent_of.count(b.name))
-      fail("bodies." + b.name, "body is not attached by any joint (every body needs one)");
+      c.fail("bodies." + b.name, "body is not attached by any joint (every body needs one)");
     std::string cur = b.name;
     for (size_t hops = 0; cur != kGround; ++hops) {
-      if (hops > s.bodies.size()) fail("joints", "joints form a cycle through '" + b.name + "'");
+      if (hops > s.bodies.size()) c.fail("joints", "joints form a cycle through '" + b.name + "'");
       cur = parent_of[cur];
     }
   }
+}
 
+void check_loops(const Checker& c, const Scene& s) {
   for (const auto& l : s.loops) {
     const std::string f = "loops." + l.name;
-    if (!is_body_or_ground(l.body_a))
-      fail(f + ".body_a", "unknown body '" + printable(l.body_a) + "'");
-    if (!is_body_or_ground(l.body_b))
-      fail(f + ".body_b", "unknown body '" + printable(l.body_b) + "'");
-    if (l.body_a == l.body_b) fail(f, "a loop must join two different bodies");
+    if (!is_body_or_ground(s, l.body_a))
+      c.fail(f + ".body_a", "unknown body '" + printable(l.body_a) + "'");
+    if (!is_body_or_ground(s, l.body_b))
+      c.fail(f + ".body_b", "unknown body '" + printable(l.body_b) + "'");
+    if (l.body_a == l.body_b) c.fail(f, "a loop must join two different bodies");
     c.point(f + ".point_a", l.point_a);
     c.point(f + ".point_b", l.point_b);
   }
+}
+
+void check_gears(const Checker& c, const Scene& s) {
   for (const auto& g : s.gears) {
     const std::string f = "gears." + g.name;
     const Joint* a = s.find_joint(g.driver);
     const Joint* b = s.find_joint(g.driven);
-    if (!a) fail(f + ".driver", "unknown joint '" + printable(g.driver) + "'");
-    if (!b) fail(f + ".driven", "unknown joint '" + printable(g.driven) + "'");
+    if (!a) c.fail(f + ".driver", "unknown joint '" + printable(g.driver) + "'");
+    if (!b) c.fail(f + ".driven", "unknown joint '" + printable(g.driven) + "'");
     // A joint geared to itself is no constraint at all (rate = r·rate is 0 = 0 for r = 1, or
     // freezes the joint otherwise), yet it would be counted as one in the mobility below.
     if (a == b)
-      fail(f + ".driven", "a gear must couple two different joints (driver and driven are both '" +
-                              g.driver + "')");
+      c.fail(f + ".driven", "a gear must couple two different joints (driver and driven are both '" +
+                                g.driver + "')");
     if (a->type != JointType::Revolute || b->type != JointType::Revolute)
-      fail(f, "gears couple two revolute joints");
+      c.fail(f, "gears couple two revolute joints");
     if (!std::isfinite(g.ratio) || std::abs(g.ratio) < limits::kMinGearRatio ||
         std::abs(g.ratio) > limits::kMaxGearRatio)
-      fail(f + ".ratio", fmt::format("must be finite with |ratio| in [{:g}, {:g}] (got {:g})",
-                                     limits::kMinGearRatio, limits::kMaxGearRatio, g.ratio));
+      c.fail(f + ".ratio", fmt::format("must be finite with |ratio| in [{:g}, {:g}] (got {:g})",
+                                       limits::kMinGearRatio, limits::kMaxGearRatio, g.ratio));
   }
+}
 
-  // Mobility (Grübler for planar joints): each joint adds one coordinate, each loop
-  // removes two, each gear one.
+// Mobility (Grübler for planar joints): each joint adds one coordinate, each loop removes two,
+// each gear one; and the independent coordinate is one of the joints.
+void check_mobility(const Checker& c, const Scene& s) {
   const int dof = static_cast<int>(s.joints.size()) - 2 * static_cast<int>(s.loops.size()) -
                   static_cast<int>(s.gears.size());
   if (dof != 1)
-    fail("joints", fmt::format("the mechanism has {} degrees of freedom ({} joints, {} loops, "
-                               "{} gears); rdyn needs exactly 1",
-                               dof, s.joints.size(), s.loops.size(), s.gears.size()));
+    c.fail("joints", fmt::format("the mechanism has {} degrees of freedom ({} joints, {} loops, "
+                                 "{} gears); rdyn needs exactly 1",
+                                 dof, s.joints.size(), s.loops.size(), s.gears.size()));
+  if (!s.find_joint(s.independent))
+    c.fail("independent", "unknown joint '" + printable(s.independent) + "'");
+}
 
-  const Joint* independent = s.find_joint(s.independent);
-  if (!independent) fail("independent", "unknown joint '" + printable(s.independent) + "'");
-
-  auto check_joint_ref = [&](const std::string& field, const std::string& j) {
-    if (!s.find_joint(j)) fail(field, "unknown joint '" + printable(j) + "'");
-  };
+void check_joint_torques(const Checker& c, const Scene& s) {
   for (const auto& t : s.joint_torques) {
     const std::string f = "loads." + t.name;
-    check_joint_ref(f + ".joint", t.joint);
+    check_joint_ref(c, f + ".joint", t.joint);
     const bool prismatic = s.find_joint(t.joint)->type == JointType::Prismatic;
     c.abs_at_most(f + (prismatic ? ".force_N" : ".torque_Nm"), t.value, limits::kMaxForce,
                   prismatic ? "N" : "N·m");
-    if (t.active_when) check_joint_ref(f + ".active_when.joint", t.active_when->joint);
+    if (t.active_when) check_joint_ref(c, f + ".active_when.joint", t.active_when->joint);
     if (t.profile)
       check_profile(c, f, *t.profile, t.value, prismatic ? "force_N" : "torque_Nm", prismatic ? "N" : "N·m");
   }
+}
+
+void check_point_forces(const Checker& c, const Scene& s) {
   for (const auto& pf : s.point_forces) {
     // Coincident points in the assembled configuration (no direction) are the engine's check:
     // only an assembly knows where the points are (engine/full_model.cpp).
     const std::string f = "loads." + pf.name;
-    if (!is_body_or_ground(pf.body_a)) fail(f + ".body_a", "unknown body '" + printable(pf.body_a) + "'");
-    if (!is_body_or_ground(pf.body_b)) fail(f + ".body_b", "unknown body '" + printable(pf.body_b) + "'");
+    if (!is_body_or_ground(s, pf.body_a)) c.fail(f + ".body_a", "unknown body '" + printable(pf.body_a) + "'");
+    if (!is_body_or_ground(s, pf.body_b)) c.fail(f + ".body_b", "unknown body '" + printable(pf.body_b) + "'");
     if (pf.body_a == pf.body_b)
-      fail(f + ".body_b", "a point force between two points of one body ('" + pf.body_a +
-                              "') keeps its length and does nothing: give two different bodies");
+      c.fail(f + ".body_b", "a point force between two points of one body ('" + pf.body_a +
+                                "') keeps its length and does nothing: give two different bodies");
     c.point(f + ".point_a", pf.point_a);
     c.point(f + ".point_b", pf.point_b);
     c.abs_at_most(f + ".force_N", pf.value, limits::kMaxForce, "N");
-    if (pf.active_when) check_joint_ref(f + ".active_when.joint", pf.active_when->joint);
+    if (pf.active_when) check_joint_ref(c, f + ".active_when.joint", pf.active_when->joint);
     if (pf.profile) check_profile(c, f, *pf.profile, pf.value, "force_N", "N");
   }
+}
+
+void check_resistances(const Checker& c, const Scene& s) {
   for (const auto& r : s.resistances) {
     const std::string f = "loads." + r.name;
     const Body* b = s.find_body(r.body);
-    if (!b) fail(f + ".body", "unknown body '" + printable(r.body) + "'");
+    if (!b) c.fail(f + ".body", "unknown body '" + printable(r.body) + "'");
     const double max_c = b->inertia_kgm2 / limits::kMinResistanceTimeConstant_s;
     if (!std::isfinite(r.coefficient) || r.coefficient < 0.0 || r.coefficient > max_c)
-      fail(f + ".coefficient",
-           fmt::format(
-               "must be in [0, {:g}] = inertia of '{}' / {:g} s, so that the resistance alone "
-               "cannot change its speed faster than that time constant (got {:g})",
-               max_c, b->name, limits::kMinResistanceTimeConstant_s, r.coefficient));
+      c.fail(f + ".coefficient",
+             fmt::format(
+                 "must be in [0, {:g}] = inertia of '{}' / {:g} s, so that the resistance alone "
+                 "cannot change its speed faster than that time constant (got {:g})",
+                 max_c, b->name, limits::kMinResistanceTimeConstant_s, r.coefficient));
   }
+}
+
+void check_springs(const Checker& c, const Scene& s) {
   for (const auto& sp : s.springs) {
     const std::string f = "loads." + sp.name;
-    if (!is_body_or_ground(sp.body_a))
-      fail(f + ".body_a", "unknown body '" + printable(sp.body_a) + "'");
-    if (!is_body_or_ground(sp.body_b))
-      fail(f + ".body_b", "unknown body '" + printable(sp.body_b) + "'");
+    if (!is_body_or_ground(s, sp.body_a))
+      c.fail(f + ".body_a", "unknown body '" + printable(sp.body_a) + "'");
+    if (!is_body_or_ground(s, sp.body_b))
+      c.fail(f + ".body_b", "unknown body '" + printable(sp.body_b) + "'");
     c.point(f + ".point_a", sp.point_a);
     c.point(f + ".point_b", sp.point_b);
     c.in_range(f + ".stiffness_N_per_m", sp.stiffness_N_per_m, 0.0, limits::kMaxStiffness_N_per_m,
                "N/m");
     c.in_range(f + ".rest_length_m", sp.rest_length_m, 0.0, limits::kMaxCoordinate_m, "m");
   }
+}
+
+void check_motors(const Checker& c, const Scene& s) {
   for (const auto& m : s.motors) {
     const std::string f = "loads." + m.name;
-    check_joint_ref(f + ".joint", m.joint);
+    check_joint_ref(c, f + ".joint", m.joint);
     const bool prismatic = s.find_joint(m.joint)->type == JointType::Prismatic;
     const std::string speed = f + (prismatic ? ".no_load_speed_m_s" : ".no_load_speed_rad_s");
     c.abs_at_most(f + (prismatic ? ".stall_force_N" : ".stall_torque_Nm"), m.stall_torque,
                   limits::kMaxForce, prismatic ? "N" : "N·m");
     if (!std::isfinite(m.no_load_speed) || std::abs(m.no_load_speed) < limits::kMinMotorSpeed ||
         std::abs(m.no_load_speed) > limits::kMaxRate)
-      fail(speed, fmt::format("must be finite with |value| in [{:g}, {:g}] (got {:g})",
-                              limits::kMinMotorSpeed, limits::kMaxRate, m.no_load_speed));
+      c.fail(speed, fmt::format("must be finite with |value| in [{:g}, {:g}] (got {:g})",
+                                limits::kMinMotorSpeed, limits::kMaxRate, m.no_load_speed));
     // τ = stall·(1 − rate/no_load_speed) drives the rate toward no_load_speed only when both have
     // the same sign; with opposite signs the torque grows with the speed it produces (a runaway).
     if (m.stall_torque * m.no_load_speed < 0.0)
-      fail(speed,
-           fmt::format(
-               "has the opposite sign of the stall torque ({:g} vs {:g}): such a motor pushes "
-               "harder the faster it turns and runs away; give both the sign of the "
-               "direction it drives",
-               m.no_load_speed, m.stall_torque));
+      c.fail(speed,
+             fmt::format(
+                 "has the opposite sign of the stall torque ({:g} vs {:g}): such a motor pushes "
+                 "harder the faster it turns and runs away; give both the sign of the "
+                 "direction it drives",
+                 m.no_load_speed, m.stall_torque));
   }
+}
+
+// outputs: the constraint forces asked for, the reduced-table columns they make, and the bodies
+// whose motion is written.
+void check_outputs(const Checker& c, const Scene& s) {
   for (size_t i = 0; i < s.outputs.constraint_forces.size(); ++i) {
     const auto& cf = s.outputs.constraint_forces[i];
     const std::string f = "outputs.constraint_forces." + cf.name;
     const Joint* j = s.find_joint(cf.joint);
-    if (!j) fail(f + ".joint", "unknown joint '" + printable(cf.joint) + "'");
-    if (j->type != JointType::Revolute) fail(f, "constraint forces are offered on revolute joints");
+    if (!j) c.fail(f + ".joint", "unknown joint '" + printable(cf.joint) + "'");
+    if (j->type != JointType::Revolute) c.fail(f, "constraint forces are offered on revolute joints");
     // The independent joint too: its pin is the prescribed (or free) coordinate and the
     // constraint actuator's sliders follow it (engine/full_model.cpp).
     c.direction(f + ".direction", cf.direction);
   }
   check_table_column_names(c, s);
-  {
-    std::set<std::string> seen;
-    for (size_t i = 0; i < s.outputs.bodies.size(); ++i) {
-      const std::string& b = s.outputs.bodies[i];
-      const std::string f = fmt::format("outputs.bodies[{}]", i);
-      if (!s.find_body(b)) fail(f, "unknown body '" + printable(b) + "'");
-      if (!seen.insert(b).second) fail(f, "body '" + b + "' listed twice");
-    }
+  std::set<std::string> seen;
+  for (size_t i = 0; i < s.outputs.bodies.size(); ++i) {
+    const std::string& b = s.outputs.bodies[i];
+    const std::string f = fmt::format("outputs.bodies[{}]", i);
+    if (!s.find_body(b)) c.fail(f, "unknown body '" + printable(b) + "'");
+    if (!seen.insert(b).second) c.fail(f, "body '" + b + "' listed twice");
   }
+}
 
+// Gravity, the initial state and the independent coordinate's declared range.
+void check_initial(const Checker& c, const Scene& s) {
+  const Joint* independent = s.find_joint(s.independent);
   c.abs_at_most("gravity.g_m_s2[0]", s.gravity.g_m_s2.x, limits::kMaxGravity_m_s2, "m/s²");
   c.abs_at_most("gravity.g_m_s2[1]", s.gravity.g_m_s2.y, limits::kMaxGravity_m_s2, "m/s²");
   c.coordinate("initial.q", independent, s.initial.q);
@@ -484,26 +516,32 @@ void check_scene(const Scene& s) {
     const std::string f = "independent_range";
     c.coordinate(f + "[0]", independent, r->min);
     c.coordinate(f + "[1]", independent, r->max);
-    if (!(r->min < r->max)) fail(f, fmt::format("needs min < max (got [{:g}, {:g}])", r->min, r->max));
+    if (!(r->min < r->max)) c.fail(f, fmt::format("needs min < max (got [{:g}, {:g}])", r->min, r->max));
     if (!(s.initial.q >= r->min && s.initial.q <= r->max))
-      fail("initial.q", fmt::format("{:.9g} lies outside independent_range [{:.9g}, {:.9g}] (rad or m)", s.initial.q, r->min, r->max));
+      c.fail("initial.q", fmt::format("{:.9g} lies outside independent_range [{:.9g}, {:.9g}] (rad or m)", s.initial.q, r->min, r->max));
   }
+}
 
+void check_simulation(const Checker& c, const Scene& s) {
   const auto& sim = s.simulation;
   if (!(sim.duration_s > 0.0 && sim.duration_s <= limits::kMaxDuration_s))
-    fail("simulation.duration_s",
-         fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
+    c.fail("simulation.duration_s",
+           fmt::format("must be in (0, {:g}] s (got {:g})", limits::kMaxDuration_s, sim.duration_s));
   c.in_range("simulation.output_interval_s", sim.output_interval_s, limits::kMinOutputInterval_s,
              sim.duration_s, "s");
   const double longest = std::max(sim.duration_s, s.validation.duration_s);
   if (longest / sim.output_interval_s > limits::kMaxOutputRows)
-    fail("simulation.output_interval_s",
-         fmt::format("{:g} s over {:g} s gives {:g} output rows; at most {:g}",
-                     sim.output_interval_s, longest, longest / sim.output_interval_s,
-                     limits::kMaxOutputRows));
+    c.fail("simulation.output_interval_s",
+           fmt::format("{:g} s over {:g} s gives {:g} output rows; at most {:g}",
+                       sim.output_interval_s, longest, longest / sim.output_interval_s,
+                       limits::kMaxOutputRows));
   c.in_range("simulation.tolerance", sim.tolerance, limits::kMinTolerance, limits::kMaxTolerance,
              "");
+}
 
+// validation: its durations and tolerance, the thresholds' quantities and grids, and the
+// calibration's operating point.
+void check_validation(const Checker& c, const Scene& s) {
   const auto& v = s.validation;
   c.in_range("validation.duration_s", v.duration_s, 0.0, limits::kMaxDuration_s,
              "s (0: simulation.duration_s)");
@@ -515,31 +553,55 @@ void check_scene(const Scene& s) {
     bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
     for (const auto& cf : s.outputs.constraint_forces) known |= cf.name == th.quantity;
     if (!known)
-      fail(f + ".quantity",
-           fmt::format(
-               "'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
-               printable(th.quantity)));
+      c.fail(f + ".quantity",
+             fmt::format(
+                 "'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
+                 printable(th.quantity)));
     if (!th.interpolation.empty() && !is_valid_name(th.interpolation))
-      fail(f + ".interpolation",
-           fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
+      c.fail(f + ".interpolation",
+             fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
     if (!(th.max_error > 0.0 && th.max_error <= 1.0))
-      fail(f + ".max_error", fmt::format("must be in (0, 1] (a fraction; got {:g})", th.max_error));
+      c.fail(f + ".max_error", fmt::format("must be in (0, 1] (a fraction; got {:g})", th.max_error));
     c.in_range(f + ".grid_deg", th.grid_deg, limits::kMinGrid_deg, limits::kMaxGrid_deg, "degrees");
     // The table is periodic over one turn: the grid must divide 360° into whole steps.
     const double steps = 360.0 / th.grid_deg;
     if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
-      fail(f + ".grid_deg",
-           fmt::format("{:g}° does not divide 360° into whole steps", th.grid_deg));
+      c.fail(f + ".grid_deg",
+             fmt::format("{:g}° does not divide 360° into whole steps", th.grid_deg));
   }
   if (v.calibrate_cadence_Hz != 0.0 || v.calibrate_power_W != 0.0) {
     if (!(v.calibrate_cadence_Hz > 0.0 && v.calibrate_cadence_Hz <= limits::kMaxCadence_Hz))
-      fail("validation.calibrate.cadence_Hz",
-           fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz,
-                       v.calibrate_cadence_Hz));
+      c.fail("validation.calibrate.cadence_Hz",
+             fmt::format("must be in (0, {:g}] Hz (got {:g})", limits::kMaxCadence_Hz,
+                         v.calibrate_cadence_Hz));
     if (!(v.calibrate_power_W >= 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
-      fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
-                                                       limits::kMaxPower_W, v.calibrate_power_W));
+      c.fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
+                                                         limits::kMaxPower_W, v.calibrate_power_W));
   }
+}
+
+}  // namespace
+
+// Each stage throws SceneError on its first violation; the order of the stages is the order in
+// which a scene's errors are reported (names before the fields that name items by name).
+void check_scene(const Scene& s) {
+  const Checker c{s};
+  check_header_and_counts(c, s);
+  check_names(c, s);
+  check_bodies(c, s);
+  check_joint_tree(c, s);
+  check_loops(c, s);
+  check_gears(c, s);
+  check_mobility(c, s);
+  check_joint_torques(c, s);
+  check_point_forces(c, s);
+  check_resistances(c, s);
+  check_springs(c, s);
+  check_motors(c, s);
+  check_outputs(c, s);
+  check_initial(c, s);
+  check_simulation(c, s);
+  check_validation(c, s);
 }
 
 int dissipation_exponent(ResistanceLaw law) {

@@ -932,33 +932,27 @@ void read_optimize(const Fields& f, Scene& s) {
   s.optimize = o;
 }
 
-// Reads the YAML tree into `s` (names and shapes checked here, values by check_scene).
-void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
-  Fields top(
-      root, "", ctx,
-      {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
-       "independent", "independent_range", "independent_range_deg", "loads", "gravity", "outputs", "initial",
-       "simulation", "validation", "optimize"});
-  s.name = top.name("name");
-  s.description = top.str_or("description", "");
+// initial: read before the mechanism, because the generator places the mechanism at q0.
+void read_initial(const Fields& top, const Context& ctx, Scene& s) {
+  if (!top.has("initial")) return;
+  Fields f(top.raw("initial"), "initial", ctx, {"q", "q_deg", "qdot", "cadence_Hz"});
+  s.key_lines["initial"] = f.line();
+  if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
+  if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
+  // Ranges in SI are check_scene's; the converted units are checked here, where the
+  // message can quote them (the generator places the mechanism at q before that).
+  s.initial.q = f.has("q_deg") ? f.num_abs_max("q_deg", 0.0, limits::kMaxAngle_rad * 180.0 / kPi,
+                                               "degrees") *
+                                     kPi / 180.0
+                               : f.num_abs_max("q", 0.0, limits::kMaxAngle_rad, "rad or m");
+  s.initial.qdot =
+      f.has("cadence_Hz")
+          ? f.num_abs_max("cadence_Hz", 0.0, limits::kMaxRate / (2.0 * kPi), "Hz") * 2.0 * kPi
+          : f.num_or("qdot", 0.0);
+}
 
-  // Initial conditions first: the generator places the mechanism at q0.
-  if (top.has("initial")) {
-    Fields f(top.raw("initial"), "initial", ctx, {"q", "q_deg", "qdot", "cadence_Hz"});
-    s.key_lines["initial"] = f.line();
-    if (f.has("q") && f.has("q_deg")) f.fail("q", "give q or q_deg, not both");
-    if (f.has("qdot") && f.has("cadence_Hz")) f.fail("qdot", "give qdot or cadence_Hz, not both");
-    // Ranges in SI are check_scene's; the converted units are checked here, where the
-    // message can quote them (the generator places the mechanism at q before that).
-    s.initial.q = f.has("q_deg") ? f.num_abs_max("q_deg", 0.0, limits::kMaxAngle_rad * 180.0 / kPi,
-                                                 "degrees") *
-                                       kPi / 180.0
-                                 : f.num_abs_max("q", 0.0, limits::kMaxAngle_rad, "rad or m");
-    s.initial.qdot =
-        f.has("cadence_Hz")
-            ? f.num_abs_max("cadence_Hz", 0.0, limits::kMaxRate / (2.0 * kPi), "Hz") * 2.0 * kPi
-            : f.num_or("qdot", 0.0);
-  }
+// The mechanism: generated from bicycle_leg, or the scene's own bodies, joints, loops and gears.
+void read_mechanism_or_leg(const Fields& top, const Context& ctx, Scene& s) {
   if (top.has("bicycle_leg")) {
     for (const char* k : {"bodies", "joints", "loops", "gears", "independent", "ground_points"})
       if (top.has(k))
@@ -971,11 +965,12 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
   } else {
     read_mechanism(top, s);
   }
-  read_independent_range(top, s);
-  for (const char* k : {"independent_range", "independent_range_deg"})
-    if (top.has(k)) note_key(s, ctx, k, top.raw(k));
-  std::vector<PendingDissipation> pending;
-  read_loads(top, s, pending);
+}
+
+// A resistance given by `dissipates` (power at a cadence) becomes a coefficient once the
+// mechanism and its gears are known: P = c·ωⁿ at the body's speed.
+void resolve_dissipations(const Context& ctx, const std::vector<PendingDissipation>& pending,
+                          Scene& s) {
   for (const auto& p : pending) {
     Resistance& r = s.resistances[p.index];
     if (!s.find_body(r.body))
@@ -989,130 +984,182 @@ void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
     const double omega = std::abs(*ratio) * 2.0 * kPi * p.cadence_Hz;
     r.coefficient = p.power_W / std::pow(omega, dissipation_exponent(r.law));  // P = c·ωⁿ
   }
-  if (top.has("gravity")) {
-    Fields f(top.raw("gravity"), "gravity", ctx, {"enabled", "g_m_s2"});
-    s.gravity.enabled = f.flag_or("enabled", true);
-    if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
-  }
-  if (top.has("outputs")) {
-    Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies", "joints", "reactions", "shaking"});
-    for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
-      Fields c(n, path, ctx, {"name", "joint", "direction"});
-      ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
-      const Joint* j = s.find_joint(r.joint);
-      if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
-      const YAML::Node d = c.required("direction");
-      if (d.IsScalar()) {  // toward a named point of the child, from the joint
-        const Vec2 to = read_point(c, "direction", j->child, s);
-        r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
-      } else {
-        r.direction = c.vec2("direction");
-      }
-      const double len = std::hypot(r.direction.x, r.direction.y);
-      if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
-      r.direction = unit_vector(r.direction, len);
-      for (const auto& other : s.outputs.constraint_forces)
-        if (other.name == r.name) c.fail("name", "duplicate constraint force name");
-      s.outputs.constraint_forces.push_back(r);
-    });
-    if (f.has("bodies")) {
-      const YAML::Node b = f.raw("bodies");
-      if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
-      for (size_t i = 0; i < b.size(); ++i) {
-        // A body name, not a mapping or a list (yaml-cpp would only say "bad conversion").
-        if (!b[i].IsScalar()) f.fail_at(b[i], fmt::format("outputs.bodies[{}]", i), "expected a body name");
-        s.outputs.bodies.push_back(b[i].as<std::string>());
-      }
+}
+
+void read_gravity(const Fields& top, const Context& ctx, Scene& s) {
+  if (!top.has("gravity")) return;
+  Fields f(top.raw("gravity"), "gravity", ctx, {"enabled", "g_m_s2"});
+  s.gravity.enabled = f.flag_or("enabled", true);
+  if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
+}
+
+// outputs.constraint_forces: name, joint and a direction (a vector, or a named point of the
+// joint's child), stored as a unit vector.
+void read_constraint_force_requests(const Fields& f, const Context& ctx, Scene& s) {
+  for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
+    Fields c(n, path, ctx, {"name", "joint", "direction"});
+    ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
+    const Joint* j = s.find_joint(r.joint);
+    if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
+    const YAML::Node d = c.required("direction");
+    if (d.IsScalar()) {  // toward a named point of the child, from the joint
+      const Vec2 to = read_point(c, "direction", j->child, s);
+      r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
+    } else {
+      r.direction = c.vec2("direction");
     }
-    // `all` or a list of names; each name known (joints; for reactions, joints or loops).
-    auto names_or_all = [&](const std::string& key, bool loops_too) {
-      std::vector<std::string> out;
-      const YAML::Node n = f.raw(key);
-      const std::string what = loops_too ? "joint or loop" : "joint";
-      if (n.IsScalar() && n.Scalar() == "all") {
-        for (const auto& j : s.joints) out.push_back(j.name);
-        if (loops_too)
-          for (const auto& l : s.loops) out.push_back(l.name);
-      } else if (n.IsSequence()) {
-        for (const auto& item : n) {
-          const std::string name = item.IsScalar() ? item.Scalar() : "";
-          const bool loop = loops_too && std::any_of(s.loops.begin(), s.loops.end(),
-                                                     [&](const Loop& l) { return l.name == name; });
-          if (!s.find_joint(name) && !loop)
-            f.fail_at(item, f.join(key), "unknown " + what + " '" + name.substr(0, 64) + "'");
-          if (std::find(out.begin(), out.end(), name) != out.end())
-            f.fail_at(item, f.join(key), "'" + name + "' is listed twice");
-          out.push_back(name);
-        }
-      } else {
-        f.fail(key, "expected all or a list of " + what + " names");
-      }
-      for (const auto& name : out)  // R_<name> must say which one it is
-        if (loops_too && s.find_joint(name) &&
-            std::any_of(s.loops.begin(), s.loops.end(), [&](const Loop& l) { return l.name == name; }))
-          f.fail(key, "'" + name + "' names both a joint and a loop: rename one");
-      return out;
-    };
-    if (f.has("joints")) s.outputs.joints = names_or_all("joints", false);
-    if (f.has("reactions")) {
-      s.outputs.reactions = names_or_all("reactions", true);
-      note_key(s, f.ctx(), "outputs.reactions", f.raw("reactions"));
+    const double len = std::hypot(r.direction.x, r.direction.y);
+    if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
+    r.direction = unit_vector(r.direction, len);
+    for (const auto& other : s.outputs.constraint_forces)
+      if (other.name == r.name) c.fail("name", "duplicate constraint force name");
+    s.outputs.constraint_forces.push_back(r);
+  });
+}
+
+void read_output_bodies(const Fields& f, Scene& s) {
+  if (!f.has("bodies")) return;
+  const YAML::Node b = f.raw("bodies");
+  if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
+  for (size_t i = 0; i < b.size(); ++i) {
+    // A body name, not a mapping or a list (yaml-cpp would only say "bad conversion").
+    if (!b[i].IsScalar()) f.fail_at(b[i], fmt::format("outputs.bodies[{}]", i), "expected a body name");
+    s.outputs.bodies.push_back(b[i].as<std::string>());
+  }
+}
+
+// `all` or a list of names; each name known (joints; for reactions, joints or loops).
+std::vector<std::string> read_names_or_all(const Fields& f, const Scene& s, const std::string& key,
+                                           bool loops_too) {
+  std::vector<std::string> out;
+  const YAML::Node n = f.raw(key);
+  const std::string what = loops_too ? "joint or loop" : "joint";
+  if (n.IsScalar() && n.Scalar() == "all") {
+    for (const auto& j : s.joints) out.push_back(j.name);
+    if (loops_too)
+      for (const auto& l : s.loops) out.push_back(l.name);
+  } else if (n.IsSequence()) {
+    for (const auto& item : n) {
+      const std::string name = item.IsScalar() ? item.Scalar() : "";
+      const bool loop = loops_too && std::any_of(s.loops.begin(), s.loops.end(),
+                                                 [&](const Loop& l) { return l.name == name; });
+      if (!s.find_joint(name) && !loop)
+        f.fail_at(item, f.join(key), "unknown " + what + " '" + name.substr(0, 64) + "'");
+      if (std::find(out.begin(), out.end(), name) != out.end())
+        f.fail_at(item, f.join(key), "'" + name + "' is listed twice");
+      out.push_back(name);
     }
-    s.outputs.shaking = f.flag_or("shaking", false);
+  } else {
+    f.fail(key, "expected all or a list of " + what + " names");
   }
-  if (top.has("simulation")) {
-    Fields f(top.raw("simulation"), "simulation", ctx,
-             {"duration_s", "output_interval_s", "tolerance"});
-    s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
-    s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
-    s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
+  for (const auto& name : out)  // R_<name> must say which one it is
+    if (loops_too && s.find_joint(name) &&
+        std::any_of(s.loops.begin(), s.loops.end(), [&](const Loop& l) { return l.name == name; }))
+      f.fail(key, "'" + name + "' names both a joint and a loop: rename one");
+  return out;
+}
+
+void read_outputs(const Fields& top, const Context& ctx, Scene& s) {
+  if (!top.has("outputs")) return;
+  Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies", "joints", "reactions", "shaking"});
+  read_constraint_force_requests(f, ctx, s);
+  read_output_bodies(f, s);
+  if (f.has("joints")) s.outputs.joints = read_names_or_all(f, s, "joints", false);
+  if (f.has("reactions")) {
+    s.outputs.reactions = read_names_or_all(f, s, "reactions", true);
+    note_key(s, f.ctx(), "outputs.reactions", f.raw("reactions"));
   }
-  if (top.has("validation")) {
-    Fields f(top.raw("validation"), "validation", ctx,
-             {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
-              "reference_integrator", "compare"});
-    s.validation.duration_s = f.num_or("duration_s", 0.0);
-    s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
-    s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
-    const auto& ri = s.validation.reference_integrator;
-    if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
-      f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
-    s.validation.note = f.str_or("note", "");
-    for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
-      Fields t(n, path, ctx, {"quantity", "grid_deg", "interpolation", "max_error"});
-      Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
-                   t.num("max_error")};
-      // quantity, grid_deg, max_error: check_scene.
-      s.validation.thresholds.push_back(th);
-    });
-    if (f.has("calibrate")) {
-      Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
-      s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
-      // power_W absent: mean-speed mode (the resistances stay as given).
-      s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
-      s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
-      if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
-      if (c.has("load") && s.validation.calibrate_load.empty())
-        c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
-      // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
-      if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
-      if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
-    }
-    // Published values the report sets beside the calibration's (e.g. the original authors'
-    // hip torque): plain text, HTML-escaped by the report.
-    for_each_item(f, "compare", [&](const YAML::Node& n, const std::string& path) {
-      Fields c(n, path, ctx, {"quantity", "value", "unit", "source", "explanation"});
-      CompareValue cv{c.str("quantity"), c.num("value"), c.str_or("unit", ""), c.str_or("source", ""),
-                      c.str_or("explanation", "")};
-      if (std::find(kCompareQuantities.begin(), kCompareQuantities.end(), cv.quantity) ==
-          kCompareQuantities.end())
-        c.fail("quantity", "expected drive_torque_Nm, peak_force_N, speed_fluctuation or mean_power_W");
-      if (!std::isfinite(cv.value)) c.fail("value", "must be a finite number");
-      if (!f.has("calibrate"))
-        c.fail("quantity", "compared values are calibration results: add validation.calibrate");
-      s.validation.compare.push_back(cv);
-    });
-  }
+  s.outputs.shaking = f.flag_or("shaking", false);
+}
+
+void read_simulation(const Fields& top, const Context& ctx, Scene& s) {
+  if (!top.has("simulation")) return;
+  Fields f(top.raw("simulation"), "simulation", ctx,
+           {"duration_s", "output_interval_s", "tolerance"});
+  s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
+  s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
+  s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
+}
+
+// validation.calibrate: the operating point (cadence, and power or mean-speed mode) and the load
+// calibrated to reach it.
+void read_calibrate(const Fields& f, const Context& ctx, Scene& s) {
+  if (!f.has("calibrate")) return;
+  Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
+  s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
+  // power_W absent: mean-speed mode (the resistances stay as given).
+  s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
+  s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
+  if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
+  if (c.has("load") && s.validation.calibrate_load.empty())
+    c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
+  // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
+  if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
+  if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
+}
+
+// Published values the report sets beside the calibration's (e.g. the original authors'
+// hip torque): plain text, HTML-escaped by the report.
+void read_compare(const Fields& f, const Context& ctx, Scene& s) {
+  for_each_item(f, "compare", [&](const YAML::Node& n, const std::string& path) {
+    Fields c(n, path, ctx, {"quantity", "value", "unit", "source", "explanation"});
+    CompareValue cv{c.str("quantity"), c.num("value"), c.str_or("unit", ""), c.str_or("source", ""),
+                    c.str_or("explanation", "")};
+    if (std::find(kCompareQuantities.begin(), kCompareQuantities.end(), cv.quantity) ==
+        kCompareQuantities.end())
+      c.fail("quantity", "expected drive_torque_Nm, peak_force_N, speed_fluctuation or mean_power_W");
+    if (!std::isfinite(cv.value)) c.fail("value", "must be a finite number");
+    if (!f.has("calibrate"))
+      c.fail("quantity", "compared values are calibration results: add validation.calibrate");
+    s.validation.compare.push_back(cv);
+  });
+}
+
+void read_validation(const Fields& top, const Context& ctx, Scene& s) {
+  if (!top.has("validation")) return;
+  Fields f(top.raw("validation"), "validation", ctx,
+           {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
+            "reference_integrator", "compare"});
+  s.validation.duration_s = f.num_or("duration_s", 0.0);
+  s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
+  s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
+  const auto& ri = s.validation.reference_integrator;
+  if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
+    f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
+  s.validation.note = f.str_or("note", "");
+  for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
+    Fields t(n, path, ctx, {"quantity", "grid_deg", "interpolation", "max_error"});
+    Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
+                 t.num("max_error")};
+    // quantity, grid_deg, max_error: check_scene.
+    s.validation.thresholds.push_back(th);
+  });
+  read_calibrate(f, ctx, s);
+  read_compare(f, ctx, s);
+}
+
+// Reads the YAML tree into `s` (names and shapes checked here, values by check_scene), section
+// by section in the order the sections depend on each other: the first error found is reported.
+void read_scene(const YAML::Node& root, const Context& ctx, Scene& s) {
+  Fields top(
+      root, "", ctx,
+      {"name", "description", "bicycle_leg", "ground_points", "bodies", "joints", "loops", "gears",
+       "independent", "independent_range", "independent_range_deg", "loads", "gravity", "outputs", "initial",
+       "simulation", "validation", "optimize"});
+  s.name = top.name("name");
+  s.description = top.str_or("description", "");
+  read_initial(top, ctx, s);
+  read_mechanism_or_leg(top, ctx, s);
+  read_independent_range(top, s);
+  for (const char* k : {"independent_range", "independent_range_deg"})
+    if (top.has(k)) note_key(s, ctx, k, top.raw(k));
+  std::vector<PendingDissipation> pending;
+  read_loads(top, s, pending);
+  resolve_dissipations(ctx, pending, s);
+  read_gravity(top, ctx, s);
+  read_outputs(top, ctx, s);
+  read_simulation(top, ctx, s);
+  read_validation(top, ctx, s);
   if (top.has("optimize")) read_optimize(Fields(top.raw("optimize"), "optimize", ctx,
                                                 {"loads", "of", "force", "harmonics", "max_load", "nonnegative",
                                                  "objective", "p"}),

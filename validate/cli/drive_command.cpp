@@ -52,110 +52,120 @@ void write_drive_csv(const std::string& path, const DriveRecord& r, bool revolut
   sink.close();
 }
 
-}  // namespace
+// An argument the scene cannot take: reported as the scene's error on the option (exit 2).
+[[noreturn]] void refuse(const models::Scene& scene, const std::string& option, const std::string& msg) {
+  throw models::SceneError(scene.source_file, 0, option, msg);
+}
 
-int run_drive(const DriveArgs& a) {
-  std::vector<models::Override> overrides;
-  for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
-  const models::Scene scene = models::load_scene(a.scene, overrides);
-  auto bad = [&](const std::string& option, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, option, msg);
-  };
-  const auto* joint = scene.find_joint(scene.independent);
-  const bool revolute = joint->type == models::JointType::Revolute;
-  // Every number before any work.
-  if (a.cadence_hz.has_value() == !a.profile.empty()) bad("--cadence-hz", "give --cadence-hz or --profile (one of them)");
+// Every number before any work: one motion (--cadence-hz or --profile), the duration, the output
+// interval `dt` [s], the grid and the model.
+void check_drive_arguments(const DriveArgs& a, const models::Scene& scene, bool revolute, double dt) {
+  if (a.cadence_hz.has_value() == !a.profile.empty()) refuse(scene, "--cadence-hz", "give --cadence-hz or --profile (one of them)");
   if (a.cadence_hz) {
-    if (!revolute) bad("--cadence-hz", "a constant rate needs a revolute independent coordinate: give --profile");
+    if (!revolute) refuse(scene, "--cadence-hz", "a constant rate needs a revolute independent coordinate: give --profile");
     if (!(std::isfinite(*a.cadence_hz) && *a.cadence_hz != 0 && std::abs(*a.cadence_hz) <= cli_limits::kMaxCadence_Hz))
-      bad("--cadence-hz", fmt::format("must be a finite, non-zero rate with |F| ≤ {:g} rev/s (got {:g})",
-                                      cli_limits::kMaxCadence_Hz, *a.cadence_hz));
+      refuse(scene, "--cadence-hz", fmt::format("must be a finite, non-zero rate with |F| ≤ {:g} rev/s (got {:g})",
+                                                cli_limits::kMaxCadence_Hz, *a.cadence_hz));
   }
   if (a.duration && !(std::isfinite(*a.duration) && *a.duration > 0 && *a.duration <= cli_limits::kMaxDuration_s))
-    bad("--duration", fmt::format("must be in (0, {:g}] s (got {:g})", cli_limits::kMaxDuration_s, *a.duration));
-  const double dt = a.dt_out.value_or(scene.simulation.output_interval_s);
+    refuse(scene, "--duration", fmt::format("must be in (0, {:g}] s (got {:g})", cli_limits::kMaxDuration_s, *a.duration));
   if (!(std::isfinite(dt) && dt >= cli_limits::kMinOutputInterval_s && dt <= cli_limits::kMaxDuration_s))
-    bad("--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", cli_limits::kMinOutputInterval_s,
-                                cli_limits::kMaxDuration_s, dt));
+    refuse(scene, "--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", cli_limits::kMinOutputInterval_s,
+                                          cli_limits::kMaxDuration_s, dt));
   if (!(a.grid_deg >= 0.05 && a.grid_deg <= 90) || std::abs(360 / a.grid_deg - std::round(360 / a.grid_deg)) > 1e-9 * 360 / a.grid_deg)
-    bad("--grid-deg", fmt::format("must be in [0.05, 90] deg and divide 360° (got {:g})", a.grid_deg));
-  if (a.model != "full" && a.model != "reduced") bad("--model", "full or reduced");
-  // --motor STALL,NO_LOAD in the scene's units for a motor (N·m and rad/s on a revolute
-  // coordinate, N and m/s on a prismatic one), one sign for both (docs/scene-format.md, motor).
-  std::optional<std::pair<double, double>> motor;
-  if (!a.motor.empty()) {
-    const auto comma = a.motor.find(',');
-    const std::string units = revolute ? "N·m,rad/s" : "N,m/s";
-    if (comma == std::string::npos || a.motor.find(',', comma + 1) != std::string::npos)
-      bad("--motor", "give STALL,NO_LOAD (" + units + "), e.g. 40,12 (got '" + a.motor + "')");
-    double v[2];
-    for (int i = 0; i < 2; ++i) {
-      const std::string part = i == 0 ? a.motor.substr(0, comma) : a.motor.substr(comma + 1);
-      if (const auto why = check_decimal_number(part); !why.empty()) bad("--motor", why + " in '" + a.motor + "'");
-      v[i] = read_decimal_number(part);
-    }
-    if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && v[0] != 0 && v[1] != 0 && (v[0] > 0) == (v[1] > 0) &&
-          std::abs(v[0]) <= cli_limits::kMaxMotorStall && std::abs(v[1]) <= cli_limits::kMaxMotorSpeed))
-      bad("--motor", fmt::format("stall and no-load speed must be non-zero, finite, of one sign (the speed the motor "
-                                 "drives toward), |stall| ≤ {:g} and |no-load speed| ≤ {:g} ({}; got {})",
-                                 cli_limits::kMaxMotorStall, cli_limits::kMaxMotorSpeed, units, a.motor));
-    motor = std::make_pair(v[0], v[1]);
-  }
+    refuse(scene, "--grid-deg", fmt::format("must be in [0.05, 90] deg and divide 360° (got {:g})", a.grid_deg));
+  if (a.model != "full" && a.model != "reduced") refuse(scene, "--model", "full or reduced");
+}
 
-  // The motion is computed on a grid fine enough for its statistics — at most 1° of q between
-  // rows (0.001 m for a slider), and the output grid itself — and the output keeps every k-th row
-  // (run.json's peaks and means from 0.5 s rows missed the parallelogram's peak by 13 %).
-  nlohmann::json run = {{"scene", scene.name}, {"scene_file", scene.source_file}, {"model", a.model}};
-  auto motion_at = [&](double step) {
-    PrescribedMotion m;
-    if (a.cadence_hz) {
-      const double duration = a.duration.value_or(1.0 / std::abs(*a.cadence_hz));  // one revolution
-      if (dt > duration * (1 + 1e-12)) bad("--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, duration));
-      if (duration / step > cli_limits::kMaxOutputRows)
-        bad("--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
-      m = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, step);
-      m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
-    } else {
-      m = profile_motion(a.profile, revolute, a.duration, step, cli_limits::kMaxOutputRows);
-      if (dt > m.t.back() * (1 + 1e-12)) bad("--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, m.t.back()));
-      m.how = "profile " + a.profile + " (natural cubic spline, from its first time)";
-    }
-    return m;
-  };
-  const PrescribedMotion coarse = motion_at(dt);
+// --motor STALL,NO_LOAD in the scene's units for a motor (N·m and rad/s on a revolute
+// coordinate, N and m/s on a prismatic one), one sign for both (docs/scene-format.md, motor).
+std::optional<std::pair<double, double>> parse_motor_option(const DriveArgs& a, const models::Scene& scene,
+                                                            bool revolute) {
+  if (a.motor.empty()) return std::nullopt;
+  const auto comma = a.motor.find(',');
+  const std::string units = revolute ? "N·m,rad/s" : "N,m/s";
+  if (comma == std::string::npos || a.motor.find(',', comma + 1) != std::string::npos)
+    refuse(scene, "--motor", "give STALL,NO_LOAD (" + units + "), e.g. 40,12 (got '" + a.motor + "')");
+  double v[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string part = i == 0 ? a.motor.substr(0, comma) : a.motor.substr(comma + 1);
+    if (const auto why = check_decimal_number(part); !why.empty()) refuse(scene, "--motor", why + " in '" + a.motor + "'");
+    v[i] = read_decimal_number(part);
+  }
+  if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && v[0] != 0 && v[1] != 0 && (v[0] > 0) == (v[1] > 0) &&
+        std::abs(v[0]) <= cli_limits::kMaxMotorStall && std::abs(v[1]) <= cli_limits::kMaxMotorSpeed))
+    refuse(scene, "--motor",
+           fmt::format("stall and no-load speed must be non-zero, finite, of one sign (the speed the motor "
+                       "drives toward), |stall| ≤ {:g} and |no-load speed| ≤ {:g} ({}; got {})",
+                       cli_limits::kMaxMotorStall, cli_limits::kMaxMotorSpeed, units, a.motor));
+  return std::make_pair(v[0], v[1]);
+}
+
+// The prescribed motion at time steps `step` [s], checked against the output interval `dt` [s].
+PrescribedMotion calc_motion_at(const DriveArgs& a, const models::Scene& scene, bool revolute, double dt,
+                                double step) {
+  PrescribedMotion m;
+  if (a.cadence_hz) {
+    const double duration = a.duration.value_or(1.0 / std::abs(*a.cadence_hz));  // one revolution
+    if (dt > duration * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, duration));
+    if (duration / step > cli_limits::kMaxOutputRows)
+      refuse(scene, "--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
+    m = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, step);
+    m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
+  } else {
+    m = profile_motion(a.profile, revolute, a.duration, step, cli_limits::kMaxOutputRows);
+    if (dt > m.t.back() * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, m.t.back()));
+    m.how = "profile " + a.profile + " (natural cubic spline, from its first time)";
+  }
+  return m;
+}
+
+// The motion on a grid fine enough for its statistics, and `k`: the output keeps every k-th row.
+struct DriveMotion {
+  PrescribedMotion motion;
+  long k = 1;
+};
+
+// The motion is computed on a grid fine enough for its statistics — at most 1° of q between
+// rows (0.001 m for a slider), and the output grid itself — and the output keeps every k-th row
+// (run.json's peaks and means from 0.5 s rows missed the parallelogram's peak by 13 %).
+DriveMotion calc_drive_motion(const DriveArgs& a, const models::Scene& scene, bool revolute, double dt) {
+  const PrescribedMotion coarse = calc_motion_at(a, scene, revolute, dt, dt);
   double rate_max = 0.0;
   for (double v : coarse.qdot) rate_max = std::max(rate_max, std::abs(v));
   const double row_step = revolute ? M_PI / 180 : 1e-3;  // [rad or m] between statistics rows
   const long k = std::max(1L, static_cast<long>(std::ceil(dt * rate_max / row_step - 1e-9)));
   if (static_cast<double>(k) * static_cast<double>(coarse.t.size()) > cli_limits::kMaxOutputRows)
-    bad(a.cadence_hz ? "--duration" : "--profile", fmt::format("the motion needs {:.3g} rows of at most 1° each; at most {:g}",
-                                  static_cast<double>(k) * static_cast<double>(coarse.t.size()),
-                                  cli_limits::kMaxOutputRows));
-  const PrescribedMotion motion = k == 1 ? coarse : motion_at(dt / static_cast<double>(k));
-  if (a.model == "full" && calc_drive_moves(motion) > kMaxDriveMoves)
-    bad(a.cadence_hz ? "--duration" : "--profile",
-        fmt::format("the full model would follow {:.3g} continuation moves of 5° (at most {:g}, about a minute): "
-                    "shorten the run or use --model reduced",
-                    calc_drive_moves(motion), kMaxDriveMoves));
-  if (a.cadence_hz) run["cadence_hz"] = *a.cadence_hz;
-  else run["profile"] = a.profile;
-  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+    refuse(scene, a.cadence_hz ? "--duration" : "--profile",
+           fmt::format("the motion needs {:.3g} rows of at most 1° each; at most {:g}",
+                       static_cast<double>(k) * static_cast<double>(coarse.t.size()), cli_limits::kMaxOutputRows));
+  DriveMotion d{k == 1 ? coarse : calc_motion_at(a, scene, revolute, dt, dt / static_cast<double>(k)), k};
+  if (a.model == "full" && calc_drive_moves(d.motion) > kMaxDriveMoves)
+    refuse(scene, a.cadence_hz ? "--duration" : "--profile",
+           fmt::format("the full model would follow {:.3g} continuation moves of 5° (at most {:g}, about a minute): "
+                       "shorten the run or use --model reduced",
+                       calc_drive_moves(d.motion), kMaxDriveMoves));
+  return d;
+}
 
-  DriveRecord r;
-  if (a.model == "full") {
-    r = calc_drive_full(scene, motion);
-  } else {
-    auto e = extract_from_full(scene, a.grid_deg, reduced::Method::Kinetostatic);
-    const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(a.interpolation));
-    r = calc_drive_reduced(model, motion);
-    run.update({{"grid_deg", a.grid_deg}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
-  }
-  const DriveStats st = calc_drive_stats(r);
-  const char* unit = revolute ? "N·m" : "N";
+// The drive the chosen model needs along the motion; the reduced model's settings go into `run`.
+DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, const PrescribedMotion& motion,
+                              nlohmann::json& run) {
+  if (a.model == "full") return calc_drive_full(scene, motion);
+  auto e = extract_from_full(scene, a.grid_deg, reduced::Method::Kinetostatic);
+  const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(a.interpolation));
+  DriveRecord r = calc_drive_reduced(model, motion);
+  run.update({{"grid_deg", a.grid_deg}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
+  return r;
+}
+
+// run.json's results: the drive's statistics, the constraint-force peaks and the motor check.
+void add_drive_results(nlohmann::json& run, const PrescribedMotion& motion, const DriveRecord& r,
+                       const DriveStats& st, double dt, bool revolute, const std::optional<MotorCheck>& mc) {
   run.update({{"motion", motion.how},
               {"duration_s", r.t.back()},
               {"output_interval_s", dt},
-              {"drive_unit", unit},
+              {"drive_unit", revolute ? "N·m" : "N"},
               {"drive_rms", st.rms},
               {"drive_peak", st.peak},
               {"drive_mean", st.mean},
@@ -166,9 +176,7 @@ int run_drive(const DriveArgs& a) {
   for (size_t c = 0; c < r.force_names.size(); ++c) peaks[r.force_names[c]] = st.force_peaks[c];
   run["constraint_force_peaks_N"] = peaks;
   run["statistics_rows"] = r.t.size();
-  std::optional<MotorCheck> mc;
-  if (motor) {
-    mc = calc_motor_check(r, motor->first, motor->second);
+  if (mc)
     run["motor_check"] = {{"stall", mc->stall},
                           {"no_load_speed", mc->no_load_speed},
                           {"covers", mc->covers},
@@ -179,12 +187,36 @@ int run_drive(const DriveArgs& a) {
                           {"at_q_unit", revolute ? "deg" : "m"},
                           {"drive_there", mc->drive_there},
                           {"line_there", mc->line_there}};
-  }
-  write_drive_csv(out.file("timeseries.csv"), every_kth_row(r, k), revolute);
+}
+
+}  // namespace
+
+int run_drive(const DriveArgs& a) {
+  std::vector<models::Override> overrides;
+  for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
+  const models::Scene scene = models::load_scene(a.scene, overrides);
+  const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  const double dt = a.dt_out.value_or(scene.simulation.output_interval_s);
+  check_drive_arguments(a, scene, revolute, dt);
+  const auto motor = parse_motor_option(a, scene, revolute);
+  const DriveMotion d = calc_drive_motion(a, scene, revolute, dt);
+
+  nlohmann::json run = {{"scene", scene.name}, {"scene_file", scene.source_file}, {"model", a.model}};
+  if (a.cadence_hz) run["cadence_hz"] = *a.cadence_hz;
+  else run["profile"] = a.profile;
+  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+  const DriveRecord r = calc_drive_record(a, scene, d.motion, run);
+  const DriveStats st = calc_drive_stats(r);
+  std::optional<MotorCheck> mc;
+  if (motor) mc = calc_motor_check(r, motor->first, motor->second);
+  add_drive_results(run, d.motion, r, st, dt, revolute, mc);
+
+  write_drive_csv(out.file("timeseries.csv"), every_kth_row(r, d.k), revolute);
   write_text_file(out.file("run.json"), run.dump(2) + "\n");
   out.commit();
+  const char* unit = revolute ? "N·m" : "N";
   std::fprintf(stderr, "rdyn: %s (%s model) driven by %s: drive RMS %.4g %s, peak %.4g %s, mean power %.4g W; wrote %s\n",
-               scene.name.c_str(), a.model.c_str(), motion.how.c_str(), st.rms, unit, st.peak, unit, st.mean_power_W,
+               scene.name.c_str(), a.model.c_str(), d.motion.how.c_str(), st.rms, unit, st.peak, unit, st.mean_power_W,
                (a.out + "/timeseries.csv").c_str());
   if (mc)
     std::fprintf(stderr, "rdyn: motor %s: %s (smallest margin %.4g %s, %.3g %% of stall, at t = %.6g s, %s)\n",

@@ -18,19 +18,18 @@
 #include "validate/harness/peers.hpp"
 
 namespace {
+using namespace rdyn::validate;
+
 constexpr int kExitBadInput = 2;
 constexpr int kExitNumerical = 1;
+
+// An empty --load would silently mean "no load named" (every joint torque): refuse it.
+CLI::Validator names_a_load() {
+  return CLI::Validator(
+      [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
 }
 
-int main(int argc, char** argv) {
-  using namespace rdyn::validate;
-  CLI::App app{
-      "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
-      "full multibody model (Simbody).\n"
-      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
-  app.require_subcommand(1);
-
-  SimulateArgs sim;
+void add_simulate_command(CLI::App& app, SimulateArgs& sim) {
   auto* simulate = app.add_subcommand(
       "simulate",
       "Simulate a scene with the full model (Simbody forward dynamics) or the reduced model, and write "
@@ -39,14 +38,17 @@ int main(int argc, char** argv) {
   simulate->add_option("scene", sim.scene, "Scene name or YAML file")->required();
   simulate->add_option("--model", sim.model, "full (Simbody) or reduced (tables + Eksergian's equation)")
       ->check(CLI::IsMember({"full", "reduced"}));
-  double duration = 0, dt_out = 0, tolerance = 0;  // copied into `sim` when given
-  auto* duration_opt = simulate->add_option("--duration", duration, "Simulated time [s] (default: the scene's)");
-  auto* dt_out_opt = simulate->add_option("--dt-out", dt_out, "Output interval [s] (default: the scene's)");
+  // Typed values are kept apart from the defaults: the optional fields are set only when given.
+  simulate->add_option_function<double>("--duration", [&sim](const double& v) { sim.duration = v; },
+                                        "Simulated time [s] (default: the scene's)");
+  simulate->add_option_function<double>("--dt-out", [&sim](const double& v) { sim.dt_out = v; },
+                                        "Output interval [s] (default: the scene's)");
   simulate->add_option("--set", sim.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   simulate->add_option("--out", sim.out, "Output folder (written atomically)")->required();
   simulate->add_flag("--force", sim.force, kForceHelpDir);
   auto* full = simulate->add_option_group("full model");
-  auto* tolerance_opt = full->add_option("--tolerance", tolerance, "Integrator accuracy (default: the scene's)");
+  full->add_option_function<double>("--tolerance", [&sim](const double& v) { sim.tolerance = v; },
+                                    "Integrator accuracy (default: the scene's)");
   full->add_option("--integrator", sim.integrator, "rkmerson, rk3 or cpodes")
       ->check(CLI::IsMember({"rkmerson", "rk3", "cpodes"}));
   full->add_option("--constraint-force-route", sim.route,
@@ -66,8 +68,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"rk8pd", "rkf45", "rkck", "rk4-fixed"}));
   red->add_option("--reduced-tolerance", sim.reduced_tolerance, "Adaptive integrator tolerance (default 1e-8)");
   red->add_option("--fixed-step", sim.fixed_step, "rk4-fixed step [s] (default 1e-3)");
+}
 
-  ExtractArgs ext;
+void add_extract_command(CLI::App& app, ExtractArgs& ext) {
   auto* extract = app.add_subcommand(
       "extract",
       "Extract the reduced parameters of a scene from kinetostatic calls of the full model and write a portable "
@@ -81,8 +84,9 @@ int main(int argc, char** argv) {
   extract->add_option("--set", ext.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   extract->add_option("--out", ext.out, "Output CSV file")->required();
   extract->add_flag("--force", ext.force, kForceHelpFile);
+}
 
-  CalibrateArgs cal;
+void add_calibrate_command(CLI::App& app, CalibrateArgs& cal) {
   auto* calibrate = app.add_subcommand(
       "calibrate",
       "Find (GSL Brent) the value of a drive load -- a joint torque or force, or a motor's stall torque with its "
@@ -96,19 +100,17 @@ int main(int argc, char** argv) {
       "speed_fluctuation, ...); progress goes to standard error.");
   calibrate->add_option("scene", cal.scene, "Scene name or YAML file")->required();
   add_operating_point_options(*calibrate, cal.cadence_hz, cal.cadence_given, cal.power_w, cal.power_given);
-  // An empty --load would silently mean "no load named" (every joint torque): refuse it.
-  const CLI::Validator names_a_load(
-      [](std::string& v) { return v.empty() ? std::string("an empty name names no load") : std::string(); }, "NAME");
   calibrate->add_option("--load", cal.load,
                         "The joint_torque, point_force or motor to adjust, or joint torques or point forces joined "
                         "by + (default: the scene's validation.calibrate.load, else every joint torque together)")
-      ->check(names_a_load);
+      ->check(names_a_load());
   calibrate->add_option("--write-scene", cal.write_scene, "Write the calibrated scene (YAML) here");
   calibrate->add_flag("--force", cal.force, kForceHelpFile);
   add_scene_overrides(*calibrate, cal.sets);
   add_reduced_table_options(*calibrate, cal.grid_deg, cal.interpolation);
+}
 
-  ValidateArgs val;
+void add_validate_command(CLI::App& app, ValidateArgs& val) {
   auto* validate = app.add_subcommand(
       "validate",
       "Validate the reduced model against full forward dynamics: a converged reference, a ladder of full-model "
@@ -130,8 +132,9 @@ int main(int argc, char** argv) {
                        "the scene's time scale, in summary.json's peers and the accuracy-against-cost figure; needs "
                        "rdyn built with MuJoCo)")
       ->check(CLI::IsMember(kPeers));
+}
 
-  ReportArgs rep;
+void add_report_command(CLI::App& app, ReportArgs& rep) {
   auto* report = app.add_subcommand(
       "report",
       "Re-render a validation report from its summary.json alone (e.g. after editing a gnuplot style or moving "
@@ -139,8 +142,9 @@ int main(int argc, char** argv) {
   report->add_option("summary", rep.summary, "summary.json written by `rdyn validate`")->required();
   report->add_option("--out", rep.out, "Output folder (written atomically)")->required();
   report->add_flag("--force", rep.force, kForceHelpDir);
+}
 
-  SweepArgs sw;
+void add_sweep_command(CLI::App& app, SweepArgs& sw) {
   auto* sweep = app.add_subcommand(
       "sweep",
       "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
@@ -162,10 +166,11 @@ int main(int argc, char** argv) {
   sweep->add_option_function<double>(
       "--power-w", [&sw](const double& v) { sw.power_w = v; },
       "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as given)");
-  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load);
+  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load());
   sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+}
 
-  InspectArgs ins;
+void add_inspect_command(CLI::App& app, InspectArgs& ins) {
   auto* inspect = app.add_subcommand(
       "inspect",
       "Assemble a scene and print, as JSON on standard output, what a newcomer needs while writing it: every "
@@ -174,7 +179,9 @@ int main(int argc, char** argv) {
       "dead points, found by continuation) and warnings (also on standard error).");
   inspect->add_option("scene", ins.scene, "Scene name or YAML file")->required();
   inspect->add_option("--set", ins.sets, "Override a scalar of the scene: key.path=value (repeatable)");
-  ExportMjcfArgs mj;
+}
+
+void add_export_mjcf_command(CLI::App& app, ExportMjcfArgs& mj) {
   auto* export_mjcf = app.add_subcommand(
       "export-mjcf",
       "Write the scene as MJCF (MuJoCo XML): bodies, hinges and slides, loops as connect equalities and gears as "
@@ -188,8 +195,9 @@ int main(int argc, char** argv) {
   export_mjcf->add_option("--timestep", mj.timestep_s, "<option timestep> [s] (default 1e-3)");
   export_mjcf->add_option("--integrator", mj.integrator, "<option integrator>: Euler or RK4")
       ->check(CLI::IsMember({"Euler", "RK4"}));
+}
 
-  OptimizeArgs opz;
+void add_optimize_command(CLI::App& app, OptimizeArgs& opz) {
   auto* optimize = app.add_subcommand(
       "optimize",
       "Find the shape of drive loads (truncated Fourier series of a joint angle, the scene's `optimize` block) that "
@@ -206,7 +214,9 @@ int main(int argc, char** argv) {
   optimize->add_option("--max-load", opz.max_load,
                        "Bound on |value·τ(θ)| of the scene's design loads [N·m or N] (default: the scene's optimize.max_load, "
                        "else 5× the constant strategy's value; loads added by --add-torque take --add-torque-max)");
-  auto* opz_force_name = optimize->add_option("--force-name", opz.force_name, "Constraint force to minimise (default: the scene's, else the first)");
+  optimize->add_option_function<std::string>(
+      "--force-name", [&opz](const std::string& v) { opz.force_name = v, opz.force_name_given = true; },
+      "Constraint force to minimise (default: the scene's, else the first)");
   optimize->add_option("--add-torque", opz.add_torques,
                        "Add a profiled torque torque_<JOINT> on a revolute joint as a further design load (signed "
                        "shape; repeatable)");
@@ -217,7 +227,9 @@ int main(int argc, char** argv) {
   optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
   add_scene_overrides(*optimize, opz.sets);
   add_output_folder(*optimize, opz.out, opz.force);
-  DriveArgs drv;
+}
+
+void add_drive_command(CLI::App& app, DriveArgs& drv) {
   auto* drive = app.add_subcommand(
       "drive",
       "Prescribed motion: the independent coordinate follows a constant rate (--cadence-hz) or a profile q(t) "
@@ -225,22 +237,25 @@ int main(int argc, char** argv) {
       "model says what the drive must supply. Writes DIR/timeseries.csv (t,q,qdot,qddot,drive_Nm or drive_N, "
       "drive_W, F_<name>...) and DIR/run.json (drive RMS, peak, mean, mean and peak power, constraint-force peaks).");
   drive->add_option("scene", drv.scene, "Scene name or YAML file")->required();
-  double drive_cadence = 0, drive_duration = 0, drive_dt = 0;
-  auto* drive_cadence_opt =
-      drive->add_option("--cadence-hz", drive_cadence, "Constant rate [rev/s] of a revolute coordinate (sign: direction)");
+  // Typed values are kept apart from the defaults: the optional fields are set only when given.
+  drive->add_option_function<double>("--cadence-hz", [&drv](const double& v) { drv.cadence_hz = v; },
+                                     "Constant rate [rev/s] of a revolute coordinate (sign: direction)");
   drive->add_option("--profile", drv.profile, "CSV of t,q_deg (revolute) or t,q_m (prismatic) to follow");
   drive->add_option("--model", drv.model, "full (Simbody inverse dynamics, default) or reduced")
       ->check(CLI::IsMember({"full", "reduced"}));
-  auto* drive_duration_opt =
-      drive->add_option("--duration", drive_duration, "Time [s] (default: one revolution, or the profile's span)");
-  auto* drive_dt_opt = drive->add_option("--dt-out", drive_dt, "Output interval [s] (default: the scene's)");
+  drive->add_option_function<double>("--duration", [&drv](const double& v) { drv.duration = v; },
+                                     "Time [s] (default: one revolution, or the profile's span)");
+  drive->add_option_function<double>("--dt-out", [&drv](const double& v) { drv.dt_out = v; },
+                                     "Output interval [s] (default: the scene's)");
   drive->add_option("--motor", drv.motor,
                     "STALL,NO_LOAD: check that a motor on the independent coordinate with this torque-speed line "
                     "(N*m,rad/s; N,m/s on a slider) covers the drive at every angle; run.json gets motor_check");
   add_reduced_table_options(*drive, drv.grid_deg, drv.interpolation);
   add_scene_overrides(*drive, drv.sets);
   add_output_folder(*drive, drv.out, drv.force);
-  ExpandArgs exp;
+}
+
+void add_expand_command(CLI::App& app, ExpandArgs& exp) {
   auto* expand = app.add_subcommand(
       "expand",
       "Write the scene as rdyn reads it -- generators (bicycle_leg) expanded into bodies and joints, --set "
@@ -251,38 +266,38 @@ int main(int argc, char** argv) {
   expand->add_option("--set", exp.sets, "Override a scalar of the scene: key.path=value (repeatable)");
   expand->add_option("--out", exp.out, "Output YAML file (default: standard output)");
   expand->add_flag("--force", exp.force, kForceHelpFile);
+}
 
-  require_decimal_numbers(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return kExitBadInput;
-  }
+// Every subcommand's arguments, filled while the command line is parsed.
+struct CommandArgs {
+  SimulateArgs sim;
+  ExtractArgs ext;
+  CalibrateArgs cal;
+  ValidateArgs val;
+  ReportArgs rep;
+  SweepArgs sw;
+  InspectArgs ins;
+  ExportMjcfArgs mj;
+  OptimizeArgs opz;
+  DriveArgs drv;
+  ExpandArgs exp;
+};
 
-  if (duration_opt->count()) sim.duration = duration;
-  if (dt_out_opt->count()) sim.dt_out = dt_out;
-  opz.force_name_given = opz_force_name->count() > 0;
-  if (tolerance_opt->count()) sim.tolerance = tolerance;
-  if (drive_cadence_opt->count()) drv.cadence_hz = drive_cadence;
-  if (drive_duration_opt->count()) drv.duration = drive_duration;
-  if (drive_dt_opt->count()) drv.dt_out = drive_dt;
+// Runs the one subcommand given; the errors a command reports become the exit status (README,
+// "Exit status") with one line on standard error.
+int run_command(const CLI::App& app, const CommandArgs& a) {
   try {
-    if (*simulate) return run_simulate(sim);
-    if (*extract) return run_extract(ext);
-    if (*calibrate) return run_calibrate(cal);
-    if (*validate) return run_validate(val);
-    if (*sweep) return run_sweep_command(sw);
-    if (*report) return run_report(rep);
-    if (*inspect) return run_inspect(ins);
-    if (*export_mjcf) return run_export_mjcf(mj);
-    if (*optimize) return run_optimize(opz);
-    if (*drive) return run_drive(drv);
-    if (*expand) return run_expand(exp);
+    if (app.got_subcommand("simulate")) return run_simulate(a.sim);
+    if (app.got_subcommand("extract")) return run_extract(a.ext);
+    if (app.got_subcommand("calibrate")) return run_calibrate(a.cal);
+    if (app.got_subcommand("validate")) return run_validate(a.val);
+    if (app.got_subcommand("sweep")) return run_sweep_command(a.sw);
+    if (app.got_subcommand("report")) return run_report(a.rep);
+    if (app.got_subcommand("inspect")) return run_inspect(a.ins);
+    if (app.got_subcommand("export-mjcf")) return run_export_mjcf(a.mj);
+    if (app.got_subcommand("optimize")) return run_optimize(a.opz);
+    if (app.got_subcommand("drive")) return run_drive(a.drv);
+    if (app.got_subcommand("expand")) return run_expand(a.exp);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;
@@ -309,4 +324,38 @@ int main(int argc, char** argv) {
     return kExitNumerical;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
+      "full multibody model (Simbody).\n"
+      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
+  app.require_subcommand(1);
+  CommandArgs a;
+  add_simulate_command(app, a.sim);
+  add_extract_command(app, a.ext);
+  add_calibrate_command(app, a.cal);
+  add_validate_command(app, a.val);
+  add_report_command(app, a.rep);
+  add_sweep_command(app, a.sw);
+  add_inspect_command(app, a.ins);
+  add_export_mjcf_command(app, a.mj);
+  add_optimize_command(app, a.opz);
+  add_drive_command(app, a.drv);
+  add_expand_command(app, a.exp);
+  require_decimal_numbers(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  }
+  return run_command(app, a);
 }
