@@ -112,29 +112,36 @@ void combine_last_rows(TimeSeries& ts, const LimitStencil& st) {
 
 // One output row of a singular passage at p: the full state on the branch with the free
 // acceleration prescribed (the drive it needs is then zero), recorded as the integrator's rows
-// are; near rank loss, where the multipliers are poorly determined, the interpolation of rows
-// taken outside the limit radius. Returns the kinetic
-// energy (of the row, or the largest of the four) [J].
+// are. Near rank loss q̈ comes from the limit stencil, but the row — its constraint forces and
+// reactions above all — is taken at p itself: those forces can grow without bound toward the
+// flat configuration (a loss-torque's share ~τ/(2 sin q) in a parallelogram), which an
+// interpolation from outside the limit radius misses (−33 N for −41 N at 0.013 rad from a
+// 3-loop chain's flat position). Only where the rates are not determined at all
+// (κ < kSingularConditioning, ~1e-4 rad from it) is the row the stencil's interpolation.
+// Returns the kinetic energy (of the row, or the largest of the stencil's) [J].
 double record_passage(const FullModel& model, BranchGuard& guard, const IndependentDomain& domain,
                       const PassagePoint& p, TimeSeries& ts) {
   const auto& m = model.impl();
   double kinetic_J = 0.0;
-  auto row_at = [&](double q) {
-    const auto fm = calc_free_motion(model, guard, q, p.qdot, LimitStencil{});
-    set_passage_state(model, guard, q, p.qdot, fm.qddot);
+  auto row_at = [&](double q, const LimitStencil& stencil) {
+    const auto fm = calc_free_motion(model, guard, q, p.qdot, stencil);
+    const double k = set_passage_state(model, guard, q, p.qdot, fm.qddot);
     State& st = guard.ws.impl().state;  // its time stays 0: the prescribed law is q + q̇ t + ½ q̈ t²
     m.set_work(st, p.work);
     initialize_gates(m, st);
     record(m, st, ts);
     ts.t.back() = p.t;
     kinetic_J = std::max(kinetic_J, m.system.calcKineticEnergy(st));
+    return k;
   };
   const auto stencil = limit_stencil_at(domain.singular, domain.periodic, p.q);
-  if (stencil.x.empty()) {
-    row_at(p.q);
-    return kinetic_J;
-  }
-  for (const double x : stencil.x) row_at(x);
+  if (row_at(p.q, stencil) >= kSingularConditioning) return kinetic_J;
+  for (auto* v : {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work}) v->pop_back();
+  for (auto& v : ts.forces) v.pop_back();
+  for (auto& v : ts.columns) v.pop_back();
+  ts.gates.pop_back();
+  kinetic_J = 0.0;
+  for (const double x : stencil.x) row_at(x, LimitStencil{});
   combine_last_rows(ts, stencil);
   ts.t.back() = p.t, ts.q.back() = p.q, ts.qdot.back() = p.qdot, ts.work.back() = p.work;
   follow_branch(model, guard.ws, p.q, guard.max_move, guard.max_correction);
@@ -310,14 +317,20 @@ void FullRun::start() {
   ts_.forces.resize(ts_.force_names.size());
   ts_.column_names = reduced::joint_output_names(m_.scene);
   ts_.columns.resize(ts_.column_names.size());
-  record(m_, integ_->getState(), ts_);
-  check_finite_row(ts_);
-  motion_scale_J_ = m_.system.calcKineticEnergy(integ_->getState());
-  m_.system.realize(integ_->getState(), Stage::Position);
-  check_point_force_lines(m_, integ_->getState(), line_dir_);
-  // Started inside a window (near, not at, a configuration of rank loss).
+  // Started inside a window (near, not at, a configuration of rank loss): the partitioned
+  // formulation from the first row on (Simbody's q̈ there carried the projection's error: 1.9
+  // rad/s² where it is 0, a 3-loop chain 1e-4 rad from flat at 300 rad/s).
   if (!singular_.empty() && !outside_windows(singular_, domain_.periodic, m_.scene.initial.q))
     passage_ = PassagePoint{0.0, m_.scene.initial.q, m_.scene.initial.qdot, 0.0};
+  if (passage_) {
+    motion_scale_J_ = record_passage(model_, guard_, domain_, *passage_, ts_);
+  } else {
+    record(m_, integ_->getState(), ts_);
+    motion_scale_J_ = m_.system.calcKineticEnergy(integ_->getState());
+  }
+  check_finite_row(ts_);
+  m_.system.realize(integ_->getState(), Stage::Position);
+  check_point_force_lines(m_, integ_->getState(), line_dir_);
 }
 
 void FullRun::run() {
@@ -482,9 +495,9 @@ TimeSeries FullRun::finish() {
     throw models::NumericalError(fmt::format(
         "full model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
         "energy scale {:.3g} J (largest |E|, kinetic energy or |W|; limit {:g} %): the integration lost or invented "
-        "energy ('{}' at tolerance {:g}; try a tighter tolerance or cpodes)",
+        "energy ('{}' at tolerance {:g}; try a tighter tolerance{})",
         eb.max_residual_J, eb.worst_time_s, 100 * eb.max_residual_J / std::max(scale_J, kEnergyFloor_J), scale_J,
-        100 * opt_.energy_tolerance, opt_.integrator, opt_.tolerance));
+        100 * opt_.energy_tolerance, opt_.integrator, opt_.tolerance, opt_.integrator == "cpodes" ? "" : " or cpodes"));
   return std::move(ts_);
 }
 

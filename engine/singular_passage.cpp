@@ -80,12 +80,22 @@ std::vector<SingularPoint> calc_singular_points(const FullModel& model, const In
     k[i] = conditioning_at(model, g, x[i]);
   }
   std::vector<SingularPoint> out;
-  // Interior local minima (periodic: the walk's two ends are one point).
-  for (long i = domain.periodic ? 0 : 1; i < n; ++i) {
-    const long lo = i > 0 ? i - 1 : n - 1, hi = i + 1;
-    if (!(k[i] < kScanCandidate && k[i] <= k[lo] && k[i] <= k[hi])) continue;
-    const double a = i > 0 ? x[lo] : x[0] - (x[n] - x[n - 1]);
-    const auto [q_s, k_s] = refine_minimum(model, g, a, x[hi]);
+  // Local minima (periodic: the walk's two ends are one point). Within a range its end points
+  // count too, refined over their one interval: a rank loss a hair inside a declared edge has
+  // its smallest sampled conditioning at the edge itself (a 3-loop chain's flat 180° inside
+  // [170°, 180.1°] was missed and Simbody crossed it alone, 1.6e-3 rad off with exit 0).
+  for (long i = 0; i <= (domain.periodic ? n - 1 : n); ++i) {
+    double a = 0.0, b = 0.0;
+    if (domain.periodic) {
+      const long lo = i > 0 ? i - 1 : n - 1;
+      if (!(k[i] < kScanCandidate && k[i] <= k[lo] && k[i] <= k[i + 1])) continue;
+      a = i > 0 ? x[lo] : x[0] - (x[n] - x[n - 1]), b = x[i + 1];
+    } else {
+      const bool low = i == 0 || k[i] <= k[i - 1], high = i == n || k[i] <= k[i + 1];
+      if (!(k[i] < kScanCandidate && low && high)) continue;
+      a = x[std::max(0L, i - 1)], b = x[std::min(n, i + 1)];
+    }
+    const auto [q_s, k_s] = refine_minimum(model, g, a, b);
     if (!(k_s < kSingularConditioning)) continue;  // a narrow place, not rank loss (no window)
     if (!out.empty() && std::abs(offset(out.back(), domain.periodic, q_s)) < 1e-9 * unit) continue;
     const double half = radius_above(model, g, q_s, kPassageConditioning, kMaxPassageHalfWidth * unit);

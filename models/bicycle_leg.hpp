@@ -51,7 +51,7 @@ struct BicycleLegParams {
 // Builds bodies, joints, loops, gear, independent coordinate and loads into `scene`
 // (which must not already have any). Names: thigh_r/l, shank_r/l, crank, flywheel;
 // joints hip_r/l, knee_r/l, crank, flywheel; loops pedal_r/l; shank points knee,
-// ankle, pedal. Every parameter is checked first (ranges in models/README.md); throws
+// ankle, pedal. Every parameter is checked first (ranges in docs/scene-format.md); throws
 // SceneError naming the field ("bicycle_leg.flywheel.gear_ratio") and its range, or an
 // impossible fit.
 void make_bicycle_leg(const BicycleLegParams& p, Scene& scene);

@@ -49,7 +49,7 @@ class NumericalError : public std::runtime_error {
 inline constexpr const char* kGround = "ground";
 
 // Ranges every scene value is checked against before any work starts (check_scene and the
-// YAML reader; documented in models/README.md, "Limits"). They bound what a typo can do:
+// YAML reader; documented in docs/scene-format.md, "Limits"). They bound what a typo can do:
 // no NaN/inf, no 1e308 products, no integrator that has to resolve a sub-microsecond time
 // constant, no output that fills the disk.
 namespace limits {
@@ -301,7 +301,7 @@ struct Validation {
   std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };
 
-// The pedalling-strategy search of `rdyn optimize` (scene block `optimize`, models/README.md):
+// The pedalling-strategy search of `rdyn optimize` (scene block `optimize`, docs/scene-format.md):
 // which drive loads get a shape τ(θ) = a0 + Σ_k a_k cos kθ + b_k sin kθ of a revolute joint's
 // angle, the constraint force whose peak (or p-norm) over the steady cycle it minimises, and the
 // bounds. The loads' common amplitude is not designed: it is calibrated per shape.

@@ -1,5 +1,5 @@
 // Writing a scene back as YAML: the expanded scene (generators already applied, every value
-// explicit) in the format models/scene_yaml.cpp reads (models/README.md, "Writing a scene").
+// explicit) in the format models/scene_yaml.cpp reads (docs/scene-format.md, "Writing a scene").
 #pragma once
 
 #include <string>

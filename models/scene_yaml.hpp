@@ -1,4 +1,4 @@
-// Reading scenes from YAML (format documented in models/README.md).
+// Reading scenes from YAML (format documented in docs/scene-format.md).
 #pragma once
 
 #include <string>

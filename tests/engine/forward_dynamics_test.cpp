@@ -319,7 +319,7 @@ TEST(ForwardDynamicsChecks, StepBudgetStopsTheRunAndNamesWhereItGot) {
 TEST(ForwardDynamicsChecks, StiffResistanceIsRecognisedAsHopelessEarly) {
   // c1 = 1e9 N·m·s on a crank of ~1e-3 kg·m²: explicit steps of ~1e-11 s (measured), ~1e11
   // of them for 3 s. Before the budgets were checked per step this ran for hours. The scene
-  // reader now refuses such a coefficient (models/README.md, "Limits"); the engine must still
+  // reader now refuses such a coefficient (docs/scene-format.md, "Limits"); the engine must still
   // stop on a scene built in code, so the value is set on the struct.
   auto scene = models::load_scene("fourbar");
   scene.resistances.at(0).coefficient = 1e9;

@@ -1,7 +1,7 @@
 // Ranges of the numbers typed on rdyn's command line (README, "Limits"), one table for every
 // subcommand. Each number is checked before any work starts, so nothing hangs or exhausts memory.
 //
-// Not the scene's table: models::limits (models/scene.hpp; models/README.md, "Limits") bounds
+// Not the scene's table: models::limits (models/scene.hpp; docs/scene-format.md, "Limits") bounds
 // what a scene may hold, and several names are the same with other values — a command-line grid
 // may be finer (0.01° here, 0.05° in a scene: `extract` and `simulate` build one table from it,
 // at most 36 000 points), and a typed cadence or power may be larger (1000 Hz and 1e7 W here, 20 Hz

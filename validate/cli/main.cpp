@@ -332,7 +332,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "rdyn — reduced-parameter models of one-degree-of-freedom planar mechanisms, validated against a "
       "full multibody model (Simbody).\n"
-      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see models/README.md)."};
+      "A SCENE is a shipped scene name (bicycle, bicycle-profile, bicycle-muscle, fourbar, fourbar-rocker, slider-crank, slider-crank-slider, crane-luffing) or a YAML file (see docs/scene-format.md)."};
   app.require_subcommand(1);
   CommandArgs a;
   add_simulate_command(app, a.sim);

@@ -12,7 +12,7 @@ namespace rdyn::validate {
 // The interpolation a threshold without one is judged at (the tool's default).
 constexpr const char* kDefaultInterpolation = "fourier";
 
-// What a scene that declares no thresholds is judged against (models/README.md, "Validation
+// What a scene that declares no thresholds is judged against (docs/scene-format.md, "Validation
 // settings"): the speed and every requested constraint force on the 10° table within 0.5 % of
 // their peaks, the accuracy a 10° table reaches on every shipped scene. Without them a
 // validation whose every reduced run was 176 % off passed: nothing was judged.

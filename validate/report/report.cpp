@@ -576,7 +576,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   if (!s.at("thresholds").empty()) {
     h += "<h2>Acceptance thresholds</h2>";
     if (s.value("thresholds_are_defaults", false))
-      h += "<p>The scene declares no thresholds: it is judged against the defaults (models/README.md, "
+      h += "<p>The scene declares no thresholds: it is judged against the defaults (docs/scene-format.md, "
            "\"Validation settings\").</p>";
     h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
          "th><th>run</th>"

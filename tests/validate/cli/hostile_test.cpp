@@ -814,7 +814,7 @@ void issue23(std::vector<Case>& cs) {
                   EXPECT_FALSE(fs::exists(d / "proj/.rdyn-output"));
                   EXPECT_EQ(std::distance(fs::directory_iterator(d / "proj"), fs::directory_iterator()), 2);
                 }});
-  // "0: no drive" (models/README.md) holds with the bicycle's optimize block in place; only
+  // "0: no drive" (docs/scene-format.md) holds with the bicycle's optimize block in place; only
   // `rdyn optimize` needs the design loads, and says so when there are none.
   cs.push_back({"simulate_bicycle_without_drive",
                 {"simulate", "bicycle", "--set", "bicycle_leg.hip_torque_Nm=0", "--duration", "0.2", "--out", "o"}, 0,
