@@ -431,13 +431,26 @@ void check_turn_closes(KinetostaticSource& src, const models::Scene& scene, cons
         off = fmt::format("the velocity ratio of joint '{}' {:.6g} against {:.6g}", scene.joints[j].name,
                           gs.ratios.wrt_q[j], c.r[j][i0]);
   }
-  if (!off.empty())
-    throw SweepNotClosed(fmt::format(
-        "{}: the sweep of '{}' over a full turn does not return to its start: a turn later at {:.6g}° it finds {} "
-        "— it changed assembly between two grid points of {:g}°, where the predictor from the last grid point "
-        "reached the other branch (a nearly singular stretch, a crossing of branches, or a dead point with a "
-        "blocked range narrower than the step); extract on a finer grid (--grid-deg)",
-        scene.source_file, scene.independent, s.q[i0] * 180 / kPi, off, g.h * 180 / kPi));
+  if (off.empty()) return;
+  // Through a configuration of rank loss the branch followed may come back only after two
+  // turns (a four-bar at its Grashof change point: crank 1, coupler 2, rocker 2, ground 1): no
+  // grid closes one turn then, so finer grids are no advice.
+  std::string singular;
+  for (long i = 0; i < g.n; ++i)
+    if (c.singular[i]) singular += fmt::format("{}{:.6g}°", singular.empty() ? "" : ", ", s.q[i] * 180 / kPi);
+  const std::string advice =
+      singular.empty()
+          ? "extract on a finer grid (--grid-deg)"
+          : "the sweep passed configurations of rank loss at " + singular +
+                ", where branches cross: if the branch through them repeats only every two turns (a linkage at its "
+                "change point), no grid closes one turn and a table of this mechanism needs a declared "
+                "independent_range inside one turn; otherwise extract on a finer grid (--grid-deg)";
+  throw SweepNotClosed(fmt::format(
+      "{}: the sweep of '{}' over a full turn does not return to its start: a turn later at {:.6g}° it finds {} "
+      "— it changed assembly between two grid points of {:g}°, where the predictor from the last grid point "
+      "reached the other branch (a nearly singular stretch, a crossing of branches, or a dead point with a "
+      "blocked range narrower than the step); {}",
+      scene.source_file, scene.independent, s.q[i0] * 180 / kPi, off, g.h * 180 / kPi, advice));
 }
 
 // Samples at singular configurations (loop Jacobian lost rank) that could not take their limit

@@ -545,6 +545,21 @@ void ground_truth(std::vector<Case>& cs) {
                 {"simulate", (fs::path(RDYN_SCENES) / "hard/light-flywheel.yaml").string(), "--model", "reduced",
                  "--reduced-integrator", "rk4-fixed", "--fixed-step", "0.2", "--duration", "6", "--out", "o"},
                 1, "reduced model's energy balance does not close", {}, nullptr, "o"});
+  // A four-bar at its Grashof change point (crank 1, coupler 3, rocker 2, ground 2): through its
+  // rank loss at 0° the branch repeats only every two turns, so no table closes one turn; the
+  // message said "extract on a finer grid", which never helps here.
+  const std::string change =
+      "name: change\nground_points: {A: [0, 0], D: [2, 0]}\nbodies:\n"
+      "  - {name: crank, mass_kg: 1, com_m: [0.5, 0], inertia_kgm2: 0.0833, points: {B: [1, 0]}}\n"
+      "  - {name: coupler, mass_kg: 3, com_m: [1.5, 0], inertia_kgm2: 2.25, points: {C: [3, 0]}}\n"
+      "  - {name: rocker, mass_kg: 2, com_m: [1, 0], inertia_kgm2: 0.667, points: {C: [2, 0]}}\njoints:\n"
+      "  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank, guess_deg: 90}\n"
+      "  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler, guess_deg: -74.75}\n"
+      "  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 63.43}\n"
+      "loops:\n  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}\nindependent: crank\n"
+      "gravity: {enabled: true}\ninitial: {q_deg: 90, qdot: 5}\n";
+  cs.push_back({"extract_change_point_linkage_names_its_rank_loss", {"extract", "s.yaml", "--out", "t.csv"}, 2,
+                "repeats only every two turns", {{"s.yaml", change}}, nullptr, "t.csv"});
   // CPodes at 1e-2 keeps the four-bar's branch but loses its energy (0.7 of 2.5 J).
   cs.push_back({"energy_lost_by_a_loose_integrator",
                 {"simulate", "fourbar", "--integrator", "cpodes", "--tolerance", "1e-2", "--out", "o"}, 1,
