@@ -243,7 +243,7 @@ class FullRun {
         // 1), as the reduced model stops at its table's edge (reduced/simulate_reduced.cpp).
         domain_(opt.domain ? *opt.domain : calc_independent_domain(model)), guard_(model),
         singular_(opt.singular_passages ? domain_.singular : std::vector<SingularPoint>{}),
-        integ_(make_integrator(m_, opt.integrator)), stepper_(m_.system, *integ_),
+        integ_(make_integrator(m_, opt.integrator)), stepper_(std::make_unique<TimeStepper>(m_.system, *integ_)),
         n_(models::calc_output_rows(opt.duration_s, opt.output_interval_s)) {}
 
   // The consistent initial state (a kinetostatic projection at (q0, q̇0) in the branch guard's
@@ -276,7 +276,10 @@ class FullRun {
   BranchGuard guard_;
   const std::vector<SingularPoint> singular_;
   std::unique_ptr<Integrator> integ_;
-  TimeStepper stepper_;
+  // Replaced with the integrator at each restart: CPodes leaks its solver's memory when
+  // initialized a second time (LeakSanitizer, 340 allocations in libSimTKmath per restart).
+  std::unique_ptr<TimeStepper> stepper_;
+  void configure_integrator();
   const long n_;  // output rows after t = 0, the last at t = duration
   long i_ = 1;    // the next output row
   TimeSeries ts_;
@@ -293,8 +296,7 @@ class FullRun {
   long passage_steps_ = 0, passages_ = 0, steps_before_ = 0, attempts_before_ = 0, events_before_ = 0;
 };
 
-void FullRun::start() {
-  const State s = free_state(model_, guard_, {0.0, m_.scene.initial.q, m_.scene.initial.qdot, 0.0});
+void FullRun::configure_integrator() {
   integ_->setAccuracy(opt_.tolerance);
   integ_->setConstraintTolerance(std::min(1e-10, opt_.tolerance));
   // Return after every internal step: to track the smallest step, and so that the step and
@@ -307,9 +309,14 @@ void FullRun::start() {
   // TimeStepper::stepTo otherwise swallows the integrator's per-step returns and comes back
   // only at the output time (Simbody 3.7 TimeStepperRep::stepTo loops until then), so a
   // single output interval of microscopic steps would never reach the budget checks below.
-  stepper_.setReportAllSignificantStates(true);
+  stepper_->setReportAllSignificantStates(true);
+}
+
+void FullRun::start() {
+  const State s = free_state(model_, guard_, {0.0, m_.scene.initial.q, m_.scene.initial.qdot, 0.0});
+  configure_integrator();
   try {
-    stepper_.initialize(s);
+    stepper_->initialize(s);
   } catch (const std::exception& e) {
     throw models::NumericalError(std::string("cannot start the full model: ") + describe_simbody_exception(e));
   }
@@ -351,7 +358,7 @@ bool FullRun::step_to(double t) {
       const double t_before = integ_->getTime(), q_before = m_.joint_q(integ_->getState(), m_.independent);
       std::optional<State> before;
       if (!singular_.empty()) before = integ_->getState();
-      stepper_.stepTo(t);
+      stepper_->stepTo(t);
       if (before) {
         const double q_adv = m_.joint_q(integ_->getAdvancedState(), m_.independent);
         if (find_window(singular_, domain_.periodic, q_before, q_adv) >= 0) {
@@ -463,14 +470,15 @@ void FullRun::cross_passage() {
 }
 
 void FullRun::restart(const PassagePoint& end) {
-  const long taken_before = integ_->getNumStepsTaken(), attempted_before = integ_->getNumStepsAttempted();
+  steps_before_ += integ_->getNumStepsTaken();
+  attempts_before_ += integ_->getNumStepsAttempted();
   events_before_ += m_.events(integ_->getState());
   try {
-    stepper_.initialize(free_state(model_, guard_, end));  // EngineError too: caught below
-    if (integ_->getNumStepsAttempted() < attempted_before) {  // the statistics restarted too
-      steps_before_ += taken_before;
-      attempts_before_ += attempted_before;
-    }
+    stepper_.reset();
+    integ_ = make_integrator(m_, opt_.integrator);
+    stepper_ = std::make_unique<TimeStepper>(m_.system, *integ_);
+    configure_integrator();
+    stepper_->initialize(free_state(model_, guard_, end));  // EngineError too: caught below
   } catch (const std::exception& e) {
     throw models::NumericalError(fmt::format("full model could not restart after the singular passage at t = "
                                              "{:.6g} s: {}",
