@@ -112,17 +112,20 @@ void write_samples_csv(const std::string& path, const Samples& s) {
   if (std::fclose(f) != 0 || !written) throw TableError(path + ": cannot write: " + std::strerror(written ? errno : err));
 }
 
-Samples parse_samples_csv(const std::string& text, const std::string& name) {
-  auto fail = [&](long line, const std::string& msg) {
-    throw TableError(fmt::format("{}:{}: {}", name, line, msg));
-  };
-  if (static_cast<long long>(text.size()) > kMaxTableBytes)
-    fail(1, fmt::format("the table has {} bytes, more than the limit of {} bytes", text.size(), kMaxTableBytes));
-  // Lines without their end-of-line (\n or \r\n).
+namespace {
+
+// Reads a table's text line by line (without their \n or \r\n), failing with the file and line.
+struct TableReader {
+  const std::string& text;
+  const std::string& name;
   size_t pos = 0;
   long ln = 0;
   std::string line;
-  auto next_line = [&]() {
+
+  [[noreturn]] void fail(long at, const std::string& msg) const {
+    throw TableError(fmt::format("{}:{}: {}", name, at, msg));
+  }
+  bool next_line() {
     if (pos >= text.size()) return false;
     size_t end = text.find('\n', pos);
     if (end == std::string::npos) end = text.size();
@@ -131,162 +134,188 @@ Samples parse_samples_csv(const std::string& text, const std::string& name) {
     pos = end + 1;
     ++ln;
     return true;
-  };
-  auto number = [&](const std::string& cell, const std::string& what) {
+  }
+  double number(const std::string& cell, const std::string& what) const {
     char* end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
     if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
       fail(ln, fmt::format("{}: not a finite number: '{}'", what, cell.substr(0, 40)));
     return v;
-  };
-
-  Samples s;
-  s.file = name;
-  if (!next_line()) fail(1, "empty file: not an rdyn reduced table");
-  if (line.rfind(kOldHeader, 0) == 0)
-    fail(1, "this table was written by an older rdyn and does not record the scene it was extracted from; "
-            "re-extract it with `rdyn extract`");
-  if (line.rfind(kHeader, 0) != 0)
-    fail(1, fmt::format("not an rdyn reduced table (the first line must start with '{}')", kHeader));
-  {
-    std::istringstream meta(line.substr(std::char_traits<char>::length(kHeader)));
-    bool have_q0 = false, have_step = false, have_periodic = false;
-    double grid = NAN;
-    for (std::string kv; meta >> kv;) {
-      const auto eq = kv.find('=');
-      if (eq == std::string::npos) fail(1, "malformed metadata '" + kv.substr(0, 40) + "' (key=value)");
-      const std::string k = kv.substr(0, eq), v = kv.substr(eq + 1);
-      if (k == "scene") {
-        if (v.size() != 16 || v.find_first_not_of("0123456789abcdef") != std::string::npos)
-          fail(1, "field 'scene': the scene hash must be 16 lowercase hexadecimal digits");
-        s.scene_hash = std::stoull(v, nullptr, 16);
-      } else if (k == "name") {
-        s.scene = v;
-      } else if (k == "method") {
-        s.method = v;
-      } else if (k == "periodic") {
-        if (v != "0" && v != "1") fail(1, "field 'periodic' must be 0 or 1");
-        s.periodic = v == "1";
-        have_periodic = true;
-      } else if (k == "q0") {
-        s.q0 = number(v, "field 'q0'");
-        have_q0 = true;
-      } else if (k == "step") {
-        s.step = number(v, "field 'step'");
-        have_step = true;
-      } else if (k == "edges") {
-        const auto comma = v.find(',');
-        if (comma == std::string::npos) fail(1, "field 'edges' must be <min>,<max>");
-        for (std::string* e : {&s.min_edge, &s.max_edge}) {
-          std::string w = e == &s.min_edge ? v.substr(0, comma) : v.substr(comma + 1);
-          for (char& c : w)
-            if (c == '_') c = ' ';
-          if (w != "dead point" && w != "declared limit" && w != "unknown")
-            fail(1, "field 'edges': each edge is dead_point, declared_limit or unknown");
-          *e = w == "unknown" ? "" : w;
-        }
-      } else if (k == "grid_deg") {
-        grid = number(v, "field 'grid_deg'");
-      } else {
-        fail(1, "unknown metadata field '" + k.substr(0, 40) + "'");
-      }
-    }
-    if (!s.scene_hash)
-      fail(1, "field 'scene' (the scene hash) is missing; re-extract the table with `rdyn extract`");
-    if (!have_q0 || !have_step || !have_periodic) fail(1, "fields 'q0', 'step' and 'periodic' are required");
-    if (!(s.step > 0)) fail(1, "field 'step' must be positive");
-    if (std::isfinite(grid) && std::abs(grid - s.step * 180.0 / kPi) > 1e-9 * grid &&
-        std::abs(grid - s.step) > 1e-12 * grid)
-      fail(1, "field 'grid_deg' disagrees with 'step'");
   }
-  // Optional "# singular: q..." and "# roots <column>: r1 r2 ..." lines.
-  bool have_line = next_line();
-  while (have_line && (line.rfind("# roots ", 0) == 0 || line.rfind("# singular:", 0) == 0)) {
-    const bool singular = line.rfind("# singular:", 0) == 0;
-    const auto colon = line.find(':');
-    if (!singular && colon == std::string::npos) fail(ln, "malformed roots line (# roots <column>: values)");
+};
+
+// The first line: the header tag and its key=value metadata.
+void read_metadata(TableReader& r, Samples& s) {
+  if (!r.next_line()) r.fail(1, "empty file: not an rdyn reduced table");
+  if (r.line.rfind(kOldHeader, 0) == 0)
+    r.fail(1, "this table was written by an older rdyn and does not record the scene it was extracted from; "
+              "re-extract it with `rdyn extract`");
+  if (r.line.rfind(kHeader, 0) != 0)
+    r.fail(1, fmt::format("not an rdyn reduced table (the first line must start with '{}')", kHeader));
+  std::istringstream meta(r.line.substr(std::char_traits<char>::length(kHeader)));
+  bool have_q0 = false, have_step = false, have_periodic = false;
+  double grid = NAN;
+  for (std::string kv; meta >> kv;) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) r.fail(1, "malformed metadata '" + kv.substr(0, 40) + "' (key=value)");
+    const std::string k = kv.substr(0, eq), v = kv.substr(eq + 1);
+    if (k == "scene") {
+      if (v.size() != 16 || v.find_first_not_of("0123456789abcdef") != std::string::npos)
+        r.fail(1, "field 'scene': the scene hash must be 16 lowercase hexadecimal digits");
+      s.scene_hash = std::stoull(v, nullptr, 16);
+    } else if (k == "name") {
+      s.scene = v;
+    } else if (k == "method") {
+      s.method = v;
+    } else if (k == "periodic") {
+      if (v != "0" && v != "1") r.fail(1, "field 'periodic' must be 0 or 1");
+      s.periodic = v == "1";
+      have_periodic = true;
+    } else if (k == "q0") {
+      s.q0 = r.number(v, "field 'q0'");
+      have_q0 = true;
+    } else if (k == "step") {
+      s.step = r.number(v, "field 'step'");
+      have_step = true;
+    } else if (k == "edges") {
+      const auto comma = v.find(',');
+      if (comma == std::string::npos) r.fail(1, "field 'edges' must be <min>,<max>");
+      for (std::string* e : {&s.min_edge, &s.max_edge}) {
+        std::string w = e == &s.min_edge ? v.substr(0, comma) : v.substr(comma + 1);
+        for (char& c : w)
+          if (c == '_') c = ' ';
+        if (w != "dead point" && w != "declared limit" && w != "unknown")
+          r.fail(1, "field 'edges': each edge is dead_point, declared_limit or unknown");
+        *e = w == "unknown" ? "" : w;
+      }
+    } else if (k == "grid_deg") {
+      grid = r.number(v, "field 'grid_deg'");
+    } else {
+      r.fail(1, "unknown metadata field '" + k.substr(0, 40) + "'");
+    }
+  }
+  if (!s.scene_hash) r.fail(1, "field 'scene' (the scene hash) is missing; re-extract the table with `rdyn extract`");
+  if (!have_q0 || !have_step || !have_periodic) r.fail(1, "fields 'q0', 'step' and 'periodic' are required");
+  if (!(s.step > 0)) r.fail(1, "field 'step' must be positive");
+  if (std::isfinite(grid) && std::abs(grid - s.step * 180.0 / kPi) > 1e-9 * grid && std::abs(grid - s.step) > 1e-12 * grid)
+    r.fail(1, "field 'grid_deg' disagrees with 'step'");
+}
+
+// Optional "# singular: q..." and "# roots <column>: r1 r2 ..." lines; leaves the reader on the
+// line after them (false: none left).
+bool read_annotations(TableReader& r, Samples& s) {
+  bool have_line = r.next_line();
+  while (have_line && (r.line.rfind("# roots ", 0) == 0 || r.line.rfind("# singular:", 0) == 0)) {
+    const bool singular = r.line.rfind("# singular:", 0) == 0;
+    const auto colon = r.line.find(':');
+    if (!singular && colon == std::string::npos) r.fail(r.ln, "malformed roots line (# roots <column>: values)");
     std::vector<double> vals;
-    std::istringstream in(line.substr(colon + 1));
+    std::istringstream in(r.line.substr(colon + 1));
     for (std::string v; in >> v;) {
       if (static_cast<long>(vals.size()) >= kMaxTableRows)
-        fail(ln, fmt::format("more than {} values on one line", kMaxTableRows));
-      vals.push_back(number(v, singular ? "singular angle" : "root"));
+        r.fail(r.ln, fmt::format("more than {} values on one line", kMaxTableRows));
+      vals.push_back(r.number(v, singular ? "singular angle" : "root"));
     }
     for (size_t i = 1; i < vals.size(); ++i)
-      if (!(vals[i] > vals[i - 1])) fail(ln, "values must be strictly increasing");
+      if (!(vals[i] > vals[i - 1])) r.fail(r.ln, "values must be strictly increasing");
     if (singular) {
       s.singular_q.insert(s.singular_q.end(), vals.begin(), vals.end());
     } else {
-      const std::string col = line.substr(8, colon - 8);
-      if (s.roots_of(col)) fail(ln, "duplicate roots line for column '" + col.substr(0, 40) + "'");
-      if (static_cast<long>(s.roots.size()) >= kMaxTableColumns) fail(ln, "too many roots lines");
+      const std::string col = r.line.substr(8, colon - 8);
+      if (s.roots_of(col)) r.fail(r.ln, "duplicate roots line for column '" + col.substr(0, 40) + "'");
+      if (static_cast<long>(s.roots.size()) >= kMaxTableColumns) r.fail(r.ln, "too many roots lines");
       s.roots.emplace_back(col, std::move(vals));
     }
-    have_line = next_line();
+    have_line = r.next_line();
   }
-  if (!have_line) fail(ln + 1, "missing the column header line (q_deg or q_m, then the columns)");
+  return have_line;
+}
+
+// The column header on the reader's line: q_deg or q_m, then known, distinct column names.
+std::vector<std::string> read_column_header(TableReader& r, Samples& s) {
   std::vector<std::string> header;
-  {
-    std::istringstream h(line);
-    for (std::string cell; std::getline(h, cell, ',');) {
-      if (static_cast<long>(header.size()) > kMaxTableColumns)
-        fail(ln, fmt::format("more than {} columns", kMaxTableColumns));
-      header.push_back(cell);
-    }
-    if (!line.empty() && line.back() == ',') header.emplace_back();
+  std::istringstream h(r.line);
+  for (std::string cell; std::getline(h, cell, ',');) {
+    if (static_cast<long>(header.size()) > kMaxTableColumns) r.fail(r.ln, fmt::format("more than {} columns", kMaxTableColumns));
+    header.push_back(cell);
   }
-  if (header.empty() || (header[0] != "q_deg" && header[0] != "q_m")) fail(ln, "first column must be q_deg or q_m");
+  if (!r.line.empty() && r.line.back() == ',') header.emplace_back();
+  if (header.empty() || (header[0] != "q_deg" && header[0] != "q_m")) r.fail(r.ln, "first column must be q_deg or q_m");
   s.revolute = header[0] == "q_deg";
-  const long header_line = ln;
-  s.header_line = ln;
+  s.header_line = r.ln;
   for (size_t c = 1; c < header.size(); ++c) {
     if (!known_column(header[c]))
-      fail(ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*, p_*, k_*, tau_*, Qpf_*, Qxpf_*)",
-                           header[c].substr(0, 40)));
-    if (s.column(header[c]) >= 0) fail(ln, "duplicate column '" + header[c].substr(0, 40) + "'");
+      r.fail(r.ln, fmt::format("unknown column '{}' (m1, m2, Q_cons, V, me1_*, me2_*, Qx_cons_*, r_*, rx_*, w_*, wx_*, p_*, k_*, tau_*, Qpf_*, Qxpf_*)",
+                               header[c].substr(0, 40)));
+    if (s.column(header[c]) >= 0) r.fail(r.ln, "duplicate column '" + header[c].substr(0, 40) + "'");
     s.names.push_back(header[c]);
   }
   for (const auto& [col, rs] : s.roots)
-    if (s.column(col) < 0) fail(header_line, "roots are given for column '" + col.substr(0, 40) + "', which is absent");
+    if (s.column(col) < 0) r.fail(s.header_line, "roots are given for column '" + col.substr(0, 40) + "', which is absent");
+  return header;
+}
+
+// The data rows, one value per header column, within the table limits.
+void read_rows(TableReader& r, const std::vector<std::string>& header, Samples& s) {
   s.columns.assign(s.names.size(), {});
-  while (next_line()) {
-    if (line.empty()) continue;
+  while (r.next_line()) {
+    if (r.line.empty()) continue;
     if (static_cast<long>(s.q.size()) >= kMaxTableRows)
-      fail(ln, fmt::format("more than {} grid points (the finest extraction grid is 0.01°)", kMaxTableRows));
+      r.fail(r.ln, fmt::format("more than {} grid points (the finest extraction grid is 0.01°)", kMaxTableRows));
     if (static_cast<long>((s.q.size() + 1) * header.size()) > kMaxTableValues)
-      fail(ln, fmt::format("more than {} values", kMaxTableValues));
+      r.fail(r.ln, fmt::format("more than {} values", kMaxTableValues));
     size_t c = 0, start = 0;
     for (;; ++c) {
-      const size_t comma = line.find(',', start);
-      const std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-      if (c >= header.size()) fail(ln, fmt::format("more values than the {} columns of the header", header.size()));
-      const double v = number(cell, "column '" + header[c].substr(0, 40) + "'");
+      const size_t comma = r.line.find(',', start);
+      const std::string cell = r.line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      if (c >= header.size()) r.fail(r.ln, fmt::format("more values than the {} columns of the header", header.size()));
+      const double v = r.number(cell, "column '" + header[c].substr(0, 40) + "'");
       if (c == 0) s.q.push_back(s.revolute ? v * kPi / 180.0 : v);
       else s.columns[c - 1].push_back(v);
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
-    if (c + 1 != header.size()) fail(ln, fmt::format("{} values, the header has {}", c + 1, header.size()));
+    if (c + 1 != header.size()) r.fail(r.ln, fmt::format("{} values, the header has {}", c + 1, header.size()));
   }
-  if (s.q.size() < 4) fail(ln, "a reduced table needs at least 4 grid points");
+}
+
+// What the rows must satisfy: enough points, a positive m1, the grid of q0 and step (one turn
+// when periodic).
+void check_rows(const TableReader& r, const Samples& s) {
+  const long header_line = s.header_line;
+  if (s.q.size() < 4) r.fail(r.ln, "a reduced table needs at least 4 grid points");
   // The reduced inertia is positive wherever the mechanism moves (Eksergian divides by it):
   // refused here with its line, not later as a model that cannot be built.
   if (const int c = s.column("m1"); c >= 0)
     for (size_t i = 0; i < s.q.size(); ++i)
       if (!(s.columns[c][i] > 0))
-        fail(header_line + 1 + static_cast<long>(i),
-             fmt::format("column 'm1' (the reduced inertia, kg·m² or kg) must be positive, got {:g}; extract the "
-                         "table again with `rdyn extract`",
-                         s.columns[c][i]));
-  // The grid: increasing, equally spaced by step, starting at q0; a periodic one covers one turn.
+        r.fail(header_line + 1 + static_cast<long>(i),
+               fmt::format("column 'm1' (the reduced inertia, kg·m² or kg) must be positive, got {:g}; extract the "
+                           "table again with `rdyn extract`",
+                           s.columns[c][i]));
   const double tol = 1e-9 * std::max(1.0, std::abs(s.q0) + s.step * static_cast<double>(s.q.size()));
-  if (std::abs(s.q[0] - s.q0) > tol) fail(header_line + 1, "the first grid point differs from field 'q0'");
+  if (std::abs(s.q[0] - s.q0) > tol) r.fail(header_line + 1, "the first grid point differs from field 'q0'");
   for (size_t i = 1; i < s.q.size(); ++i)
     if (!(s.q[i] > s.q[i - 1]) || std::abs(s.q[i] - s.q[i - 1] - s.step) > tol)
-      fail(header_line + 1 + static_cast<long>(i), "grid points must increase, equally spaced by field 'step'");
-  if (s.periodic && !s.revolute) fail(1, "a periodic table has a revolute coordinate (q_deg)");
+      r.fail(header_line + 1 + static_cast<long>(i), "grid points must increase, equally spaced by field 'step'");
+  if (s.periodic && !s.revolute) r.fail(1, "a periodic table has a revolute coordinate (q_deg)");
   if (s.periodic && std::abs(s.step * static_cast<double>(s.q.size()) - 2 * kPi) > 1e-9)
-    fail(1, "a periodic table must cover exactly one turn (step × points = 360°)");
+    r.fail(1, "a periodic table must cover exactly one turn (step × points = 360°)");
+}
+
+}  // namespace
+
+Samples parse_samples_csv(const std::string& text, const std::string& name) {
+  TableReader r{text, name};
+  if (static_cast<long long>(text.size()) > kMaxTableBytes)
+    r.fail(1, fmt::format("the table has {} bytes, more than the limit of {} bytes", text.size(), kMaxTableBytes));
+  Samples s;
+  s.file = name;
+  read_metadata(r, s);
+  if (!read_annotations(r, s)) r.fail(r.ln + 1, "missing the column header line (q_deg or q_m, then the columns)");
+  const auto header = read_column_header(r, s);
+  read_rows(r, header, s);
+  check_rows(r, s);
   return s;
 }
 
