@@ -155,31 +155,33 @@ models::Scene with_reaction_requests(const models::Scene& scene) {
   return out;
 }
 
-void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::TimeSeries& ts) {
-  const auto names = joint_output_names(s);
-  const Table& T = m.table;
-  const size_t nj = s.joints.size(), nb = s.bodies.size(), ns = ts.t.size();
-  auto col = [&](const std::string& name) {
-    const int c = T.column(name);
-    if (c < 0)
-      throw TableError("the reduced table has no column '" + name +
-                       "': extract it from a scene that asks for outputs.joints, reactions or shaking");
-    return c;
-  };
-  std::vector<int> cp(nj), ck(nj), cr(nj);
-  for (size_t j = 0; j < nj; ++j) {
-    cp[j] = col("p_" + s.joints[j].name);
-    ck[j] = col("k_" + s.joints[j].name);
-    cr[j] = col("r_" + s.joints[j].name);
-  }
-  auto force = [&](const std::string& name) -> const std::vector<double>& {
-    for (size_t k = 0; k < ts.force_names.size(); ++k)
-      if (ts.force_names[k] == name) return ts.forces[k];
-    throw TableError("the reduced run has no constraint line '" + name + "'");
-  };
-  // Body order: parents before children (the scene's joints form a tree rooted at ground).
-  std::vector<int> order;
-  {
+namespace {
+
+// One output row's motion of every joint and body, and the columns it reads.
+struct RowKinematics {
+  const models::Scene& s;
+  const Table& T;
+  std::vector<int> cp, ck, cr;  // p_, k_, r_ columns per joint
+  std::vector<int> order;       // joints with parents before children (a tree rooted at ground)
+  double gx = 0.0, gy = 0.0;
+  std::vector<double> qj, uj, aj;
+  std::vector<Kin> body;
+  std::vector<double> cax, cay, cx, cy;  // centre of mass: acceleration, position
+
+  RowKinematics(const models::Scene& scene, const Table& table) : s(scene), T(table) {
+    const size_t nj = s.joints.size(), nb = s.bodies.size();
+    auto col = [&](const std::string& name) {
+      const int c = T.column(name);
+      if (c < 0)
+        throw TableError("the reduced table has no column '" + name +
+                         "': extract it from a scene that asks for outputs.joints, reactions or shaking");
+      return c;
+    };
+    for (size_t j = 0; j < nj; ++j) {
+      cp.push_back(col("p_" + s.joints[j].name));
+      ck.push_back(col("k_" + s.joints[j].name));
+      cr.push_back(col("r_" + s.joints[j].name));
+    }
     std::vector<char> done(nj, 0);
     for (size_t pass = 0; pass <= nj && order.size() < nj; ++pass)
       for (size_t j = 0; j < nj; ++j) {
@@ -190,158 +192,151 @@ void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::Ti
         for (int o : order) ready |= s.body_index(s.joints[o].child) == pb;
         if (ready) order.push_back(static_cast<int>(j)), done[j] = 1;
       }
+    gx = s.gravity.enabled ? s.gravity.g_m_s2.x : 0.0, gy = s.gravity.enabled ? s.gravity.g_m_s2.y : 0.0;
+    qj.assign(nj, 0.0), uj = aj = qj;
+    body.assign(nb, Kin{});
+    cax.assign(nb, 0.0), cay = cx = cy = cax;
   }
-  const double gx = s.gravity.enabled ? s.gravity.g_m_s2.x : 0.0, gy = s.gravity.enabled ? s.gravity.g_m_s2.y : 0.0;
-  ts.column_names = names;
-  ts.columns.assign(names.size(), std::vector<double>(ns));
-  std::vector<double> qj(nj), uj(nj), aj(nj);
-  std::vector<Kin> body(nb);
-  std::vector<double> cax(nb), cay(nb), cx(nb), cy(nb);  // centre of mass: acceleration, position
-  auto R_of = [&](const std::string& joint, size_t i, double& Rx, double& Ry) {
-    // Child-frame components of the reaction lines, turned into ground by the child's angle.
-    const double fx = force(internal_request_name(joint, 'x'))[i], fy = force(internal_request_name(joint, 'y'))[i];
-    const double th = body[s.body_index(s.find_joint(joint)->child)].th;
-    Rx = std::cos(th) * fx - std::sin(th) * fy;
-    Ry = std::sin(th) * fx + std::cos(th) * fy;
-  };
-  for (size_t i = 0; i < ns; ++i) {
-    const double q = ts.q[i], qd = ts.qdot[i], qdd = ts.qddot[i];
+
+  void calc(double q, double qd, double qdd) {
     // Joint motion: q_j = p_j + k_j q; q̇_j = r_j q̇; q̈_j = r_j q̈ + (dr_j/dq) q̇².
-    for (size_t j = 0; j < nj; ++j) {
+    for (size_t j = 0; j < s.joints.size(); ++j) {
       const double rj = T.eval(cr[j], q);
       qj[j] = T.eval(cp[j], q) + T.eval(ck[j], q) * q;
       uj[j] = rj * qd;
       aj[j] = rj * qdd + T.eval_deriv(cr[j], q) * qd * qd;
     }
-    // Planar tree kinematics: each child's frame from its parent's and its joint's motion.
-    for (int j : order) {
-      const auto& jt = s.joints[j];
-      const Kin P = jt.parent == models::kGround ? Kin{} : body[s.body_index(jt.parent)];
-      const double cP = std::cos(P.th), sP = std::sin(P.th);
-      double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
-      Kin C = P;
-      if (jt.type == models::JointType::Revolute) {
-        C.th = P.th + jt.offset_rad + qj[j];
-        C.w = P.w + uj[j];
-        C.al = P.al + aj[j];
-      } else {  // slides along the axis (parent frame) by q_j
-        px += jt.axis.x * qj[j];
-        py += jt.axis.y * qj[j];
-        const double ux = cP * jt.axis.x - sP * jt.axis.y, uy = sP * jt.axis.x + cP * jt.axis.y;
-        // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
-        arx = ux * aj[j] - 2 * P.w * uy * uj[j];
-        ary = uy * aj[j] + 2 * P.w * ux * uj[j];
-      }
-      const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
-      double Jax, Jay;
-      transfer(P, dx, dy, Jax, Jay);
-      Jax += arx, Jay += ary;
-      const double cC = std::cos(C.th), sC = std::sin(C.th);
-      const double ex = -(cC * jt.child_point.x - sC * jt.child_point.y);  // joint point → child origin
-      const double ey = -(sC * jt.child_point.x + cC * jt.child_point.y);
-      C.x = P.x + dx + ex;
-      C.y = P.y + dy + ey;
-      Kin Jk = C;
-      Jk.ax = Jax, Jk.ay = Jay;
-      transfer(Jk, ex, ey, C.ax, C.ay);
-      const int b = s.body_index(jt.child);
-      body[b] = C;
-      const auto& bd = s.bodies[b];
-      const double fx = cC * bd.com_m.x - sC * bd.com_m.y, fy = sC * bd.com_m.x + cC * bd.com_m.y;
-      cx[b] = C.x + fx, cy[b] = C.y + fy;
-      transfer(C, fx, fy, cax[b], cay[b]);
-    }
-    size_t c = 0;
-    for (const auto& name : s.outputs.joints) {
-      const int j = s.joint_index(name);
-      ts.columns[c++][i] = qj[j];
-      ts.columns[c++][i] = uj[j];
-      ts.columns[c++][i] = aj[j];
-    }
-    // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
-    // R_parent + Σ(−R_children) + F_loop + m g = m a_c.
-    auto loop_force = [&](const models::Loop& l, double& Rx, double& Ry) {
-      const auto [bname, sign] = loop_balance_body(s, l);
-      const int b = s.body_index(bname);
-      const double m_b = s.bodies[b].mass_kg;
-      double Fx = m_b * (cax[b] - gx), Fy = m_b * (cay[b] - gy);
-      for (const auto& j : s.joints) {
-        double jx, jy;
-        if (j.child == bname) R_of(j.name, i, jx, jy), Fx -= jx, Fy -= jy;
-        if (j.parent == bname) R_of(j.name, i, jx, jy), Fx += jx, Fy += jy;
-      }
-      Rx = sign * Fx, Ry = sign * Fy;
-    };
-    for (const auto& name : s.outputs.reactions) {
-      double Rx = 0, Ry = 0;
-      const auto* jt = s.find_joint(name);
-      if (jt && jt->type == models::JointType::Revolute) {
-        R_of(name, i, Rx, Ry);
-      } else if (jt) {
-        // Prismatic: Newton–Euler of the child C about the joint's child point P:
-        // R = m (a_c − g) − Σ F_loops on C + Σ R_children; M = I α + (r_c − P) × m (a_c − g)
-        // − Σ (r_k − P) × F_k over the other forces on C.
-        const int b = s.body_index(jt->child);
-        const auto& bd = s.bodies[b];
-        const Kin& C = body[b];
-        const double cC = std::cos(C.th), sC = std::sin(C.th);
-        auto at = [&](models::Vec2 p, double& x, double& y) {
-          x = C.x + cC * p.x - sC * p.y, y = C.y + sC * p.x + cC * p.y;
-        };
-        double Px, Py;
-        at(jt->child_point, Px, Py);
-        const double mx = bd.mass_kg * (cax[b] - gx), my = bd.mass_kg * (cay[b] - gy);
-        Rx = mx, Ry = my;
-        double M = bd.inertia_kgm2 * C.al + (cx[b] - Px) * my - (cy[b] - Py) * mx;
-        auto other = [&](double x, double y, double fx, double fy) {  // another force on C at (x, y)
-          Rx -= fx, Ry -= fy;
-          M -= (x - Px) * fy - (y - Py) * fx;
-        };
-        for (const auto& k : s.joints)
-          if (k.parent == jt->child) {
-            double kx, ky, x, y;
-            R_of(k.name, i, kx, ky);
-            at(k.parent_point, x, y);
-            other(x, y, -kx, -ky);
-          }
-        for (const auto& l : s.loops) {
-          if (l.body_a != jt->child && l.body_b != jt->child) continue;
-          double fx, fy, x, y;
-          loop_force(l, fx, fy);
-          const bool on_b = l.body_b == jt->child;
-          at(on_b ? l.point_b : l.point_a, x, y);
-          other(x, y, on_b ? fx : -fx, on_b ? fy : -fy);
-        }
-        ts.columns[c++][i] = Rx;
-        ts.columns[c++][i] = Ry;
-        const Kin P = jt->parent == models::kGround ? Kin{} : body[s.body_index(jt->parent)];
-        const double ux = std::cos(P.th) * jt->axis.x - std::sin(P.th) * jt->axis.y;
-        const double uy = std::sin(P.th) * jt->axis.x + std::cos(P.th) * jt->axis.y;
-        ts.columns[c++][i] = -uy * Rx + ux * Ry;
-        ts.columns[c++][i] = M;
-        continue;
-      } else {
-        for (const auto& l : s.loops)
-          if (l.name == name) loop_force(l, Rx, Ry);
-      }
-      ts.columns[c++][i] = Rx;
-      ts.columns[c++][i] = Ry;
-    }
-    if (s.outputs.shaking) {
-      // The mechanism's load on the ground: −(Σ m a_c − Σ m g), moment about O likewise.
-      double Fx = 0, Fy = 0, M = 0;
-      for (size_t b = 0; b < nb; ++b) {
-        const auto& bd = s.bodies[b];
-        const double fx = bd.mass_kg * (gx - cax[b]), fy = bd.mass_kg * (gy - cay[b]);
-        Fx += fx, Fy += fy;
-        M += cx[b] * fy - cy[b] * fx - bd.inertia_kgm2 * body[b].al;
-      }
-      ts.columns[c++][i] = Fx;
-      ts.columns[c++][i] = Fy;
-      ts.columns[c++][i] = M;
-    }
+    for (int j : order) place_child(j);
   }
-  // The internal reaction lines are not outputs of their own.
+
+  // Planar tree kinematics: the child's frame from its parent's and its joint's motion.
+  void place_child(int j) {
+    const auto& jt = s.joints[j];
+    const Kin P = jt.parent == models::kGround ? Kin{} : body[s.body_index(jt.parent)];
+    const double cP = std::cos(P.th), sP = std::sin(P.th);
+    double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
+    Kin C = P;
+    if (jt.type == models::JointType::Revolute) {
+      C.th = P.th + jt.offset_rad + qj[j];
+      C.w = P.w + uj[j];
+      C.al = P.al + aj[j];
+    } else {  // slides along the axis (parent frame) by q_j
+      px += jt.axis.x * qj[j];
+      py += jt.axis.y * qj[j];
+      const double ux = cP * jt.axis.x - sP * jt.axis.y, uy = sP * jt.axis.x + cP * jt.axis.y;
+      // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
+      arx = ux * aj[j] - 2 * P.w * uy * uj[j];
+      ary = uy * aj[j] + 2 * P.w * ux * uj[j];
+    }
+    const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
+    double Jax, Jay;
+    transfer(P, dx, dy, Jax, Jay);
+    Jax += arx, Jay += ary;
+    const double cC = std::cos(C.th), sC = std::sin(C.th);
+    const double ex = -(cC * jt.child_point.x - sC * jt.child_point.y);  // joint point → child origin
+    const double ey = -(sC * jt.child_point.x + cC * jt.child_point.y);
+    C.x = P.x + dx + ex;
+    C.y = P.y + dy + ey;
+    Kin Jk = C;
+    Jk.ax = Jax, Jk.ay = Jay;
+    transfer(Jk, ex, ey, C.ax, C.ay);
+    const int b = s.body_index(jt.child);
+    body[b] = C;
+    const auto& bd = s.bodies[b];
+    const double fx = cC * bd.com_m.x - sC * bd.com_m.y, fy = sC * bd.com_m.x + cC * bd.com_m.y;
+    cx[b] = C.x + fx, cy[b] = C.y + fy;
+    transfer(C, fx, fy, cax[b], cay[b]);
+  }
+};
+
+// The reactions of one row from its reaction lines (the run's constraint forces) and motion.
+struct RowReactions {
+  const models::Scene& s;
+  const models::TimeSeries& ts;
+  const RowKinematics& k;
+  size_t i = 0;  // the row
+
+  const std::vector<double>& force(const std::string& name) const {
+    for (size_t f = 0; f < ts.force_names.size(); ++f)
+      if (ts.force_names[f] == name) return ts.forces[f];
+    throw TableError("the reduced run has no constraint line '" + name + "'");
+  }
+  // A revolute joint's reaction: the child-frame reaction lines turned into ground by the child's angle.
+  void revolute(const std::string& joint, double& Rx, double& Ry) const {
+    const double fx = force(internal_request_name(joint, 'x'))[i], fy = force(internal_request_name(joint, 'y'))[i];
+    const double th = k.body[s.body_index(s.find_joint(joint)->child)].th;
+    Rx = std::cos(th) * fx - std::sin(th) * fy;
+    Ry = std::sin(th) * fx + std::cos(th) * fy;
+  }
+  // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
+  // R_parent + Σ(−R_children) + F_loop + m g = m a_c.
+  void loop(const models::Loop& l, double& Rx, double& Ry) const {
+    const auto [bname, sign] = loop_balance_body(s, l);
+    const int b = s.body_index(bname);
+    const double m_b = s.bodies[b].mass_kg;
+    double Fx = m_b * (k.cax[b] - k.gx), Fy = m_b * (k.cay[b] - k.gy);
+    for (const auto& j : s.joints) {
+      double jx, jy;
+      if (j.child == bname) revolute(j.name, jx, jy), Fx -= jx, Fy -= jy;
+      if (j.parent == bname) revolute(j.name, jx, jy), Fx += jx, Fy += jy;
+    }
+    Rx = sign * Fx, Ry = sign * Fy;
+  }
+  // Prismatic: Newton–Euler of the child C about the joint's child point P:
+  // R = m (a_c − g) − Σ F_loops on C + Σ R_children; M = I α + (r_c − P) × m (a_c − g)
+  // − Σ (r_k − P) × F_k over the other forces on C. Writes x, y, normal and moment.
+  void prismatic(const models::Joint& jt, double out[4]) const {
+    const int b = s.body_index(jt.child);
+    const auto& bd = s.bodies[b];
+    const Kin& C = k.body[b];
+    const double cC = std::cos(C.th), sC = std::sin(C.th);
+    auto at = [&](models::Vec2 p, double& x, double& y) {
+      x = C.x + cC * p.x - sC * p.y, y = C.y + sC * p.x + cC * p.y;
+    };
+    double Px, Py;
+    at(jt.child_point, Px, Py);
+    const double mx = bd.mass_kg * (k.cax[b] - k.gx), my = bd.mass_kg * (k.cay[b] - k.gy);
+    double Rx = mx, Ry = my;
+    double M = bd.inertia_kgm2 * C.al + (k.cx[b] - Px) * my - (k.cy[b] - Py) * mx;
+    auto other = [&](double x, double y, double fx, double fy) {  // another force on C at (x, y)
+      Rx -= fx, Ry -= fy;
+      M -= (x - Px) * fy - (y - Py) * fx;
+    };
+    for (const auto& kj : s.joints)
+      if (kj.parent == jt.child) {
+        double kx, ky, x, y;
+        revolute(kj.name, kx, ky);
+        at(kj.parent_point, x, y);
+        other(x, y, -kx, -ky);
+      }
+    for (const auto& l : s.loops) {
+      if (l.body_a != jt.child && l.body_b != jt.child) continue;
+      double fx, fy, x, y;
+      loop(l, fx, fy);
+      const bool on_b = l.body_b == jt.child;
+      at(on_b ? l.point_b : l.point_a, x, y);
+      other(x, y, on_b ? fx : -fx, on_b ? fy : -fy);
+    }
+    const Kin P = jt.parent == models::kGround ? Kin{} : k.body[s.body_index(jt.parent)];
+    const double ux = std::cos(P.th) * jt.axis.x - std::sin(P.th) * jt.axis.y;
+    const double uy = std::sin(P.th) * jt.axis.x + std::cos(P.th) * jt.axis.y;
+    out[0] = Rx, out[1] = Ry, out[2] = -uy * Rx + ux * Ry, out[3] = M;
+  }
+  // The mechanism's load on the ground: −(Σ m a_c − Σ m g), moment about O likewise.
+  void shaking(double out[3]) const {
+    double Fx = 0, Fy = 0, M = 0;
+    for (size_t b = 0; b < s.bodies.size(); ++b) {
+      const auto& bd = s.bodies[b];
+      const double fx = bd.mass_kg * (k.gx - k.cax[b]), fy = bd.mass_kg * (k.gy - k.cay[b]);
+      Fx += fx, Fy += fy;
+      M += k.cx[b] * fy - k.cy[b] * fx - bd.inertia_kgm2 * k.body[b].al;
+    }
+    out[0] = Fx, out[1] = Fy, out[2] = M;
+  }
+};
+
+// The internal reaction lines are not outputs of their own.
+void drop_internal_lines(const models::Scene& s, models::TimeSeries& ts) {
   for (size_t k = ts.force_names.size(); k-- > 0;) {
     const bool user = std::any_of(s.outputs.constraint_forces.begin(), s.outputs.constraint_forces.end(),
                                   [&](const models::ConstraintForceRequest& c) { return c.name == ts.force_names[k]; });
@@ -349,6 +344,45 @@ void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::Ti
     ts.force_names.erase(ts.force_names.begin() + static_cast<long>(k));
     ts.forces.erase(ts.forces.begin() + static_cast<long>(k));
   }
+}
+
+}  // namespace
+
+void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::TimeSeries& ts) {
+  const auto names = joint_output_names(s);
+  RowKinematics k(s, m.table);
+  const size_t ns = ts.t.size();
+  ts.column_names = names;
+  ts.columns.assign(names.size(), std::vector<double>(ns));
+  RowReactions R{s, ts, k};
+  for (size_t i = 0; i < ns; ++i) {
+    k.calc(ts.q[i], ts.qdot[i], ts.qddot[i]);
+    R.i = i;
+    size_t c = 0;
+    for (const auto& name : s.outputs.joints) {
+      const int j = s.joint_index(name);
+      ts.columns[c++][i] = k.qj[j];
+      ts.columns[c++][i] = k.uj[j];
+      ts.columns[c++][i] = k.aj[j];
+    }
+    for (const auto& name : s.outputs.reactions) {
+      double v[4] = {0, 0, 0, 0};
+      const auto* jt = s.find_joint(name);
+      const bool prismatic = jt && jt->type != models::JointType::Revolute;
+      if (jt && !prismatic) R.revolute(name, v[0], v[1]);
+      else if (prismatic) R.prismatic(*jt, v);
+      else
+        for (const auto& l : s.loops)
+          if (l.name == name) R.loop(l, v[0], v[1]);
+      for (int n = 0; n < (prismatic ? 4 : 2); ++n) ts.columns[c++][i] = v[n];
+    }
+    if (s.outputs.shaking) {
+      double v[3];
+      R.shaking(v);
+      for (double x : v) ts.columns[c++][i] = x;
+    }
+  }
+  drop_internal_lines(s, ts);
 }
 
 }  // namespace rdyn::reduced
