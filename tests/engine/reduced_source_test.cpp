@@ -238,6 +238,30 @@ TEST(ReducedSource, ParallelogramChainsFollowTheirExactMotionThroughTheFlatConfi
   }
 }
 
+// The same with the run's default tolerance (1e-8): the angle is unwrapped (30 rad after 10 s on
+// 40 loops), and an error control relative to |q| loosened with every turn, 1.27e-5 rad off with
+// a cubic 2° table. The control counts an angle's size up to one turn (simulate_reduced.cpp).
+TEST(ReducedSource, DefaultToleranceHoldsTheFortyLoopChainOverManyTurns) {
+  const auto scene = models::load_scene(RDYN_SCENES "/chains/chain-40.yaml");
+  const auto exact = test::chain_exact_q(40, scene.initial.q, scene.initial.qdot, 0.01, 1001);
+  const auto s = extract(scene, 2, reduced::Method::Kinetostatic);
+  for (auto interp : {reduced::Interpolation::CubicSpline, reduced::Interpolation::Fourier}) {
+    const auto m = reduced::make_reduced_model(s, scene, interp);
+    reduced::ReducedOptions opt;
+    opt.duration_s = 10;
+    opt.output_interval_s = 0.01;
+    ASSERT_EQ(opt.tolerance, 1e-8);  // the default this test is about
+    const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, opt);
+    ASSERT_EQ(ts.q.size(), exact.size());
+    double err = 0;
+    for (size_t i = 0; i < exact.size(); ++i) err = std::max(err, std::abs(ts.q[i] - exact[i]));
+    std::printf("chain of 40, 2° table, tolerance 1e-8: max |q − exact| = %.3g rad (q turned %.1f rad)\n", err,
+                ts.q.back() - ts.q.front());
+    EXPECT_LT(err, 1e-5);
+    EXPECT_GT(std::abs(ts.q.back() - ts.q.front()), 4 * M_PI);
+  }
+}
+
 TEST(ReducedSource, FourMethodsAgreeOnTheBicycle) {
   const auto scene = models::load_scene("bicycle");
   const auto ks = extract(scene, 10, reduced::Method::Kinetostatic);
