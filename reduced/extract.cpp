@@ -1,6 +1,7 @@
 #include "reduced/extract.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -220,6 +221,9 @@ struct SweepColumns {
   std::vector<std::vector<std::vector<double>>> rx, Lx;  // [force][joint or point force][point]
   bool slopes = true;                                     // d r_j/dq, when every sample gives it
   std::vector<char> singular, limited;  // limited: a singular point given its exact limit
+  std::vector<std::vector<double>> poles;  // [force]: singular points where its columns have a pole
+  // Singular grid points given their limit, with the pole residues their side samples show.
+  std::vector<std::pair<long, std::vector<std::array<double, 3>>>> pole_residues;
   // Joints gating loads (their ratio's zeros are the switch angles, refined during the sweep)
   // and the zeros found; joints whose angle a profiled load reads.
   std::vector<int> gate_joints, profile_joints;
@@ -234,6 +238,7 @@ struct SweepColumns {
     Lq.assign(g.npf, std::vector<double>(n));  // dL/dq of each point force's line
     Lx.assign(g.nk, Lq);                       // dL/dx_k
     singular.assign(n, 0), limited = singular;
+    poles.resize(g.nk);
     p.assign(wants_joint_outputs(scene) ? g.nj : 0, std::vector<double>(n));
     auto add_gate_joint = [&](const std::optional<models::RateGate>& gate) {
       if (!gate) return;
@@ -378,8 +383,11 @@ void sweep_grid(KinetostaticSource& src, const models::Scene& scene, const Extra
       gs = src.sample(s.q[i], conservative_loads);
       // A singular grid point gets the limit along the branch from both sides (a range's end
       // points have one side only: they keep the repair below, which refuses them).
-      if (gs.singular && (g.periodic || (i > 0 && i < n - 1)))
-        c.limited[i] = calc_singular_limit(src, s.q[i], g.h, conservative_loads, gs);
+      if (gs.singular && (g.periodic || (i > 0 && i < n - 1))) {
+        std::vector<std::array<double, 3>> residues;
+        c.limited[i] = calc_singular_limit(src, s.q[i], g.h, conservative_loads, gs, &residues);
+        if (c.limited[i]) c.pole_residues.emplace_back(i, std::move(residues));
+      }
       c.m2[i] = gs.velocity.driving_force;      // (i) q̇ = 1, q̈ = 0
       c.m1[i] = gs.acceleration.driving_force;  // (ii) q̇ = 0, q̈ = 1
       for (int k = 0; k < nk; ++k)
@@ -451,6 +459,28 @@ void check_turn_closes(KinetostaticSource& src, const models::Scene& scene, cons
       "reached the other branch (a nearly singular stretch, a crossing of branches, or a dead point with a "
       "blocked range narrower than the step); {}",
       scene.source_file, scene.independent, s.q[i0] * 180 / kPi, off, g.h * 180 / kPi, advice));
+}
+
+// A pole shape at a singular grid point (sweep_refine.hpp, is_simple_pole) is a pole of the
+// branch when the grid neighbours show the same residue: ½[f(q_s + h) − f(q_s − h)]·h = a + O(h²)
+// within 30 %. Rounding noise that took the shape at the side samples shows a residue ~1e-16
+// there, not the neighbours' h²·f'.
+void find_force_poles(const GridPlan& g, const Samples& s, SweepColumns& c) {
+  for (const auto& [i, res] : c.pole_residues) {
+    if (!g.periodic && (i == 0 || i + 1 >= g.n)) continue;
+    const long lo = (i - 1 + g.n) % g.n, hi = (i + 1) % g.n;
+    for (int k = 0; k < g.nk; ++k) {
+      const std::vector<double>* cols[3] = {&c.me1[k], &c.me2[k], &c.Qx[k]};
+      bool pole = false;
+      for (int j = 0; j < 3; ++j) {
+        const double a = res.at(k)[j];
+        if (a == 0.0) continue;
+        const double a_grid = 0.5 * ((*cols[j])[hi] - (*cols[j])[lo]) * g.h;
+        pole = pole || std::abs(a_grid - a) < 0.3 * std::abs(a);
+      }
+      if (pole) c.poles[k].push_back(s.q[i]);
+    }
+  }
 }
 
 // Samples at singular configurations (loop Jacobian lost rank) that could not take their limit
@@ -577,6 +607,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     const auto integral = g.periodic ? periodic_integral(s.q, two_m2, 2 * kPi) : range_integral(s.q, two_m2);
     for (long i = 1; i < g.n; ++i) c.m1[i] = c.m1[0] + integral[i];
   }
+  find_force_poles(g, s, c);
   repair_singular_samples(g, s, c);
   const auto& forces = scene.outputs.constraint_forces;
   s.add("m1", c.m1);
@@ -585,6 +616,8 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     s.add("me1_" + forces[k].name, c.me1[k]);
     s.add("me2_" + forces[k].name, c.me2[k]);
   }
+  for (int k = 0; k < g.nk; ++k)
+    if (!c.poles[k].empty()) s.poles.emplace_back(forces[k].name, c.poles[k]);
   s.add("Q_cons", c.Q);
   s.add("V", c.V);
   for (int k = 0; k < g.nk; ++k) s.add("Qx_cons_" + forces[k].name, c.Qx[k]);

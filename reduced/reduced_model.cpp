@@ -25,7 +25,50 @@ void check_samples_fit(const Samples& s, const models::Scene& scene) {
                                  what, models::scene_hash_hex(*s.scene_hash), models::scene_hash_hex(h), scene.name));
 }
 
+// Where the interpolant through samples with a wrong value at a pole is still off, in grid
+// steps: linear and Akima are local (the sample's own intervals; Akima's slopes reach two more);
+// a cubic spline is global but its response to one sample decays by 2 + √3 per step, 8 steps
+// ≈ 3.7⁻⁸ ≈ 3e-5; a trigonometric interpolant's decays only like 1/distance: the whole turn.
+double pole_band(const Samples& s, const std::string& fit) {
+  if (fit == interpolation_name(Interpolation::Fourier)) return INFINITY;
+  if (fit == interpolation_name(Interpolation::Linear)) return 1.0 * s.step;
+  if (fit == interpolation_name(Interpolation::Akima)) return 3.0 * s.step;
+  return 8.0 * s.step;
+}
+
+void set_force_poles(const Samples& s, ReducedModel& m) {
+  m.force_poles.assign(m.force_names.size(), {});
+  for (const auto& [force, qs] : s.poles) {
+    const auto it = std::find(m.force_names.begin(), m.force_names.end(), force);
+    if (it == m.force_names.end())
+      throw TableError(fmt::format("{} lists a pole of constraint force '{}', which the scene does not declare",
+                                   s.file.empty() ? "the table" : "table " + s.file, force.substr(0, 40)));
+    m.force_poles[it - m.force_names.begin()] = qs;
+  }
+  m.pole_band = pole_band(s, m.table.fit);
+}
+
 }  // namespace
+
+void check_force_poles(const ReducedModel& m, double q, double t) {
+  for (size_t k = 0; k < m.force_poles.size(); ++k)
+    for (double p : m.force_poles[k]) {
+      const double d = m.table.periodic ? std::remainder(q - p, 2 * M_PI) : q - p;
+      if (!(std::abs(d) < m.pole_band)) continue;
+      const bool deg = m.revolute;
+      throw models::NumericalError(fmt::format(
+          "the reduced model cannot give constraint force '{}' at t = {:.6g} s, q = {}: its parameters have a pole "
+          "at the singular configuration q = {} (the constraint actuator's rates diverge there) and no "
+          "interpolation of the table represents it within {} of it; use --model full, or leave '{}' out of the "
+          "scene's outputs",
+          m.force_names[k], t, deg ? fmt::format("{:.6g}°", q * 180 / M_PI) : fmt::format("{:.6g} m", q),
+          deg ? fmt::format("{:.6g}°", p * 180 / M_PI) : fmt::format("{:.6g} m", p),
+          std::isinf(m.pole_band) ? std::string("a whole turn (fourier)")
+                                  : deg ? fmt::format("{:.6g}°", m.pole_band * 180 / M_PI)
+                                        : fmt::format("{:.6g} m", m.pole_band),
+          m.force_names[k]));
+    }
+}
 
 ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
                                 bool energy_consistent_m2) {
@@ -50,6 +93,7 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Ta
     m.c_me2.push_back(s.require("me2_" + f.name));
     m.c_Qx.push_back(s.require("Qx_cons_" + f.name));
   }
+  set_force_poles(s, m);
   auto rx_cols = [&](const std::string& prefix, const std::string& what) {
     std::vector<int> c;
     for (const auto& f : scene.outputs.constraint_forces) c.push_back(s.require(prefix + f.name + "_" + what));

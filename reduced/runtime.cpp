@@ -1,6 +1,8 @@
 #include "reduced/runtime.hpp"
 
 #include <algorithm>
+
+#include <fmt/format.h>
 #include <cmath>
 
 #include "models/scene_yaml.hpp"
@@ -40,6 +42,13 @@ RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& sce
   RuntimeModel m;
   m.reduced = make_reduced_model(samples, scene, interp,
                                  options.energy_consistent_m2);  // checks the scene hash
+  // The runtime gives every constraint force at every step, with no way to leave one out near
+  // a pole (check_force_poles): a table with one is refused here rather than answered wrongly.
+  for (size_t k = 0; k < m.reduced.force_poles.size(); ++k)
+    if (!m.reduced.force_poles[k].empty())
+      throw TableError(fmt::format("the runtime cannot give constraint force '{}': its table parameters have a "
+                                   "pole at a singular configuration (q = {:.9g}); leave it out of the scene's outputs",
+                                   m.reduced.force_names[k], m.reduced.force_poles[k][0]));
   m.potential_min = calc_potential_min(m.reduced);
   m.scene_name = scene.name;
   m.revolute = samples.revolute;

@@ -87,6 +87,11 @@ std::string format_samples_csv(const Samples& s) {
     for (double q : s.singular_q) t += fmt::format(" {:.17g}", q);
     t += '\n';
   }
+  for (const auto& [force, qs] : s.poles) {
+    t += fmt::format("# pole {}:", force);
+    for (double q : qs) t += fmt::format(" {:.17g}", q);
+    t += '\n';
+  }
   for (const auto& [col, rs] : s.roots) {
     t += fmt::format("# roots {}:", col);
     for (double r : rs) t += fmt::format(" {:.17g}", r);
@@ -201,14 +206,17 @@ void read_metadata(TableReader& r, Samples& s) {
     r.fail(1, "field 'grid_deg' disagrees with 'step'");
 }
 
-// Optional "# singular: q..." and "# roots <column>: r1 r2 ..." lines; leaves the reader on the
-// line after them (false: none left).
+// Optional "# singular: q...", "# pole <force>: q..." and "# roots <column>: r1 r2 ..." lines;
+// leaves the reader on the line after them (false: none left).
 bool read_annotations(TableReader& r, Samples& s) {
   bool have_line = r.next_line();
-  while (have_line && (r.line.rfind("# roots ", 0) == 0 || r.line.rfind("# singular:", 0) == 0)) {
+  while (have_line && (r.line.rfind("# roots ", 0) == 0 || r.line.rfind("# singular:", 0) == 0 ||
+                       r.line.rfind("# pole ", 0) == 0)) {
     const bool singular = r.line.rfind("# singular:", 0) == 0;
+    const bool pole = r.line.rfind("# pole ", 0) == 0;
     const auto colon = r.line.find(':');
-    if (!singular && colon == std::string::npos) r.fail(r.ln, "malformed roots line (# roots <column>: values)");
+    if (!singular && colon == std::string::npos)
+      r.fail(r.ln, pole ? "malformed pole line (# pole <force>: values)" : "malformed roots line (# roots <column>: values)");
     std::vector<double> vals;
     std::istringstream in(r.line.substr(colon + 1));
     for (std::string v; in >> v;) {
@@ -220,6 +228,13 @@ bool read_annotations(TableReader& r, Samples& s) {
       if (!(vals[i] > vals[i - 1])) r.fail(r.ln, "values must be strictly increasing");
     if (singular) {
       s.singular_q.insert(s.singular_q.end(), vals.begin(), vals.end());
+    } else if (pole) {
+      const std::string force = r.line.substr(7, colon - 7);
+      for (const auto& p : s.poles)
+        if (p.first == force) r.fail(r.ln, "duplicate pole line for force '" + force.substr(0, 40) + "'");
+      if (static_cast<long>(s.poles.size()) >= kMaxTableColumns) r.fail(r.ln, "too many pole lines");
+      if (vals.empty()) r.fail(r.ln, "a pole line needs at least one value");
+      s.poles.emplace_back(force, std::move(vals));
     } else {
       const std::string col = r.line.substr(8, colon - 8);
       if (s.roots_of(col)) r.fail(r.ln, "duplicate roots line for column '" + col.substr(0, 40) + "'");

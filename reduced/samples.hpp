@@ -52,6 +52,11 @@ struct Samples {
   // Grid points at singular configurations, whose values were replaced by interpolation
   // through the regular samples of the same branch [rad or m].
   std::vector<double> singular_q;
+  // Constraint forces whose columns have a simple pole at some of those points (the constraint
+  // actuator's rates diverge there; sweep_refine.hpp, is_simple_pole): force name → sorted q
+  // [rad or m]. No interpolation represents them there; the reduced model refuses the force's
+  // rows near them (reduced_model.hpp, check_force_poles).
+  std::vector<std::pair<std::string, std::vector<double>>> poles;
   const std::vector<double>* roots_of(const std::string& column) const;  // null when absent
 
   int column(const std::string& name) const;  // −1 when absent

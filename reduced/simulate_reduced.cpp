@@ -429,6 +429,7 @@ namespace {
 // Appends one output sample at (t, q, q̇, W) with the workspace's gates.
 void record(const ReducedModel& m, ReducedWorkspace& ws, double t, double q, double qdot, double work,
             models::TimeSeries& ts, std::vector<double>& f) {
+  if (!m.force_poles.empty()) check_force_poles(m, q, t);
   double qdd, p;
   const double energy = calc_sample(m, ws, q, qdot, qdd, p, f.data());
   // No NaN in an output: a sample that is not finite fails the run, naming what and when (the

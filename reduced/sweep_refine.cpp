@@ -2,6 +2,7 @@
 #include "reduced/sweep_refine.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -200,8 +201,39 @@ std::optional<double> find_point_force_meeting(KinetostaticSource& src, long f, 
   return std::nullopt;
 }
 
+bool is_simple_pole(double m1, double m2, double p2, double p1) {
+  const double a1 = 0.5 * (p1 - m1), a2 = 0.5 * (p2 - m2);  // antisymmetric parts at δ, δ/2
+  const double s1 = 0.5 * (p1 + m1), s2 = 0.5 * (p2 + m2);  // symmetric parts
+  const double growth = std::abs(a2) / std::abs(a1);
+  return std::isfinite(growth) && growth > 1.8 && growth < 2.2 && (a1 > 0) == (a2 > 0) &&
+         std::abs(a2) > 100 * std::abs(s2 - s1);
+}
+
+namespace {
+
+// Per constraint force, the residue a of a pole a/(q − q_s) in me1, me2 and Q_x from the four
+// side samples at ±δ/2 and ±δ: a = ½[f(q_s + δ/2) − f(q_s − δ/2)]·δ/2 where is_simple_pole, else 0.
+std::vector<std::array<double, 3>> calc_pole_residues(const GridSample s[4], double d) {
+  const size_t nk = s[0].acceleration.constraint_forces.size();
+  std::vector<std::array<double, 3>> out(nk, {0.0, 0.0, 0.0});
+  auto residue = [&](auto get) {
+    double v[4];
+    for (int i = 0; i < 4; ++i) v[i] = get(s[i]);
+    return is_simple_pole(v[0], v[1], v[2], v[3]) ? 0.5 * (v[2] - v[1]) * 0.5 * d : 0.0;
+  };
+  for (size_t k = 0; k < nk; ++k) {
+    out[k][0] = residue([k](const GridSample& x) { return x.acceleration.constraint_forces.at(k); });
+    out[k][1] = residue([k](const GridSample& x) { return x.velocity.constraint_forces.at(k); });
+    if (s[0].conservative.forces.constraint_forces.size() == nk)
+      out[k][2] = residue([k](const GridSample& x) { return x.conservative.forces.constraint_forces.at(k); });
+  }
+  return out;
+}
+
+}  // namespace
+
 bool calc_singular_limit(KinetostaticSource& src, double q_s, double grid_step, bool conservative_loads,
-                         GridSample& g) {
+                         GridSample& g, std::vector<std::array<double, 3>>* pole_residues) {
   const double d = std::min(kSingularLimitStep_rad, grid_step / 4);
   // Away from q_s and back across it: each move is short, so the predictor stays on the branch
   // the sweep came along (from q_s itself it follows the chord, see calc_kinetostatic_sample).
@@ -225,6 +257,7 @@ bool calc_singular_limit(KinetostaticSource& src, double q_s, double grid_step, 
   ok &= limit_field(out.ratios.length_wrt_q, side, [](const GridSample& x) -> const std::vector<double>& { return x.ratios.length_wrt_q; });
   ok &= limit_field(out.ratios.length_wrt_x, side, [](const GridSample& x) -> const std::vector<std::vector<double>>& { return x.ratios.length_wrt_x; });
   if (!ok) return false;
+  if (pole_residues) *pole_residues = calc_pole_residues(s, d);
   out.velocity.joint_rates = out.ratios.wrt_q;
   g = std::move(out);
   return true;

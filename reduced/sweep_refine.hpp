@@ -4,7 +4,9 @@
 // limits that replace a sample at a singular configuration. Internal to reduced/.
 #pragma once
 
+#include <array>
 #include <optional>
+#include <vector>
 
 #include "reduced/kinetostatic_source.hpp"
 
@@ -42,8 +44,20 @@ inline constexpr double kSingularLimitStep_rad = 1e-2;
 
 // Replaces sample g at the singular grid point q_s by that limit (δ = kSingularLimitStep_rad, at
 // most a quarter of the grid step); false, g unchanged, when a side sample is singular too or a
-// limit is not finite.
+// limit is not finite. `pole_residues`, when given, gets per constraint force the residue a of a
+// pole a/(q − q_s) that the side samples show in me1, me2 and Q_x (0: none; is_simple_pole).
+// The extraction confirms a pole against the grid neighbours (extract.cpp, find_force_poles).
 bool calc_singular_limit(KinetostaticSource& src, double q_s, double grid_step, bool conservative_loads,
-                         GridSample& g);
+                         GridSample& g, std::vector<std::array<double, 3>>* pole_residues = nullptr);
+
+// Whether a column sampled at q_s − δ, q_s − δ/2, q_s + δ/2, q_s + δ (values m1, m2, p2, p1) has
+// the shape of a simple pole at q_s, f ≈ a/(q − q_s) + regular. Some constraint forces have one
+// at a singular configuration: the constraint actuator's own rates diverge there (an isosceles
+// slider-crank folded flat: me1 ≈ 0.026/x kg), and the symmetric limit above is then the
+// principal value, not a value of the branch. Test: the antisymmetric part ½[f(q_s + d) −
+// f(q_s − d)] doubles when d halves, keeping its sign (a regular column's halves), and dominates
+// the change of the symmetric part by 100×. Rounding noise can take that shape; the residue
+// must then also be the one the grid neighbours show.
+bool is_simple_pole(double m1, double m2, double p2, double p1);
 
 }  // namespace rdyn::reduced

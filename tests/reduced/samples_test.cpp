@@ -48,6 +48,7 @@ TEST(Samples, CsvRoundTripKeepsEveryBitTheRootsAndTheSceneHash) {
   s.add("m2", {0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7, -1e-300});
   s.roots.emplace_back("m2", std::vector<double>{0.1, 3.3});
   s.singular_q = {2 * s.step};
+  s.poles.emplace_back("rod_axial", std::vector<double>{2 * s.step});
   const std::string path = ::testing::TempDir() + "/samples_test.csv";
   write_samples_csv(path, s);
   const Samples r = read_samples_csv(path);
@@ -60,6 +61,7 @@ TEST(Samples, CsvRoundTripKeepsEveryBitTheRootsAndTheSceneHash) {
   EXPECT_EQ(r.q0, s.q0);
   EXPECT_EQ(r.step, s.step);
   EXPECT_EQ(r.singular_q, s.singular_q);
+  EXPECT_EQ(r.poles, s.poles);
   ASSERT_NE(r.roots_of("m2"), nullptr);
   EXPECT_EQ(*r.roots_of("m2"), s.roots[0].second);
   for (size_t i = 0; i < s.q.size(); ++i) EXPECT_NEAR(r.q[i], s.q[i], 1e-15);
@@ -161,6 +163,13 @@ TEST(Samples, MalformedTablesNameFileLineAndField) {
        "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# roots r_a: 2 1\n", "t.csv:2: values must"},
       {"root not finite",
        "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# roots r_a: 1 nan\n", "t.csv:2: root"},
+      {"pole without values", "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# pole f:\n",
+       "t.csv:2: a pole line needs at least one value"},
+      {"pole twice",
+       "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# pole f: 1\n# pole f: 2\n",
+       "t.csv:3: duplicate pole line for force 'f'"},
+      {"pole malformed", "# rdyn-table v1 scene=0123456789abcdef periodic=1 q0=0 step=1\n# pole f 1\n",
+       "t.csv:2: malformed pole line"},
   };
   for (const auto& c : cases) {
     const std::string e = error_of(c.text);

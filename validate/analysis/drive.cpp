@@ -208,6 +208,7 @@ DriveRecord calc_drive_reduced(const reduced::ReducedModel& model, const Prescri
       throw reduced::TableError(fmt::format("the prescribed motion leaves the table's range at t = {:.6g} s (q = "
                                             "{:.6g}): prescribe a motion inside the mechanism's range",
                                             motion.t[i], motion.q[i]));
+    reduced::check_force_poles(model, motion.q[i], motion.t[i]);
     double power_nc = 0.0;
     const double d = reduced::calc_drive(model, ws, motion.q[i], motion.qdot[i], motion.qddot[i], power_nc, f.data());
     check_finite(d, "generalized force", motion.t[i]);
