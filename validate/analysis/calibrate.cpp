@@ -391,15 +391,309 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
   return with_load(scene, select_load(scene, opt), 1.0, calc_resistance_coefficient(scene, opt));
 }
 
+namespace {
+
+[[noreturn]] void fail_field(const models::Scene& scene, const std::string& field, const std::string& msg) {
+  throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
+}
+
+// The work per revolution of every non-conservative load at the constant target rate, with the
+// selected loads at unit value (±1: set_load(m, sel, 1) first). Both parts are linear in the
+// load values: a torque does T·∫ r [gate] dq, a point force T·∫ τ (−dL/dq) [gate] dq, a motor
+// s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq (springs and gravity do none over a turn).
+struct RevolutionWork {
+  double unit = 0.0;            // the selected loads' work per unit value [J per N·m or N]
+  double other = 0.0;           // every other load's [J]
+  double scale = 0.0;           // Σ|r| dq of the selected loads, for the round-off test of `unit`
+  double other_scale = 0.0;     // Σ|work| of the others, for the round-off test of `other`
+  double max_motor_rate = 0.0;  // a selected motor's largest joint rate over its no-load speed
+  double brakes = 0.0;          // the resistances' alone [J]
+  // Each other load's [J], to name them when they already balance the resistances.
+  std::vector<double> torque, force, motor;
+};
+
+RevolutionWork calc_revolution_work(const reduced::ReducedModel& m, const Selection& sel, double q_start,
+                                    double cadence_hz) {
+  const int n = 3600;
+  const double qd = 2 * M_PI * cadence_hz, dq = 2 * M_PI / n;
+  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
+      selected_force(m.point_forces.size(), 0);
+  for (const auto& en : sel.entries)
+    (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
+  RevolutionWork w;
+  w.torque.assign(m.torques.size(), 0.0), w.force.assign(m.point_forces.size(), 0.0);
+  w.motor.assign(m.motors.size(), 0.0);
+  for (int i = 0; i < n; ++i) {
+    const double q = q_start + (i + 0.5) * dq;
+    for (size_t k = 0; k < m.torques.size(); ++k) {
+      const auto& t = m.torques[k];
+      const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
+      // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
+      const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
+      const double r_j = tau * m.table.eval(t.c_r, q);
+      if (selected_torque[k]) w.scale += std::abs(r_j) * dq;
+      if (on) (selected_torque[k] ? w.unit : w.other) += t.value * r_j * dq;  // value ±1 when selected
+      if (on && !selected_torque[k]) w.other_scale += std::abs(t.value * r_j) * dq, w.torque[k] += t.value * r_j * dq;
+    }
+    // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
+    for (size_t k = 0; k < m.point_forces.size(); ++k) {
+      const auto& f = m.point_forces[k];
+      const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
+      const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
+      if (selected_force[k]) w.scale += std::abs(Q) * dq;
+      if (on) (selected_force[k] ? w.unit : w.other) += f.value * Q * dq;
+      if (on && !selected_force[k]) w.other_scale += std::abs(f.value * Q) * dq, w.force[k] += f.value * Q * dq;
+    }
+    for (size_t k = 0; k < m.motors.size(); ++k) {
+      const auto& mo = m.motors[k];
+      const double r_j = m.table.eval(mo.c_r, q);
+      const double wm = models::motor_torque(mo.stall, mo.no_load_speed, r_j * qd) * r_j * dq;
+      if (selected_motor[k]) {
+        w.unit += wm;
+        w.scale += std::abs(r_j) * dq;
+        w.max_motor_rate = std::max(w.max_motor_rate, r_j * qd / mo.no_load_speed);
+      } else {
+        w.other += wm;
+        w.other_scale += std::abs(wm);
+        w.motor[k] += wm;
+      }
+    }
+    for (const auto& b : m.brakes) {
+      const double wr = m.table.eval(b.c_w, q);
+      const double wb = models::resistance_torque(b.law, b.coefficient, wr * qd) * wr * dq;
+      w.other += wb;
+      w.other_scale += std::abs(wb);
+      w.brakes += wb;
+    }
+  }
+  return w;
+}
+
+// The energy balance's first guess T0 = −W_other/W_unit, after refusing (exit 2, naming the load
+// field) a load that cannot set the mean speed: no net work per revolution, work of the wrong
+// sign (a motor past its no-load speed), other drive loads that already supply what the
+// resistances dissipate, or nothing that dissipates.
+double calc_energy_balance_guess(const RevolutionWork& w, const models::Scene& scene, const Selection& sel,
+                                 const CalibrationOptions& opt, const std::string& load_field) {
+  const bool motor = sel.kind.rfind("motor", 0) == 0;
+  if (!(std::abs(w.unit) > 1e-9 * w.scale) && !motor)
+    fail_field(scene, load_field,
+               fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
+                           "mean speed: calibrate a load that drives the mechanism",
+                           sel.name, w.unit, sel.unit));
+  if (!(w.unit > 0)) {
+    if (motor)
+      fail_field(scene, load_field,
+                 fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load "
+                             "speed {:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall "
+                             "torque of the no-load speed's sign holds the target (lower the target or raise the "
+                             "no-load speed)",
+                             sel.name, opt.cadence_hz, w.max_motor_rate,
+                             scene.motors[sel.entries[0].index].no_load_speed, w.unit, sel.unit));
+    fail_field(scene, load_field,
+               fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
+                           "per {}): give it the opposite sign",
+                           sel.name, w.unit, sel.unit));
+  }
+  // The resistances dissipate but other drive loads already supply it (e.g. a scene's muscles
+  // calibrated for this operating point, and a torque added beside them): the selected load
+  // has no work left to do. Name those loads: "nothing dissipates" would be untrue.
+  std::string drivers;
+  auto add_driver = [&](const std::string& name, double W) {
+    if (W > 1e-9 * w.other_scale) drivers += fmt::format("{}'{}' {:+.4g} J", drivers.empty() ? "" : ", ", name, W);
+  };
+  for (size_t k = 0; k < w.torque.size(); ++k) add_driver(scene.joint_torques[k].name, w.torque[k]);
+  for (size_t k = 0; k < w.force.size(); ++k) add_driver(scene.point_forces[k].name, w.force[k]);
+  for (size_t k = 0; k < w.motor.size(); ++k) add_driver(scene.motors[k].name, w.motor[k]);
+  if (!(w.other < -1e-9 * w.other_scale) && w.brakes < -1e-9 * w.other_scale && !drivers.empty())
+    fail_field(scene, load_field,
+               fmt::format("at {:g} Hz the other drive loads already supply what the resistances dissipate "
+                           "({:.4g} J per revolution): {} ({:+.3g} J net), so '{}' has no work left to do "
+                           "and cannot set the mean speed; calibrate those loads instead, or remove them",
+                           opt.cadence_hz, w.brakes, drivers, w.other, sel.name));
+  // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
+  // returns its work over a revolution).
+  if (!(w.other < -1e-9 * w.other_scale) || w.other == 0.0)
+    fail_field(scene, load_field,
+               fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
+                           "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
+                           "validation.calibrate.power_W) or a resistance",
+                           opt.cadence_hz, w.other, sel.name));
+  return -w.other / w.unit;
+}
+
+// One Newton iteration for the cycle, the load and (power mode) the coefficient together, from
+// the energy balance's guess (validate/analysis/operating_point.hpp); empty where there is no
+// first integral (a table that is not periodic): the nested searches then.
+std::optional<OperatingPoint> solve_direct(reduced::ReducedModel& m, const Selection& sel, const models::Scene& scene,
+                                           const CalibrationOptions& opt, const CalibrationResult& r, bool power_mode,
+                                           int& evals, Progress& progress) {
+  OperatingPointTargets tg;
+  tg.q_section = scene.initial.q;
+  tg.qdot_guess = 2 * M_PI * opt.cadence_hz;
+  tg.cadence_hz = opt.cadence_hz;
+  tg.power_w = power_mode ? opt.power_w : NAN;
+  tg.tolerance = opt.tolerance;
+  progress.note("calibrate: operating point (Newton on the first integral)");
+  try {
+    return solve_operating_point(
+        m, tg, r.initial_guess, r.resistance_coefficient,
+        [&](double load, double c) {
+          set_load(m, sel, load);
+          if (power_mode) m.brakes[0].coefficient = c;
+        },
+        evals);
+  } catch (const models::NumericalError&) {
+    return std::nullopt;
+  }
+}
+
+// Brent (GSL) on the load's magnitude until the mean steady cadence is F, from a bracket around
+// the energy balance's guess widened (at most 20 times each way) until it holds the root.
+double search_load(reduced::ReducedModel& m, const Selection& sel, const models::Scene& scene,
+                   const CalibrationOptions& opt, double guess, int& evals, Progress& progress) {
+  RootContext ctx{&m, &sel, scene.initial.q, 2 * M_PI * opt.cadence_hz, opt.cadence_hz, opt.tolerance, &evals};
+  gsl_function fn{cadence_error, &ctx};
+  double lo = 0.8 * guess, hi = 1.25 * guess;
+  double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
+  for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
+  for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
+    hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
+  if (!(flo <= 0 && fhi >= 0))
+    throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
+                                             sel.name, lo, hi, sel.unit, opt.cadence_hz));
+  gsl_set_error_handler_off();
+  std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
+      gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
+  gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
+  double T = guess;
+  for (int it = 0; it < 100; ++it) {
+    gsl_root_fsolver_iterate(solver.get());
+    T = gsl_root_fsolver_root(solver.get());
+    progress.count("calibrate: load search", it + 1, it + 1);
+    if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
+                               1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
+      break;
+  }
+  return T;
+}
+
+// A value the scene format refuses (|load| or |amplitude|·max|τ| above limits::kMaxForce, a
+// resistance coefficient beyond its body's bound) is no result: a written scene would not load.
+void check_scene_allows(const models::Scene& scene, const Selection& sel, double T, double coefficient,
+                        const CalibrationOptions& opt) {
+  try {
+    models::check_scene(with_load(scene, sel, T, coefficient));
+  } catch (const models::SceneError& e) {
+    throw models::NumericalError(fmt::format(
+        "calibration: holding {:g} Hz needs {} = {:.6g} {}, beyond what a scene allows (the limit is {:g} {} per "
+        "load): {}: {}; choose a lower power or another operating point",
+        opt.cadence_hz, sel.name, T, sel.unit, models::limits::kMaxForce, sel.unit, e.field(), e.message()));
+  }
+}
+
+// The reduced model's steady cycle at load magnitude T, sampled for its extremes, into r (load
+// value with its sign, operating point, mean cadence); it must meet its own target (issue #9):
+// the root finders converge to 1e-10 relative, so the cadence is off by far less than
+// kReducedCadenceTolerance unless the bracket held a discontinuity (a stall) instead of a root.
+Cycle settle_at_load(reduced::ReducedModel& m, const Selection& sel, const models::Scene& scene,
+                     const CalibrationOptions& opt, double T, double qdot_guess, int& evals, CalibrationResult& r) {
+  const double sign = sel.entries[0].sign;
+  r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
+  r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
+  set_load(m, sel, T);
+  Cycle cy = steady_cycle(m, scene.initial.q, qdot_guess, opt.tolerance, evals, true);
+  if (!cy.ok)
+    throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
+                                             "({:.6g} {})", r.load_value, sel.unit));
+  r.steady_q = scene.initial.q;
+  r.steady_qdot = cy.speed;
+  r.mean_cadence_hz_reduced = 1.0 / cy.period;
+  check_cadence("calibration missed its target: the reduced model's steady cadence", r.mean_cadence_hz_reduced,
+                opt.cadence_hz, kReducedCadenceTolerance, sel, r.load_value);
+  return cy;
+}
+
+// Power mode: c = P/ω_Fⁿ dissipates P only at constant speed; on a fluctuating steady cycle the
+// resistance dissipates c·⟨ωⁿ⟩ ≠ P (a motor-driven crank at 2.3× fluctuation: 25 W for 20 W).
+// So the coefficient is adjusted too, around the load search, until the steady cycle both holds
+// F (the load) and dissipates P (the coefficient): a secant on ln c ↦ ln(P_diss/P), whose slope
+// is near 1 (P_diss = c·⟨ωⁿ⟩, ⟨ωⁿ⟩ nearly independent of c), at most kMaxPowerPasses load
+// searches. True when the cycle dissipates P; otherwise the next coefficient into r.
+struct PowerSecant {
+  double ln_c_prev = NAN, f_prev = NAN;
+};
+bool power_met(const Cycle& cy, const CalibrationOptions& opt, int pass, PowerSecant& s, CalibrationResult& r) {
+  const double P_diss = cy.detail.dissipated_power_W;
+  const double f = std::log(P_diss / opt.power_w);  // 0 at the target
+  if (!std::isfinite(f))
+    throw models::NumericalError(fmt::format("calibration: the resistance dissipates {:.6g} W on the steady cycle "
+                                             "at {:g} Hz; no coefficient reaches {:g} W",
+                                             P_diss, opt.cadence_hz, opt.power_w));
+  if (std::abs(f) <= kPowerTolerance) return true;
+  if (pass + 1 >= kMaxPowerPasses)
+    throw models::NumericalError(fmt::format(
+        "calibration did not converge: after {} load searches the steady cycle at {:g} Hz dissipates {:.8g} W "
+        "(resistance coefficient {:.6g}), target {:g} W (allowed {:g} %)",
+        pass + 1, opt.cadence_hz, P_diss, r.resistance_coefficient, opt.power_w, 100 * kPowerTolerance));
+  const double ln_c = std::log(r.resistance_coefficient);
+  double slope = std::isfinite(s.ln_c_prev) && ln_c != s.ln_c_prev ? (f - s.f_prev) / (ln_c - s.ln_c_prev) : 1.0;
+  if (!(slope > 0.1 && slope < 10)) slope = 1.0;  // a wild secant: the fixed-point step
+  s.ln_c_prev = ln_c, s.f_prev = f;
+  r.resistance_coefficient = std::exp(ln_c - f / slope);
+  return false;
+}
+
+// On a steady cycle the drive supplies what the resistances dissipate. The reduced model's own
+// residual — an interpolated m2 that is not exactly ½ dm1/dq acts as a power ∝ q̇³ (docs/theory.md
+// §5; ~1.5e-4 W on the bicycle's 10° table at 1 Hz, 1e-6 of 125 W) — is small unless the
+// operating point's energy flow is small against it (a very low power, a very high cadence):
+// then the calibrated value is the interpolation error's, not the mechanism's, and that is no
+// result.
+void check_cycle_energy_balance(const Cycle& cy, const CalibrationOptions& opt) {
+  const double drive = cy.detail.drive_power_W, diss = cy.detail.dissipated_power_W;
+  if (!(std::abs(drive - diss) <= kEnergyBalanceTolerance * std::max(std::abs(drive), std::abs(diss))))
+    throw models::NumericalError(fmt::format(
+        "calibration: on the reduced model's steady cycle at {:g} Hz the drive supplies {:.6g} W but the resistances "
+        "dissipate {:.6g} W ({:.2g} % apart, allowed {:g} %): the table's interpolation error is not small against "
+        "this operating point's energy flow; extract on a finer grid (--grid-deg)",
+        opt.cadence_hz, drive, diss, 100 * std::abs(drive - diss) / std::max(std::abs(drive), std::abs(diss)),
+        100 * kEnergyBalanceTolerance));
+}
+
+// A motor's mean power depends on the speed: the trapezoid rule over the periodic cycle's
+// samples (spectrally accurate for a smooth periodic integrand).
+double calc_motor_mean_power(const reduced::ReducedModel& m, const reduced::ReducedModel::Motor& mo,
+                             const CalibrationResult& r, const Cycle& cy, double tolerance) {
+  reduced::ReducedOptions ro;
+  ro.duration_s = cy.period;
+  ro.output_interval_s = cy.period / 1440;
+  ro.tolerance = tolerance;
+  const auto cyc = reduced::simulate_reduced(m, r.steady_q, r.steady_qdot, ro);
+  double E = 0.0;
+  for (size_t i = 0; i + 1 < cyc.t.size(); ++i) {
+    auto p = [&](size_t k) {
+      const double u = m.table.eval(mo.c_r, cyc.q[k]) * cyc.qdot[k];
+      return models::motor_torque(mo.stall, mo.no_load_speed, u) * u;
+    };
+    E += 0.5 * (p(i) + p(i + 1)) * (cyc.t[i + 1] - cyc.t[i]);
+  }
+  return E / cy.period;
+}
+
+}  // namespace
+
+// Stages: the work per revolution at the target rate gives the first guess; Newton on the
+// operating point (or Brent on the load) holds the cadence; the steady cycle at that load is
+// checked against its target; in power mode the resistance coefficient is corrected and the load
+// searched again until the cycle dissipates P; then the cycle's energy balance, extremes and
+// mean power.
 CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress) {
   // The searches below set load values and the resistance coefficient on the calibration's own
   // copy: the caller's model is never left at some shape's values (issue #23: a model shared by
   // two strategies kept the last one's coefficient). The result carries the values found.
   reduced::ReducedModel m = model;
-  auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
-  };
   const Selection sel = select_load(scene, opt);
   const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
   CalibrationResult r;
@@ -407,241 +701,38 @@ CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const mo
   r.load_kind = sel.kind;
   r.load_unit = sel.unit;
   r.resistance_coefficient = calc_resistance_coefficient(scene, opt);
-  // Power mode: c = P/ω_Fⁿ dissipates P only at constant speed; on a fluctuating steady cycle the
-  // resistance dissipates c·⟨ωⁿ⟩ ≠ P (a motor-driven crank at 2.3× fluctuation: 25 W for 20 W).
-  // So the coefficient is adjusted too, around the load search, until the steady cycle both
-  // holds F (the load) and dissipates P (the coefficient): a secant on ln c ↦ ln(P_diss/P),
-  // whose slope is near 1 (P_diss = c·⟨ωⁿ⟩, ⟨ωⁿ⟩ nearly independent of c), at most
-  // kMaxPowerPasses load searches.
   const bool power_mode = std::isfinite(r.resistance_coefficient);
   if (power_mode && m.brakes.size() != 1)
     throw models::NumericalError(fmt::format("calibration: the reduced model has {} resistances, the power mode one",
                                              m.brakes.size()));
-  double T = 0.0, W_unit = 0.0, ln_c_prev = NAN, f_prev = NAN;
+  double T = 0.0;
+  RevolutionWork work;
+  PowerSecant secant;
   int evals = 0;
   Cycle cy;
   for (int pass = 0;; ++pass) {
     if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
-    set_load(m, sel, 1.0);  // the energy balance below reads the selected loads at unit value
-
-    // First guess from the energy balance per revolution at the constant target rate: the
-    // load's work T·W_unit balances the work of every other non-conservative load, W_other
-    // (springs and gravity do none over a revolution). Both are linear in the load values:
-    // a torque does T·∫ r [gate] dq, a motor s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq.
-    const int n = 3600;
-    const double qd = 2 * M_PI * opt.cadence_hz, dq = 2 * M_PI / n;
-    std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
-        selected_force(m.point_forces.size(), 0);
-    for (const auto& en : sel.entries)
-      (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
-    W_unit = 0.0;
-    double W_other = 0.0, W_scale = 0.0, W_other_scale = 0.0, max_motor_rate = 0.0;
-    // The other loads' work per revolution one by one (named when they already balance the
-    // resistances: the real cause when the selected load has nothing left to do).
-    std::vector<double> W_torque(m.torques.size(), 0.0), W_force(m.point_forces.size(), 0.0),
-        W_motor(m.motors.size(), 0.0);
-    double W_brakes = 0.0;
-    for (int i = 0; i < n; ++i) {
-      const double q = scene.initial.q + (i + 0.5) * dq;
-      for (size_t k = 0; k < m.torques.size(); ++k) {
-        const auto& t = m.torques[k];
-        const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-        // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
-        const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
-        const double r_j = tau * m.table.eval(t.c_r, q);
-        if (selected_torque[k]) W_scale += std::abs(r_j) * dq;
-        if (on) (selected_torque[k] ? W_unit : W_other) += t.value * r_j * dq;  // value ±1 when selected
-        if (on && !selected_torque[k]) W_other_scale += std::abs(t.value * r_j) * dq, W_torque[k] += t.value * r_j * dq;
-      }
-      // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
-      for (size_t k = 0; k < m.point_forces.size(); ++k) {
-        const auto& f = m.point_forces[k];
-        const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
-        const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
-        if (selected_force[k]) W_scale += std::abs(Q) * dq;
-        if (on) (selected_force[k] ? W_unit : W_other) += f.value * Q * dq;
-        if (on && !selected_force[k]) W_other_scale += std::abs(f.value * Q) * dq, W_force[k] += f.value * Q * dq;
-      }
-      for (size_t k = 0; k < m.motors.size(); ++k) {
-        const auto& mo = m.motors[k];
-        const double r_j = m.table.eval(mo.c_r, q);
-        const double w = models::motor_torque(mo.stall, mo.no_load_speed, r_j * qd) * r_j * dq;
-        if (selected_motor[k]) {
-          W_unit += w;
-          W_scale += std::abs(r_j) * dq;
-          max_motor_rate = std::max(max_motor_rate, r_j * qd / mo.no_load_speed);
-        } else {
-          W_other += w;
-          W_other_scale += std::abs(w);
-          W_motor[k] += w;
-        }
-      }
-      for (const auto& b : m.brakes) {
-        const double w = m.table.eval(b.c_w, q);
-        const double wb = models::resistance_torque(b.law, b.coefficient, w * qd) * w * dq;
-        W_other += wb;
-        W_other_scale += std::abs(wb);
-        W_brakes += wb;
-      }
-    }
-    r.work_per_rev_per_unit = W_unit;
-    if (!(std::abs(W_unit) > 1e-9 * W_scale) && sel.kind.rfind("motor", 0) != 0)
-      fail(load_field, fmt::format("'{}' does no net work per revolution ({:.3g} J per {}), so it cannot change the "
-                                   "mean speed: calibrate a load that drives the mechanism",
-                                   sel.name, W_unit, sel.unit));
-    if (!(W_unit > 0)) {
-      if (sel.kind.rfind("motor", 0) == 0)
-        fail(load_field,
-             fmt::format("motor '{}' cannot hold {:g} Hz: there its joint turns at up to {:.4g} times its no-load speed "
-                         "{:g}, so the motor does {:.3g} J per revolution per {} of stall torque; no stall torque of "
-                         "the no-load speed's sign holds the target (lower the target or raise the no-load speed)",
-                         sel.name, opt.cadence_hz, max_motor_rate, scene.motors[sel.entries[0].index].no_load_speed,
-                         W_unit, sel.unit));
-      fail(load_field, fmt::format("'{}' does negative work per revolution with the sign it has in the scene ({:.3g} J "
-                                   "per {}): give it the opposite sign",
-                                   sel.name, W_unit, sel.unit));
-    }
-    // The resistances dissipate but other drive loads already supply it (e.g. a scene's muscles
-    // calibrated for this operating point, and a torque added beside them): the selected load
-    // has no work left to do. Name those loads: "nothing dissipates" would be untrue.
-    std::string drivers;
-    auto add_driver = [&](const std::string& name, double W) {
-      if (W > 1e-9 * W_other_scale) drivers += fmt::format("{}'{}' {:+.4g} J", drivers.empty() ? "" : ", ", name, W);
-    };
-    for (size_t k = 0; k < W_torque.size(); ++k) add_driver(scene.joint_torques[k].name, W_torque[k]);
-    for (size_t k = 0; k < W_force.size(); ++k) add_driver(scene.point_forces[k].name, W_force[k]);
-    for (size_t k = 0; k < W_motor.size(); ++k) add_driver(scene.motors[k].name, W_motor[k]);
-    if (!(W_other < -1e-9 * W_other_scale) && W_brakes < -1e-9 * W_other_scale && !drivers.empty())
-      fail(load_field, fmt::format("at {:g} Hz the other drive loads already supply what the resistances dissipate "
-                                   "({:.4g} J per revolution): {} ({:+.3g} J net), so '{}' has no work left to do "
-                                   "and cannot set the mean speed; calibrate those loads instead, or remove them",
-                                   opt.cadence_hz, W_brakes, drivers, W_other, sel.name));
-    // Below round-off of the other loads' work: nothing dissipates (a constant force on a slider
-    // returns its work over a revolution).
-    if (!(W_other < -1e-9 * W_other_scale) || W_other == 0.0)
-      fail(load_field, fmt::format("nothing dissipates energy at {:g} Hz (the other loads do {:.3g} J per revolution): "
-                                   "'{}' cannot hold a mean speed; give a power to dissipate (--power-w, "
-                                   "validation.calibrate.power_W) or a resistance",
-                                   opt.cadence_hz, W_other, sel.name));
-    r.initial_guess = -W_other / W_unit;
-
-    // One Newton iteration for the cycle, the load and (power mode) the coefficient together,
-    // from the energy balance's guess; the nested searches where it does not converge.
+    set_load(m, sel, 1.0);  // the energy balance reads the selected loads at unit value
+    work = calc_revolution_work(m, sel, scene.initial.q, opt.cadence_hz);
+    r.work_per_rev_per_unit = work.unit;
+    r.initial_guess = calc_energy_balance_guess(work, scene, sel, opt, load_field);
     std::optional<OperatingPoint> direct;
-    if (opt.direct && pass == 0) {
-      OperatingPointTargets tg;
-      tg.q_section = scene.initial.q;
-      tg.qdot_guess = qd;
-      tg.cadence_hz = opt.cadence_hz;
-      tg.power_w = power_mode ? opt.power_w : NAN;
-      tg.tolerance = opt.tolerance;
-      progress.note("calibrate: operating point (Newton on the first integral)");
-      try {
-        direct = solve_operating_point(
-            m, tg, r.initial_guess, r.resistance_coefficient,
-            [&](double load, double c) {
-              set_load(m, sel, load);
-              if (power_mode) m.brakes[0].coefficient = c;
-            },
-            evals);
-      } catch (const models::NumericalError&) {
-        direct.reset();  // no first integral here (a table that is not periodic): the nested route
-      }
-    }
+    if (opt.direct && pass == 0) direct = solve_direct(m, sel, scene, opt, r, power_mode, evals, progress);
     if (direct) {
       T = direct->load;
       if (power_mode) r.resistance_coefficient = direct->coefficient;
     } else {
       if (power_mode) m.brakes[0].coefficient = r.resistance_coefficient;
-      // Brent (GSL) on the load's magnitude: mean steady cadence = F.
-      RootContext ctx{&m, &sel, scene.initial.q, qd, opt.cadence_hz, opt.tolerance, &evals};
-      gsl_function fn{cadence_error, &ctx};
-      double lo = 0.8 * r.initial_guess, hi = 1.25 * r.initial_guess;
-      double flo = cadence_error(lo, &ctx), fhi = cadence_error(hi, &ctx);
-      for (int i = 0; i < 20 && flo > 0; ++i) lo *= 0.7, flo = cadence_error(lo, &ctx);
-      for (int i = 0; i < 20 && fhi < 0 && hi < models::limits::kMaxForce; ++i)
-        hi = std::min(hi * 1.4, models::limits::kMaxForce), fhi = cadence_error(hi, &ctx);
-      if (!(flo <= 0 && fhi >= 0))
-        throw models::NumericalError(fmt::format("calibration: no value of '{}' between {:.4g} and {:.4g} {} holds {} Hz",
-                                                 sel.name, lo, hi, sel.unit, opt.cadence_hz));
-      gsl_set_error_handler_off();
-      std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> solver(
-          gsl_root_fsolver_alloc(gsl_root_fsolver_brent), gsl_root_fsolver_free);
-      gsl_root_fsolver_set(solver.get(), &fn, lo, hi);
-      T = r.initial_guess;
-      for (int it = 0; it < 100; ++it) {
-        gsl_root_fsolver_iterate(solver.get());
-        T = gsl_root_fsolver_root(solver.get());
-        progress.count("calibrate: load search", it + 1, it + 1);
-        if (gsl_root_test_interval(gsl_root_fsolver_x_lower(solver.get()), gsl_root_fsolver_x_upper(solver.get()), 0,
-                                   1e-10 * std::max(1.0, std::abs(T))) == GSL_SUCCESS)
-          break;
-      }
+      T = search_load(m, sel, scene, opt, r.initial_guess, evals, progress);
     }
     progress.note("");
-    // A value the scene format refuses (|load| or |amplitude|·max|τ| above limits::kMaxForce, a
-    // resistance coefficient beyond its body's bound) is no result: a written scene would not load.
-    try {
-      models::check_scene(with_load(scene, sel, T, r.resistance_coefficient));
-    } catch (const models::SceneError& e) {
-      throw models::NumericalError(fmt::format(
-          "calibration: holding {:g} Hz needs {} = {:.6g} {}, beyond what a scene allows (the limit is {:g} {} per "
-          "load): {}: {}; choose a lower power or another operating point",
-          opt.cadence_hz, sel.name, T, sel.unit, models::limits::kMaxForce, sel.unit, e.field(), e.message()));
-    }
-    const double sign = sel.entries[0].sign;
-    r.load_value = sel.kind == "joint_torques" || sel.together ? T : sign * T;
-    r.torque_Nm = sel.unit == "N·m" && sel.kind.rfind("joint", 0) == 0 ? T : NAN;  // NaN for point forces
-    set_load(m, sel, T);
-    cy = steady_cycle(m, scene.initial.q, direct ? direct->qdot_section : qd, opt.tolerance, evals, true);
-    if (!cy.ok)
-      throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
-                                               "({:.6g} {})", r.load_value, sel.unit));
-    r.steady_q = scene.initial.q;
-    r.steady_qdot = cy.speed;
-    r.mean_cadence_hz_reduced = 1.0 / cy.period;
-    // The result must meet its own target (issue #9): the root finder converges to 1e-10
-    // relative, so the reduced cadence is off by far less than kReducedCadenceTolerance unless
-    // the bracket held a discontinuity (a stall) instead of a root.
-    check_cadence("calibration missed its target: the reduced model's steady cadence", r.mean_cadence_hz_reduced,
-                  opt.cadence_hz, kReducedCadenceTolerance, sel, r.load_value);
+    check_scene_allows(scene, sel, T, r.resistance_coefficient, opt);
+    cy = settle_at_load(m, sel, scene, opt, T, direct ? direct->qdot_section : 2 * M_PI * opt.cadence_hz, evals, r);
     r.load_searches = pass + 1;
-    if (!power_mode) break;
-    const double P_diss = cy.detail.dissipated_power_W;
-    const double f = std::log(P_diss / opt.power_w);  // 0 at the target
-    if (!std::isfinite(f))
-      throw models::NumericalError(fmt::format("calibration: the resistance dissipates {:.6g} W on the steady cycle "
-                                               "at {:g} Hz; no coefficient reaches {:g} W",
-                                               P_diss, opt.cadence_hz, opt.power_w));
-    if (std::abs(f) <= kPowerTolerance) break;
-    if (pass + 1 >= kMaxPowerPasses)
-      throw models::NumericalError(fmt::format(
-          "calibration did not converge: after {} load searches the steady cycle at {:g} Hz dissipates {:.8g} W "
-          "(resistance coefficient {:.6g}), target {:g} W (allowed {:g} %)",
-          pass + 1, opt.cadence_hz, P_diss, r.resistance_coefficient, opt.power_w, 100 * kPowerTolerance));
-    const double ln_c = std::log(r.resistance_coefficient);
-    double slope = std::isfinite(ln_c_prev) && ln_c != ln_c_prev ? (f - f_prev) / (ln_c - ln_c_prev) : 1.0;
-    if (!(slope > 0.1 && slope < 10)) slope = 1.0;  // a wild secant: the fixed-point step
-    ln_c_prev = ln_c, f_prev = f;
-    r.resistance_coefficient = std::exp(ln_c - f / slope);
+    if (!power_mode || power_met(cy, opt, pass, secant, r)) break;
   }
   r.mean_dissipated_power_w = cy.detail.dissipated_power_W;
-  // On a steady cycle the drive supplies what the resistances dissipate. The reduced model's
-  // own residual — an interpolated m2 that is not exactly ½ dm1/dq acts as a power ∝ q̇³
-  // (docs/theory.md §5; ~1.5e-4 W on the bicycle's 10° table at 1 Hz, 1e-6 of 125 W) — is
-  // small unless the operating point's energy flow is small against it (a very low power, a
-  // very high cadence): then the calibrated value is the interpolation error's, not the
-  // mechanism's, and that is no result.
-  {
-    const double drive = cy.detail.drive_power_W, diss = cy.detail.dissipated_power_W;
-    if (!(std::abs(drive - diss) <= kEnergyBalanceTolerance * std::max(std::abs(drive), std::abs(diss))))
-      throw models::NumericalError(fmt::format(
-          "calibration: on the reduced model's steady cycle at {:g} Hz the drive supplies {:.6g} W but the resistances "
-          "dissipate {:.6g} W ({:.2g} % apart, allowed {:g} %): the table's interpolation error is not small against "
-          "this operating point's energy flow; extract on a finer grid (--grid-deg)",
-          opt.cadence_hz, drive, diss, 100 * std::abs(drive - diss) / std::max(std::abs(drive), std::abs(diss)),
-          100 * kEnergyBalanceTolerance));
-  }
+  check_cycle_energy_balance(cy, opt);
   r.evaluations = evals;
 
   // Fluctuation and peak force over the steady cycle (sampled and refined by steady_cycle).
@@ -651,28 +742,9 @@ CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const mo
     r.peak_force_N = cy.detail.peak_force_N[0];
   }
   r.peak_forces_N = cy.detail.peak_force_N;
-  if (sel.entries[0].motor) {
-    // A motor's power depends on the speed: trapezoid rule over the periodic cycle samples
-    // (spectrally accurate for a smooth periodic integrand).
-    const auto& mo = m.motors[sel.entries[0].index];
-    reduced::ReducedOptions ro;
-    ro.duration_s = cy.period;
-    ro.output_interval_s = cy.period / 1440;
-    ro.tolerance = opt.tolerance;
-    const auto cyc = reduced::simulate_reduced(m, r.steady_q, r.steady_qdot, ro);
-    double E = 0.0;
-    for (size_t i = 0; i + 1 < cyc.t.size(); ++i) {
-      auto p = [&](size_t k) {
-        const double u = m.table.eval(mo.c_r, cyc.q[k]) * cyc.qdot[k];
-        return models::motor_torque(mo.stall, mo.no_load_speed, u) * u;
-      };
-      E += 0.5 * (p(i) + p(i + 1)) * (cyc.t[i + 1] - cyc.t[i]);
-    }
-    r.mean_power_w = E / cy.period;
-  } else {
-    r.mean_power_w = T * W_unit / cy.period;  // a position-dependent load: its work per revolution is exact
-  }
-
+  r.mean_power_w = sel.entries[0].motor
+                       ? calc_motor_mean_power(m, m.motors[sel.entries[0].index], r, cy, opt.tolerance)
+                       : T * work.unit / cy.period;  // a position-dependent load: its work per revolution is exact
   r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;
   return r;
 }
