@@ -4,6 +4,7 @@
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
 #include "engine/independent_range.hpp"
+#include "engine/inspect.hpp"  // kFarFromGuess_deg
 #include "engine/kinetostatic.hpp"
 
 #include <cctype>
@@ -530,6 +531,96 @@ bool FullModel::is_folded(const std::string& body) const {
   return b >= 0 && impl_->body_fold[b].has_value();
 }
 
+namespace {
+
+// Simbody's assembler from the state's coordinates, the constraint actuators locked at x = 0 and
+// the independent coordinate locked when `lock_independent`; the loops' worst gap after it [m].
+double assemble(const FullModel::Impl& m, State& s, bool lock_independent) {
+  Assembler assembler(m.system);
+  assembler.setAccuracy(1e-12);
+  if (lock_independent) assembler.lockMobilizer(m.joint_mobod[m.independent].getMobilizedBodyIndex());
+  for (const auto& sl : m.actuator_slider) assembler.lockMobilizer(sl.getMobilizedBodyIndex());
+  try {
+    assembler.initialize(s);
+    assembler.assemble();
+  } catch (const std::exception&) {
+    // Fall through: the gap check reports which loop fails and by how much.
+  }
+  assembler.updateFromInternalState(s);
+  m.system.realize(s, Stage::Position);
+  return m.worst_loop_gap(s).first;
+}
+
+// Direct assembly at the initial q failed from the scene's guesses: they are too far from the
+// configuration there for the assembler's Newton steps (a parallelogram chain started 0.01° from
+// flat with its 90°/−90° guesses left a gap of 2 m). Assemble where the guesses fit — every
+// joint at its guess, the independent coordinate too, and free — then walk the independent to
+// the initial q in moves of at most 2°, each assembled from the last. The state is left at the
+// last move that closed; true when it reached the initial q.
+bool assemble_by_continuation(const FullModel::Impl& m, State& s) {
+  const State start = s;
+  m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.joints[m.independent].guess);
+  m.set_law(s, 0, poly_law(m.scene.joints[m.independent].guess, 0.0, 0.0));
+  if (!(assemble(m, s, false) <= 1e-8)) {
+    s = start;
+    return false;
+  }
+  const double q_to = m.scene.initial.q;
+  const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  const double q_from = m.joint_mobod[m.independent].getOneQ(s, MobilizerQIndex(0));
+  const double max_move = rev ? 2 * M_PI / 180 : 0.02 * std::max(1e-3, std::abs(q_to - q_from));
+  // A move that does not close is halved (near a flat configuration Newton's basin shrinks),
+  // down to 1e-6 of the largest move; at most 4000 assemblies.
+  // The walk must not pass a configuration where the loop Jacobian loses rank: branches cross
+  // there, and which one it leaves on is an accident (a chain walked from 90° to 270° through its
+  // flat configuration came out folded). A minimum of the conditioning below kSingularWindow with
+  // a rise after it is such a passage: the walk gives up. An approach to the target is not.
+  constexpr double kSingularWindow = 1e-2;
+  double q = q_from, move = max_move, lowest = calc_loop_conditioning(m, s);
+  for (int it = 0; it < 4000 && q != q_to && move >= 1e-6 * max_move; ++it) {
+    const double q_next = std::abs(q_to - q) <= move ? q_to : q + std::copysign(move, q_to - q);
+    State next = s;
+    m.joint_mobod[m.independent].setOneQ(next, MobilizerQIndex(0), q_next);
+    m.set_law(next, 0, poly_law(q_next, 0.0, 0.0));  // the prescribed position the assembly keeps
+    if (assemble(m, next, true) <= 1e-8) {
+      const double k = calc_loop_conditioning(m, next);
+      if (lowest < kSingularWindow && k > 2 * lowest) return false;
+      lowest = std::min(lowest, k);
+      s = next, q = q_next;
+      move = std::min(max_move, 2 * move);
+    } else {
+      move *= 0.5;
+    }
+  }
+  return q == q_to;
+}
+
+bool far_from_guesses(const FullModel::Impl& m, const State& s) {
+  for (size_t j = 0; j < m.scene.joints.size(); ++j) {
+    if (m.joint_fold[j] || static_cast<int>(j) == m.independent) continue;
+    if (m.scene.joints[j].type != models::JointType::Revolute) continue;
+    const double q = m.joint_mobod[j].getOneQ(s, MobilizerQIndex(0)), g = m.scene.joints[j].guess;
+    if (std::abs(std::remainder(q - g, 2 * M_PI)) > kFarFromGuess_deg * M_PI / 180) return true;
+  }
+  return false;
+}
+
+// Each revolute joint's angle within half a turn of its guess: the assembler may land whole
+// turns away (8224 turns for a chain started 0.5° from flat), which is the same configuration
+// but not the coordinate a user reads or a branch check compares.
+void wrap_to_guesses(const FullModel::Impl& m, State& s) {
+  for (size_t j = 0; j < m.scene.joints.size(); ++j) {
+    if (m.joint_fold[j] || static_cast<int>(j) == m.independent) continue;
+    if (m.scene.joints[j].type != models::JointType::Revolute) continue;
+    const double q = m.joint_mobod[j].getOneQ(s, MobilizerQIndex(0)), g = m.scene.joints[j].guess;
+    const double wrapped = g + std::remainder(q - g, 2 * M_PI);
+    if (wrapped != q) m.joint_mobod[j].setOneQ(s, MobilizerQIndex(0), wrapped);
+  }
+  m.system.realize(s, Stage::Position);
+}
+
+}  // namespace
+
 FullWorkspace::FullWorkspace(const FullModel& model)
     : impl_(std::make_unique<Impl>(model.impl())) {
   const auto& m = model.impl();
@@ -540,22 +631,28 @@ FullWorkspace::FullWorkspace(const FullModel& model)
     if (!m.joint_fold[j]) m.joint_mobod[j].setOneQ(s, MobilizerQIndex(0), m.scene.joints[j].guess);
   m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.initial.q);
   m.set_law(s, 0, poly_law(m.scene.initial.q, 0.0, 0.0));
-  Assembler assembler(m.system);
-  assembler.setAccuracy(1e-12);
-  assembler.lockMobilizer(m.joint_mobod[m.independent].getMobilizedBodyIndex());
-  for (const auto& sl : m.actuator_slider) assembler.lockMobilizer(sl.getMobilizedBodyIndex());
-  try {
-    assembler.initialize(s);
-    assembler.assemble();
-  } catch (const std::exception&) {
-    // Fall through: the gap check below reports which loop fails and by how much.
+  const State guesses = s;
+  // Directly at the initial q; where that fails, or lands a revolute joint more than
+  // kFarFromGuess_deg from its guess (on another branch: a parallelogram chain started 0.1° from
+  // flat with its 90° guesses folded into the antiparallelogram), by continuation from the
+  // configuration the guesses describe, when that reaches the initial q.
+  const bool direct = assemble(m, s, true) <= 1e-8;
+  if (!direct || far_from_guesses(m, s)) {
+    State walked = guesses;
+    if (assemble_by_continuation(m, walked)) {
+      s = walked;
+    } else if (!direct) {
+      s = guesses;  // report the direct attempt's gap
+      assemble(m, s, true);
+    }
   }
-  assembler.updateFromInternalState(s);
-  m.system.realize(s, Stage::Position);
+  wrap_to_guesses(m, s);
   const auto [gap, loop] = m.worst_loop_gap(s);
   if (gap > 1e-8) {
     throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {:.6g}: the best assembly attempt "
-                                  "leaves a gap of {:.6g} m (check lengths and ground points)",
+                                  "leaves a gap of {:.6g} m (check lengths and ground points, and that the joints' "
+                                  "guesses describe the configuration at this q: assembly walks from them to q, but "
+                                  "not across a singular configuration)",
                                   m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
   }
   check_one_dof(m, s);

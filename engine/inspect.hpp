@@ -16,7 +16,7 @@ namespace rdyn::engine {
 struct AssembledJoint {
   std::string name;
   bool revolute = true;
-  double q = 0.0;      // assembled coordinate [rad or m] (revolute: as Simbody continued it, not wrapped)
+  double q = 0.0;      // assembled coordinate [rad or m] (revolute: within half a turn of the guess)
   double guess = 0.0;  // the scene's guess [rad or m]
 };
 

@@ -3,6 +3,7 @@
 #include "engine/full_model.hpp"
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <string>
 #include <utility>
 
+#include "engine/inspect.hpp"
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
 #include "test_scenes.hpp"
@@ -281,6 +283,32 @@ TEST(FullModelBranch, GuessesOfTheOtherBranchFailNamingTheLoop) {
   EXPECT_TRUE(has(m, "joint 'rocker' is at -109.9")) << m;
   EXPECT_TRUE(has(m, "loops.C.branch")) << m;
   EXPECT_TRUE(has(m, "fourbar.yaml")) << m;
+}
+
+// A parallelogram chain started near its flat configuration with the shipped guesses (90°, −90°):
+// Newton's steps from them left a 2 m gap at 0.01°, folded the loop into the antiparallelogram at
+// 0.1°, and put crank1 8224 turns away at 0.5°. Assembly now walks from the configuration the
+// guesses describe: the parallelogram (crank1 turned as crank0, the coupler level), every angle
+// within half a turn of its guess. Across the flat configuration from the guesses (−0.1°) the
+// walk does not go (the branch would be an accident): refused, naming the guesses.
+TEST(FullModelAssembly, FarGuessesNearAFlatConfigurationWalkToTheStart) {
+  for (double deg : {0.5, 0.1, 0.01, 179.9, 45.0, 270.0}) {
+    const auto scene =
+        models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", fmt::format("{}", deg)}});
+    const Inspection a = calc_assembly(FullModel(scene));
+    auto angle = [&](const std::string& body) -> double {
+      for (const auto& b : a.bodies)
+        if (b.name == body) return b.angle_rad;
+      ADD_FAILURE() << body;
+      return std::nan("");
+    };
+    EXPECT_NEAR(std::remainder(angle("crank1") - angle("crank0"), 2 * kPi), 0, 1e-9) << deg << "°";
+    EXPECT_NEAR(std::remainder(angle("coupler0"), 2 * kPi), 0, 1e-9) << deg << "°";
+    for (const auto& j : a.joints) EXPECT_LE(std::abs(j.q - j.guess), kPi + 1e-12) << j.name << " at " << deg << "°";
+  }
+  const auto across = models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", "-0.1"}});
+  const std::string m = refusal(across);
+  EXPECT_TRUE(has(m, "guesses describe the configuration at this q")) << m;
 }
 
 // A point force whose points coincide where the mechanism assembles has no direction: refused
