@@ -552,11 +552,12 @@ void check_validation(const Checker& c, const Scene& s) {
     const std::string f = fmt::format("validation.thresholds[{}]", i);
     bool known = th.quantity == "qdot" || th.quantity == "mean_qdot";
     for (const auto& cf : s.outputs.constraint_forces) known |= cf.name == th.quantity;
+    for (const auto& col : joint_output_names(s)) known |= col == th.quantity;
     if (!known)
       c.fail(f + ".quantity",
-             fmt::format(
-                 "'{}' is neither qdot, mean_qdot nor the name of a requested constraint force",
-                 printable(th.quantity)));
+             fmt::format("'{}' is neither qdot, mean_qdot, the name of a requested constraint force nor a requested "
+                         "joint output column (q_<joint>, qdot_<joint>, qddot_<joint>, R_<joint>_x …, shaking_x …)",
+                         printable(th.quantity)));
     if (!th.interpolation.empty() && !is_valid_name(th.interpolation))
       c.fail(f + ".interpolation",
              fmt::format("'{}' is not a valid interpolation name", printable(th.interpolation)));
@@ -620,6 +621,30 @@ std::optional<double> fixed_speed_ratio(const Scene& s, const std::string& body)
     }
   }
   return std::nullopt;
+}
+
+std::vector<std::string> joint_output_names(const Scene& s) {
+  std::vector<std::string> n;
+  for (const auto& j : s.outputs.joints) {
+    n.push_back("q_" + j);
+    n.push_back("qdot_" + j);
+    n.push_back("qddot_" + j);
+  }
+  for (const auto& r : s.outputs.reactions) {
+    n.push_back("R_" + r + "_x");
+    n.push_back("R_" + r + "_y");
+    const auto* j = s.find_joint(r);
+    if (j && j->type == JointType::Prismatic) {
+      n.push_back("R_" + r + "_normal");
+      n.push_back("R_" + r + "_M");
+    }
+  }
+  if (s.outputs.shaking) {
+    n.push_back("shaking_x");
+    n.push_back("shaking_y");
+    n.push_back("shaking_M");
+  }
+  return n;
 }
 
 }  // namespace rdyn::models

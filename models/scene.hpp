@@ -243,6 +243,9 @@ struct Outputs {
   // the loop's force of body_a on body_b, ground frame [N]); prismatic joints add R_<n>_normal
   // [N] and R_<n>_M [N·m] ("all": every joint, then every loop).
   std::vector<std::string> reactions;
+  // `reactions: all`: the reduced model's runs give every reaction it can and name the others
+  // (reduced::split_reduced_reactions), where a listed reaction it cannot give is refused.
+  bool reactions_all = false;
   bool shaking = false;  // shaking_x, shaking_y [N], shaking_M [N·m]: the mechanism's load on the ground
 };
 
@@ -402,5 +405,12 @@ int dissipation_exponent(ResistanceLaw law);
 // constant of the topology: the body is the independent joint's child (ratio 1) or the
 // child of a joint geared to it (ratio r). Empty otherwise.
 std::optional<double> fixed_speed_ratio(const Scene& scene, const std::string& body);
+
+// The joint-output columns both models write (timeseries.csv), in this order: per outputs.joints
+// q_<j>, qdot_<j>, qddot_<j> [rad or m, /s, /s²]; per outputs.reactions R_<n>_x, R_<n>_y [N]
+// (ground frame) and, for a prismatic joint, R_<n>_normal [N] (along the axis turned +90°) and
+// R_<n>_M [N·m] (about the child point); then shaking_x, shaking_y [N], shaking_M [N·m] (about
+// the ground origin) when outputs.shaking. Validation thresholds may name any of them.
+std::vector<std::string> joint_output_names(const Scene& scene);
 
 }  // namespace rdyn::models

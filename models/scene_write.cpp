@@ -328,7 +328,7 @@ void write_outputs(Writer& w, const Scene& s) {
   }
   w.line("  bodies: " + names(o.bodies));
   w.line("  joints: " + names(o.joints));
-  w.line("  reactions: " + names(o.reactions));
+  w.line("  reactions: " + (o.reactions_all ? std::string("all") : names(o.reactions)));
   w.line(std::string("  shaking: ") + (o.shaking ? "true" : "false"));
 }
 

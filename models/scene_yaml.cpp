@@ -1067,6 +1067,8 @@ void read_outputs(const Fields& top, const Context& ctx, Scene& s) {
   if (f.has("joints")) s.outputs.joints = read_names_or_all(f, s, "joints", false);
   if (f.has("reactions")) {
     s.outputs.reactions = read_names_or_all(f, s, "reactions", true);
+    const YAML::Node r = f.raw("reactions");
+    s.outputs.reactions_all = r.IsScalar() && r.Scalar() == "all";
     note_key(s, f.ctx(), "outputs.reactions", f.raw("reactions"));
   }
   s.outputs.shaking = f.flag_or("shaking", false);

@@ -7,30 +7,6 @@
 
 namespace rdyn::reduced {
 
-std::vector<std::string> joint_output_names(const models::Scene& s) {
-  std::vector<std::string> n;
-  for (const auto& j : s.outputs.joints) {
-    n.push_back("q_" + j);
-    n.push_back("qdot_" + j);
-    n.push_back("qddot_" + j);
-  }
-  for (const auto& r : s.outputs.reactions) {
-    n.push_back("R_" + r + "_x");
-    n.push_back("R_" + r + "_y");
-    const auto* j = s.find_joint(r);
-    if (j && j->type == models::JointType::Prismatic) {
-      n.push_back("R_" + r + "_normal");
-      n.push_back("R_" + r + "_M");
-    }
-  }
-  if (s.outputs.shaking) {
-    n.push_back("shaking_x");
-    n.push_back("shaking_y");
-    n.push_back("shaking_M");
-  }
-  return n;
-}
-
 namespace {
 
 constexpr double kTwoPi = 2 * 3.14159265358979323846;
@@ -150,6 +126,22 @@ models::Scene with_reaction_requests(const models::Scene& scene) {
         if (c.name == name)
           throw TableError("constraint force name '" + name + "' is reserved for the reduced model's reaction lines");
       out.outputs.constraint_forces.push_back({name, j, axis == 'x' ? models::Vec2{1, 0} : models::Vec2{0, 1}});
+    }
+  }
+  return out;
+}
+
+ReducedReactions split_reduced_reactions(const models::Scene& scene) {
+  ReducedReactions out{scene, {}};
+  out.scene.outputs.reactions.clear();
+  for (const auto& name : scene.outputs.reactions) {
+    models::Scene one = scene;
+    one.outputs.reactions = {name};
+    try {
+      with_reaction_requests(one);
+      out.scene.outputs.reactions.push_back(name);
+    } catch (const TableError& e) {
+      out.not_given.emplace_back(name, e.what());
     }
   }
   return out;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "models/scene.hpp"
@@ -14,11 +15,8 @@
 
 namespace rdyn::reduced {
 
-// Column names, in this order: per outputs.joints q_<j>, qdot_<j>, qddot_<j> [rad or m, /s, /s²];
-// per outputs.reactions R_<n>_x, R_<n>_y [N] (ground frame) and, for a prismatic joint,
-// R_<n>_normal [N] (along the axis turned +90°) and R_<n>_M [N·m] (about the child point); then
-// shaking_x, shaking_y [N], shaking_M [N·m] (about the ground origin) when outputs.shaking.
-std::vector<std::string> joint_output_names(const models::Scene& scene);
+// The column names (models/scene.hpp).
+using models::joint_output_names;
 
 // Whether the scene asks for any of these columns.
 inline bool wants_joint_outputs(const models::Scene& s) {
@@ -45,6 +43,15 @@ inline std::string internal_request_name(const std::string& joint, char axis) {
 // for reactions the reduced model cannot give: a prismatic joint's, or a loop neither of whose
 // bodies hangs from revolute joints only, touches no spring and no other loop.
 models::Scene with_reaction_requests(const models::Scene& scene);
+
+// The reactions the reduced model can give and the others with the reason (with_reaction_requests'
+// message for each alone). `scene` keeps those it can; validate compares them and names the
+// others, and a run of a scene that asked for `reactions: all` leaves the others out.
+struct ReducedReactions {
+  models::Scene scene;
+  std::vector<std::pair<std::string, std::string>> not_given;  // reaction name, why
+};
+ReducedReactions split_reduced_reactions(const models::Scene& scene);
 
 // Fills ts.columns with joint_output_names(scene) for a reduced run of the model built from
 // with_reaction_requests(scene), from the table (p_, k_, r_ columns, dr_/dq of the cubic) and

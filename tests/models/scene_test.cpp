@@ -197,6 +197,23 @@ TEST(CheckScene, ValidationSettingsHaveRanges) {
             "validation.calibrate.power_W");
 }
 
+// A threshold may judge a requested joint output (issue #23: one on R_crank_x was refused), not
+// one the scene does not ask for.
+TEST(CheckScene, ThresholdsMayNameRequestedJointOutputs) {
+  auto with = [](const std::string& quantity, bool request) {
+    return refused_field([&](Scene& s) {
+      if (request) s.outputs.reactions = {"pinion"}, s.outputs.joints = {"wheel"}, s.outputs.shaking = true;
+      s.validation.thresholds[0].quantity = quantity;
+    });
+  };
+  for (const char* q : {"R_pinion_x", "R_pinion_y", "q_wheel", "qddot_wheel", "shaking_M"}) {
+    EXPECT_EQ(with(q, true), "") << q;
+    EXPECT_EQ(with(q, false), "validation.thresholds[0].quantity") << q;
+  }
+  EXPECT_EQ(with("R_wheel_x", true), "validation.thresholds[0].quantity");  // not requested
+  EXPECT_EQ(joint_output_names(geared_pair()).size(), 0u);
+}
+
 TEST(FixedSpeedRatio, GearsAndUnknownJointsBeforeTheChecks) {
   Scene s = geared_pair();
   EXPECT_EQ(fixed_speed_ratio(s, "wheel"), 1.0);

@@ -37,6 +37,14 @@ namespace rdyn::validate {
 
 namespace {
 
+// The reactions a reduced run gives: with `reactions: all`, those the reduced model can (the
+// others named); a listed one it cannot give is refused (with_reaction_requests).
+reduced::ReducedReactions reduced_reactions(const models::Scene& scene) {
+  if (scene.outputs.reactions_all) return reduced::split_reduced_reactions(scene);
+  return {scene, {}};
+}
+
+
 std::vector<models::Override> overrides_of(const std::vector<std::string>& sets) {
   std::vector<models::Override> overrides;
   for (const auto& s : sets) overrides.push_back(models::parse_override(s));
@@ -130,7 +138,19 @@ int run_simulate(const SimulateArgs& a) {
                 {"events", ts.stats.events}});
   } else {
     // Joint outputs: the table and the model carry one constraint line per reaction component.
-    const models::Scene rscene = reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene;
+    // `reactions: all` gives those the reduced model can and names the others.
+    const auto split = reduced_reactions(scene);
+    const models::Scene& oscene = split.scene;
+    if (!split.not_given.empty()) {
+      auto ng = nlohmann::json::array();
+      for (const auto& [name, why] : split.not_given) {
+        std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
+                     name.c_str(), why.c_str());
+        ng.push_back({{"reaction", name}, {"why", why}});
+      }
+      run["reactions_not_given"] = ng;
+    }
+    const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
     reduced::Samples samples;
     double extraction_ms = 0.0;
     if (!a.table.empty()) {
@@ -158,7 +178,7 @@ int run_simulate(const SimulateArgs& a) {
         ts, 0.01,
         a.reduced_integrator == "rk4-fixed" ? fmt::format("rk4-fixed at {:g} s steps", opt.fixed_step_s)
                                             : fmt::format("{} at tolerance {:g}", a.reduced_integrator, a.reduced_tolerance));
-    if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(scene, model, ts);
+    if (reduced::wants_joint_outputs(oscene)) reduced::add_joint_outputs(oscene, model, ts);
     // The interpolant the table was built with (a range table's not-a-knot spline stands in for
     // fourier), not the option's name.
     run.update({{"interpolation", model.table.fit},
@@ -193,7 +213,8 @@ int run_extract(const ExtractArgs& a) {
   const models::Scene scene = load(a.scene, a.sets);
   const auto method = reduced::parse_method(a.method);
   OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
-  const auto e = extract_from_full(reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(scene) : scene,
+  const models::Scene oscene = reduced_reactions(scene).scene;
+  const auto e = extract_from_full(reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene,
                                    a.grid_deg, method);
   out.write(reduced::format_samples_csv(e.samples));
   out.commit();

@@ -32,7 +32,8 @@ struct SignalError {
 };
 
 struct Comparison {
-  std::vector<SignalError> signals;  // qdot, the constraint forces, then mean_qdot (mean speed)
+  // qdot, the constraint forces, the joint outputs both runs carry, then mean_qdot (mean speed)
+  std::vector<SignalError> signals;
   long samples = 0;   // compared
   long excluded = 0;  // skipped because a load gate differed (between two switch instants)
   const SignalError* find(const std::string& name) const;

@@ -10,6 +10,7 @@
 
 #include "engine/forward_dynamics.hpp"
 #include "engine/independent_range.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/analysis/build_reduced.hpp"
@@ -22,6 +23,27 @@
 namespace rdyn::validate {
 
 namespace {
+
+// The scene whose joint outputs the reduced runs give: the requested reactions it can give (the
+// others are compared on the full model alone; ValidationResult::reactions_not_given).
+models::Scene reduced_outputs_scene(const models::Scene& scene) {
+  return reduced::split_reduced_reactions(scene).scene;
+}
+
+// The scene a reduced model is extracted from: with the internal constraint lines its joint
+// outputs need (reduced/joint_outputs.hpp), when the scene asks for reactions or shaking.
+models::Scene extraction_scene(const models::Scene& scene) {
+  return reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(reduced_outputs_scene(scene)) : scene;
+}
+
+// A reduced run of that model as the user gets it: the joint outputs the scene asks for, from
+// the table, and the internal lines removed again (what `rdyn simulate --model reduced` writes).
+models::TimeSeries with_joint_outputs(const models::Scene& scene, const reduced::ReducedModel& model,
+                                      models::TimeSeries ts) {
+  if (reduced::wants_joint_outputs(scene)) reduced::add_joint_outputs(reduced_outputs_scene(scene), model, ts);
+  return ts;
+}
+
 
 using Clock = std::chrono::steady_clock;
 
@@ -147,6 +169,14 @@ ValidationResult describe(const models::Scene& scene) {
   v.headline_quantity = scene.outputs.constraint_forces.empty() ? "qdot" : scene.outputs.constraint_forces[0].name;
   v.quantities = {"qdot"};
   for (const auto& c : scene.outputs.constraint_forces) v.quantities.push_back(c.name);
+  // The joint outputs both models give are judged like the constraint forces; a reaction only the
+  // full model gives is plotted from it and named (reduced::split_reduced_reactions).
+  if (reduced::wants_joint_outputs(scene)) {
+    auto split = reduced::split_reduced_reactions(scene);
+    v.joint_output_quantities = models::joint_output_names(split.scene);
+    for (const auto& n : v.joint_output_quantities) v.quantities.push_back(n);
+    v.reactions_not_given = std::move(split.not_given);
+  }
   v.quantities.push_back("mean_qdot");
   v.reference_tolerance = scene.validation.reference_tolerance;
   return v;
@@ -206,7 +236,7 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
     Extraction e;
     std::vector<double> ms, build_ms, assembly_ms, kinetostatics_ms;
     for (int k = 0; k < (grid == 10 ? plan.extraction_repeats_10deg : 1); ++k) {
-      e = extract_from_full(scene, grid, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
+      e = extract_from_full(extraction_scene(scene), grid, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
       ms.push_back(e.extraction_ms);
       build_ms.push_back(e.stages.system_build_ms);
       assembly_ms.push_back(e.stages.assembly_ms);
@@ -219,8 +249,8 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
       v.samples10 = e.samples;
     }
     for (const auto& var : plan.variants) {
-      const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(var.interpolation),
-                                                     var.energy_consistent);
+      const auto model = reduced::make_reduced_model(e.samples, extraction_scene(scene),
+                                                     reduced::parse_interpolation(var.interpolation), var.energy_consistent);
       auto add_run = [&](const std::string& integrator, double tol, double h) {
         progress.count(scene.name + ": reduced ladder", done++, total);
         RunRecord r;
@@ -248,11 +278,12 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
               plan.reduced_repeats);
           r.timed_output_interval_s = ro_timed.output_interval_s;
           r.timed_steps = timed.stats.steps_taken;
-          rows = plan.time_reduced_without_outputs
-                     ? reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro)
-                     : timed;
+          rows = with_joint_outputs(scene, model,
+                                    plan.time_reduced_without_outputs
+                                        ? reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro)
+                                        : timed);
           ro.step_outputs = true;
-          ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro);
+          ts = with_joint_outputs(scene, model, reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, ro));
         } catch (const std::runtime_error& e) {  // TableError (validity domain) or NumericalError
           record_stopped(r, e.what(), v);
           return;
@@ -279,10 +310,10 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
 // The interpolant of the 10° table at 1° (figure 1).
 void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
   if (v.samples10.q.empty()) return;
-  const auto m = reduced::make_reduced_model(v.samples10, scene, reduced::Interpolation::Fourier);
+  const auto m = reduced::make_reduced_model(v.samples10, extraction_scene(scene), reduced::Interpolation::Fourier);
   std::vector<int> cols{m.c_m1, m.c_m2};
   v.dense_names = {"q_deg", "m1", "m2"};
-  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+  for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k) {  // not the internal lines
     cols.push_back(m.c_me1[k]);
     cols.push_back(m.c_me2[k]);
     v.dense_names.push_back("me1_" + m.force_names[k]);
@@ -316,8 +347,9 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
     auto tr = judge_threshold(th, v.runs, v.tightest_tolerance);
     if (!tr) {
       const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
-      const auto e = extract_from_full(scene, th.grid_deg, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
-      const auto m = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(interp));
+      const auto e =
+          extract_from_full(extraction_scene(scene), th.grid_deg, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
+      const auto m = reduced::make_reduced_model(e.samples, extraction_scene(scene), reduced::parse_interpolation(interp));
       RunRecord r;
       r.model = "reduced";
       r.grid_deg = th.grid_deg;
@@ -327,7 +359,7 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
       r.tolerance = v.tightest_tolerance;
       auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);
       ro.step_outputs = true;  // compared rows as accurate as the steps, as in the ladder
-      const auto ts = reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro);
+      const auto ts = with_joint_outputs(scene, m, reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro));
       r.errors = compare_series(v.reference, ts, v.window.t_start);
       tr = judge_threshold_on(th, r);
     }

@@ -60,7 +60,10 @@ struct ValidationResult {
   ExtractionStages extraction_stages;  // the 10° table, median of each stage over the repeats
   double tightest_tolerance = 0.0;  // of the reduced rk8pd ladder
   std::string headline_quantity;  // the error that matches: first constraint force, else qdot
-  std::vector<std::string> quantities;  // qdot, the constraint forces, mean_qdot
+  std::vector<std::string> quantities;  // qdot, the constraint forces, the joint outputs, mean_qdot
+  // Requested reactions the reduced model cannot give: name, why (compared on the full model alone).
+  std::vector<std::pair<std::string, std::string>> reactions_not_given;
+  std::vector<std::string> joint_output_quantities;  // the joint outputs among `quantities`
   double matched_target = 1e-3;
   std::optional<double> speedup_at_matched_error;
   int matched_full = -1, matched_reduced = -1;  // indices into runs

@@ -68,6 +68,27 @@ nlohmann::json figures_json(const ValidationResult& v) {
     f["timeseries"] = table_json(names, cols);
     f["timeseries"]["force_name"] = has_f ? a.force_names[0] : "";
     f["timeseries"]["reduced_run"] = v.showcase_run >= 0 ? v.runs[v.showcase_run].label() : "";
+    // The requested reactions and shaking load over the same periods: <column>_full, and
+    // <column>_reduced where the reduced model gives it (the others are the full model's alone).
+    std::vector<std::string> jn{"t"};
+    std::vector<const std::vector<double>*> src;
+    for (size_t c = 0; c < a.column_names.size(); ++c) {
+      const std::string& n = a.column_names[c];
+      if (n.rfind("R_", 0) != 0 && n.rfind("shaking_", 0) != 0) continue;
+      jn.push_back(n + "_full");
+      src.push_back(&a.columns[c]);
+      for (size_t d = 0; d < b.column_names.size(); ++d)
+        if (b.column_names[d] == n) jn.push_back(n + "_reduced"), src.push_back(&b.columns[d]);
+    }
+    if (!src.empty()) {
+      std::vector<std::vector<double>> jc(jn.size());
+      for (size_t i = 0; i < a.t.size(); ++i) {
+        if (a.t[i] < t0) continue;
+        jc[0].push_back(a.t[i]);
+        for (size_t k = 0; k < src.size(); ++k) jc[k + 1].push_back((*src[k])[i]);
+      }
+      f["joint_outputs"] = table_json(jn, jc);
+    }
   }
   return f;
 }
@@ -180,6 +201,10 @@ nlohmann::json summary_json(const ValidationResult& v) {
   j["extractions"] = ex;
   j["headline_quantity"] = v.headline_quantity;
   j["quantities"] = v.quantities;
+  nlohmann::json not_given = nlohmann::json::array();
+  for (const auto& [name, why] : v.reactions_not_given) not_given.push_back({{"reaction", name}, {"why", why}});
+  j["reactions_not_given"] = not_given;
+  j["joint_output_quantities"] = v.joint_output_quantities;
   j["matched_error_target"] = v.matched_target;
   j["speedup_at_matched_error"] =
       v.speedup_at_matched_error ? num(*v.speedup_at_matched_error) : nullptr;

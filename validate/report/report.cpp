@@ -145,6 +145,35 @@ std::string timeseries_gp(const json& ts) {
   return gp + "unset multiplot\n";
 }
 
+// Figure 2b: every requested reaction and the shaking load, full (grey) and reduced (red) where
+// the reduced model gives it, one panel each, two panels a row. Data: joint_outputs.csv.
+std::string joint_outputs_gp(const json& jo) {
+  const auto& names = jo.at("names");
+  std::vector<std::pair<std::string, int>> panels;  // column name, its _full column (1-based)
+  for (size_t c = 1; c < names.size(); ++c) {
+    const std::string n = names[c].get<std::string>();
+    if (n.size() > 5 && n.compare(n.size() - 5, 5, "_full") == 0) panels.emplace_back(n.substr(0, n.size() - 5), c + 1);
+  }
+  const size_t rows = (panels.size() + 1) / 2;
+  std::string gp = "# Requested reactions and shaking load, full and reduced model. Data: joint_outputs.csv.\n";
+  gp += fmt::format(fmt::runtime(kSvgHead), 60 + 220 * rows);
+  gp += fmt::format(
+      "set output 'joint_outputs.svg'\nset datafile separator ','\nset grid\nset xlabel 't [s]'\n"
+      "set multiplot layout {},2\n",
+      rows);
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const auto& [n, col] = panels[p];
+    const bool reduced = col < static_cast<int>(names.size()) && names[col].get<std::string>() == n + "_reduced";
+    const std::string unit = n.size() > 2 && n.compare(n.size() - 2, 2, "_M") == 0 ? "N·m" : "N";
+    gp += fmt::format("set title {} noenhanced\nplot 'joint_outputs.csv' skip 1 using 1:{} with lines lw 3 lc rgb "
+                      "'#aaaaaa' title 'full'",
+                      gnuplot_quoted(n + " [" + unit + "]" + (reduced ? "" : " (full model only)")), col);
+    if (reduced) gp += fmt::format(", '' skip 1 using 1:{} with lines lw 1 lc rgb '#d62728' title 'reduced'", col + 1);
+    gp += "\n";
+  }
+  return gp + "unset multiplot\n";
+}
+
 // Figure 3 data and script: error of the headline quantity against cost, every run.
 void write_pareto(const json& s, const std::string& dir) {
   const std::string Q = str(s, "headline_quantity");
@@ -444,6 +473,14 @@ std::string calibration_section(const json& s) {
 
 }  // namespace
 
+// A joint output (reaction, shaking, joint motion) among the judged quantities: the headline
+// gives their largest error, not a sentence each.
+bool is_joint_output(const json& s, const json& q) {
+  for (const auto& j : s.value("joint_output_quantities", json::array()))
+    if (j == q) return true;
+  return false;
+}
+
 std::string headline(const json& s) {
   std::string out;
   const std::string Q = str(s, "headline_quantity");
@@ -478,9 +515,20 @@ std::string headline(const json& s) {
   if (sc.is_object()) {
     out += fmt::format("At the 10° grid ({}), the errors are {} for the speed", str(sc, "label"),
                        pct(error_of(sc, "qdot")));
-    for (const auto& q : s.at("quantities"))
-      if (q != "qdot" && q != "mean_qdot")
-        out += fmt::format(" and {} for {}", pct(error_of(sc, q)), q.get<std::string>());
+    std::string worst_joint;
+    double worst = -1;
+    for (const auto& q : s.at("quantities")) {
+      if (q == "qdot" || q == "mean_qdot") continue;
+      if (is_joint_output(s, q)) {
+        const double e = error_of(sc, q);
+        if (!(e <= worst)) worst = e, worst_joint = q.get<std::string>();
+        continue;
+      }
+      out += fmt::format(" and {} for {}", pct(error_of(sc, q)), q.get<std::string>());
+    }
+    if (!worst_joint.empty())
+      out += fmt::format(", and at most {} for the {} joint outputs ({})", pct(worst),
+                         s.value("joint_output_quantities", json::array()).size(), worst_joint);
     out += ". ";
   }
   const auto& ref = s.at("reference");
@@ -490,13 +538,19 @@ std::string headline(const json& s) {
       num(d(ref, "tolerance"), "{:.0e}"));
   const auto& ch = ref.at("change_when_tolerance_halved").at("errors");
   bool first = true;
+  double joint_change = -1;
   for (const auto& q : s.at("quantities")) {
     const std::string name = q.get<std::string>();
     if (name == "mean_qdot" || !ch.contains(name)) continue;
+    if (is_joint_output(s, q)) {
+      joint_change = std::max(joint_change, d(ch[name], "max_rel"));
+      continue;
+    }
     out += fmt::format("{} {} by {}", first ? "" : " and", name == "qdot" ? "the speed" : name,
                        pct(d(ch[name], "max_rel")));
     first = false;
   }
+  if (joint_change >= 0) out += fmt::format(" and the joint outputs by at most {}", pct(joint_change));
   out += " of their peaks. ";
   const auto& w = s.at("steady_window");
   // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
@@ -562,6 +616,14 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
                        ? "<h2>2. Full and reduced model toward the end of the run</h2>"
                        : "<h2>2. Full and reduced model over the last periods</h2>") +
        svg_or_note(figures, "timeseries");
+  if (s.contains("figures") && s.at("figures").contains("joint_outputs")) {
+    h += "<h3>Joint reactions and shaking load</h3><p>The requested reactions (the joint's force on its child, "
+         "the loop's force of body_a on body_b, ground frame) and the mechanism's load on the ground, over the "
+         "same periods; their errors are in the verdicts and the runs table.</p>" +
+         svg_or_note(figures, "joint_outputs");
+    for (const auto& r : s.value("reactions_not_given", json::array()))
+      h += "<p class=warn>Reaction " + H(str(r, "reaction")) + ": full model only (" + H(str(r, "why")) + ").</p>";
+  }
   h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto") + baselines_note(s);
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");
   h += "<p>Observed orders (fitted above 10× the reference's own change, " +
@@ -651,6 +713,11 @@ void render_report(const json& s, const std::string& dir) {
     write_text_file(dir + "/compare.csv", table_csv(fig.at("timeseries")));
     write_text_file(dir + "/timeseries.gp", timeseries_gp(fig.at("timeseries")));
     names.push_back("timeseries");
+  }
+  if (fig.contains("joint_outputs")) {
+    write_text_file(dir + "/joint_outputs.csv", table_csv(fig.at("joint_outputs")));
+    write_text_file(dir + "/joint_outputs.gp", joint_outputs_gp(fig.at("joint_outputs")));
+    names.push_back("joint_outputs");
   }
   write_pareto(s, dir);
   write_convergence(s, dir);

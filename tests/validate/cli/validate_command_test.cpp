@@ -2,6 +2,9 @@
 // 30 ms transient.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 
 #include <array>
 #include <cstdio>
@@ -112,6 +115,75 @@ TEST(ValidateCommand, SuiteWritesReportsAndFailsOnAThreshold) {
   const std::string th = slurp(dir / "out" / "d_transient" / "report.html");
   EXPECT_EQ(th.find("per simulated second"), std::string::npos);
   EXPECT_NE(th.find("for the 0.03 s run"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+#include "tests/validate/run_rdyn.hpp"
+
+namespace {
+
+// A user's leg press asks for every reaction and the shaking load (issue #23): validate compares
+// each one the reduced model gives with the full model, judges a threshold on one of them, plots
+// them, and names the reaction only the full model gives (the rail: a spring acts on its
+// carriage). The reduced model agrees with the full one to about 1e-5 of each peak.
+TEST(ValidateCommand, JointReactionsAndShakingAreComparedJudgedAndPlotted) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_joints_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string scene = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml");
+  scene += "    - {quantity: R_crank_x, grid_deg: 10, max_error: 1.0e-3}\n";
+  std::ofstream(dir / "legpress.yaml") << scene;
+  const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir, {600.0});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(slurp(dir / "v/summary.json"));
+  const auto& q = s.at("quantities");
+  for (const char* name : {"R_crank_x", "R_knee_y", "R_wrist_x", "shaking_M"})
+    EXPECT_NE(std::find(q.begin(), q.end(), name), q.end()) << name;
+  EXPECT_EQ(std::find(q.begin(), q.end(), "R_rail_x"), q.end());  // not given by the reduced model
+  ASSERT_EQ(s.at("reactions_not_given").size(), 1u);
+  EXPECT_EQ(s.at("reactions_not_given")[0].at("reaction"), "rail");
+  bool judged = false;
+  for (const auto& t : s.at("thresholds"))
+    if (t.at("quantity") == "R_crank_x") {
+      judged = true;
+      EXPECT_LT(t.at("error").get<double>(), 1e-4);
+    }
+  EXPECT_TRUE(judged);
+  for (const char* name : {"R_crank_x", "R_hip_y", "shaking_x"}) {
+    const double e = s.at("showcase_reduced").at("errors").at(name).at("max_rel").get<double>();
+    EXPECT_LT(e, 1e-4) << name;
+  }
+  const std::string html = slurp(dir / "v/report.html");
+  EXPECT_NE(html.find("Joint reactions and shaking load"), std::string::npos);
+  EXPECT_NE(html.find("Reaction rail: full model only"), std::string::npos);
+  EXPECT_NE(slurp(dir / "v/joint_outputs.csv").find("R_rail_y_full"), std::string::npos);
+  EXPECT_NE(slurp(dir / "v/joint_outputs.svg").find("<svg"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// `reactions: all` on the reduced model gives every reaction it can and names the others (the
+// leg press's rail); a listed reaction it cannot give is still refused (exit 2, with the line).
+TEST(ValidateCommand, ReactionsAllOnTheReducedModelNamesTheOnesItCannotGive) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_reactions_all_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string scene = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml";
+  const auto r = rdyn::test::run_rdyn({"simulate", scene, "--model", "reduced", "--duration", "0.5", "--out", "red"}, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("does not give reaction 'rail'"), std::string::npos) << r.err;
+  const std::string header = slurp(dir / "red/timeseries.csv").substr(0, 2000);
+  EXPECT_NE(header.find(",R_crank_x,"), std::string::npos) << header;
+  EXPECT_EQ(header.find("R_rail_"), std::string::npos) << header;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir / "red/run.json")).at("reactions_not_given")[0].at("reaction"), "rail");
+  std::string text = slurp(scene);
+  text.replace(text.find("reactions: all"), 14, "reactions: [rail, crank]");
+  std::ofstream(dir / "listed.yaml") << text;
+  const auto listed =
+      rdyn::test::run_rdyn({"simulate", "listed.yaml", "--model", "reduced", "--out", "listed"}, dir);
+  EXPECT_EQ(listed.status, 2) << listed.err;
+  EXPECT_NE(listed.err.find("cannot give the reaction of prismatic joint 'rail'"), std::string::npos) << listed.err;
   fs::remove_all(dir);
 }
 

@@ -93,3 +93,36 @@ TEST(Compare, MeanSpeedOfAnOscillationIsScaledByThePeakSpeed) {
 
 }  // namespace
 }  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// Joint outputs are compared by name where both runs carry them (a reaction only the full model
+// gives is skipped), after the constraint forces; one that is zero but for rounding is measured
+// against 1e-9 of the largest joint output, not against its own noise.
+TEST(Compare, JointOutputsAreMatchedByNameAndNoiseHasAFloor) {
+  auto ref = relaxing(0.5), run = ref;
+  const size_t n = ref.t.size();
+  ref.column_names = {"R_a_x", "R_only_full_x", "R_noise_x"};
+  run.column_names = {"R_noise_x", "R_a_x"};  // another order, one missing
+  ref.columns.assign(3, std::vector<double>(n));
+  run.columns.assign(2, std::vector<double>(n));
+  for (size_t i = 0; i < n; ++i) {
+    ref.columns[0][i] = 200 * std::cos(ref.q[i]);
+    run.columns[1][i] = 1.001 * ref.columns[0][i];  // 0.1 % off
+    ref.columns[1][i] = 50;
+    ref.columns[2][i] = 1e-11 * std::sin(1e3 * ref.t[i]);  // rounding noise
+    run.columns[0][i] = -ref.columns[2][i];                 // other noise: 100 % of its own peak
+  }
+  const auto c = compare_series(ref, run, 3.0);
+  ASSERT_NE(c.find("R_a_x"), nullptr);
+  EXPECT_NEAR(c.find("R_a_x")->max_rel, 1e-3, 1e-9);
+  EXPECT_EQ(c.find("R_only_full_x"), nullptr);
+  ASSERT_NE(c.find("R_noise_x"), nullptr);
+  EXPECT_NEAR(c.find("R_noise_x")->max_rel, 2e-11 / (1e-9 * 200), 1e-3);  // 1e-4, not 2
+  EXPECT_EQ(c.signals[1].name, "F");  // forces first, then joint outputs, then the mean speed
+  EXPECT_EQ(c.signals.back().name, "mean_qdot");
+}
+
+}  // namespace
+}  // namespace rdyn::validate
