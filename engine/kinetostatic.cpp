@@ -155,6 +155,15 @@ KinetostaticResult calc_kinetostatic(const FullModel& model, FullWorkspace& ws, 
   return collect(m, s);
 }
 
+std::vector<double> calc_joint_output_row(const FullModel& model, FullWorkspace& ws) {
+  const auto& m = model.impl();
+  const State& s = ws.impl().state;
+  m.system.realize(s, Stage::Acceleration);
+  std::vector<double> out;
+  calc_joint_outputs(m, s, out);
+  return out;
+}
+
 void move_configuration(const FullModel& model, FullWorkspace& ws, double q) {
   const auto& m = model.impl();
   check_finite_input(m, {q});

@@ -72,6 +72,11 @@ inline constexpr double kSingularConditioning = 1e-5;
 // the mechanism has no loop or gear constraint.
 double calc_loop_conditioning(const FullModel& model, FullWorkspace& ws);
 
+// The joint-output columns (models::joint_output_names: joint motions, reactions, shaking) at the
+// state the last calc_kinetostatic call left in `ws` — its q, q̇, q̈ and loads — as forward
+// dynamics writes them at a row (the inverse-dynamics rows of `rdyn drive`).
+std::vector<double> calc_joint_output_row(const FullModel& model, FullWorkspace& ws);
+
 // One grid point of the kinetostatic method from one position projection (Newton, the only
 // iterative step) and linear solves with the constraint Jacobian G of that configuration
 // (issue #11 item 3). Velocities of call (i) (q̇ = 1, ẋ = 0): r from G r = 0; its accelerations

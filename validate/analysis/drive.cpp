@@ -1,5 +1,7 @@
 #include "validate/analysis/drive.hpp"
 
+#include "reduced/joint_outputs.hpp"
+
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_spline.h>
 
@@ -161,6 +163,11 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
     return engine::calc_kinetostatic(model, ws, q, motion.qdot[i], motion.qddot[i], engine::Loads::All);
   };
   const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  const bool joint_outputs = reduced::wants_joint_outputs(scene);
+  if (joint_outputs) {
+    r.column_names = models::joint_output_names(scene);
+    r.columns.assign(r.column_names.size(), {});
+  }
   for (size_t i = 0; i < motion.t.size(); ++i) {
     if (std::chrono::duration<double>(Clock::now() - start).count() > kDriveMaxWall_s)
       throw models::NumericalError(fmt::format("the full model's drive stopped at t = {:.6g} s: it used its wall-time "
@@ -168,6 +175,7 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
                                                motion.t[i], kDriveMaxWall_s));
     follow(motion.q[i]);
     auto k = inverse(motion.q[i], i);
+    std::vector<double> cols = joint_outputs ? engine::calc_joint_output_row(model, ws) : std::vector<double>{};
     if (engine::calc_loop_conditioning(model, ws) < engine::kSingularConditioning) {
       // At a singular configuration the constraint forces (and with them T_act) are a
       // least-squares split of no branch (a parallelogram's drive came out 0.31 k for k): the
@@ -175,11 +183,15 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
       // (Richardson on q ± δ/2, q ± δ; reduced/extract.cpp).
       const double d = revolute ? 1e-2 : 1e-3;
       std::vector<engine::KinetostaticResult> side;
+      std::vector<std::vector<double>> side_cols;
       for (double off : {-d, -d / 2, d / 2, d}) {
         follow(motion.q[i] + off);
         side.push_back(inverse(motion.q[i] + off, i));
+        if (joint_outputs) side_cols.push_back(engine::calc_joint_output_row(model, ws));
       }
       auto limit = [](double m1, double m2, double p2, double p1) { return (2 * (m2 + p2) - 0.5 * (m1 + p1)) / 3; };
+      for (size_t c = 0; c < cols.size(); ++c)
+        cols[c] = limit(side_cols[0][c], side_cols[1][c], side_cols[2][c], side_cols[3][c]);
       k.driving_force = limit(side[0].driving_force, side[1].driving_force, side[2].driving_force,
                               side[3].driving_force);
       for (size_t c = 0; c < names.size(); ++c)
@@ -192,6 +204,10 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
     for (size_t c = 0; c < names.size(); ++c) {
       check_finite(k.constraint_forces[c], "constraint force", motion.t[i]);
       r.forces[c].push_back(k.constraint_forces[c]);
+    }
+    for (size_t c = 0; c < cols.size(); ++c) {
+      check_finite(cols[c], "joint output", motion.t[i]);
+      r.columns[c].push_back(cols[c]);
     }
   }
   r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
@@ -220,6 +236,24 @@ DriveRecord calc_drive_reduced(const reduced::ReducedModel& model, const Prescri
     }
   }
   r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
+}
+
+DriveRecord calc_drive_reduced(const models::Scene& scene, const reduced::ReducedModel& model,
+                               const PrescribedMotion& motion) {
+  DriveRecord r = calc_drive_reduced(model, motion);
+  if (!reduced::wants_joint_outputs(scene)) return r;
+  // The rows as a reduced run, so the joint outputs come from the one implementation
+  // (reduced::add_joint_outputs), which also drops the internal constraint lines.
+  models::TimeSeries ts;
+  ts.force_names = r.force_names;
+  ts.t = r.t, ts.q = r.q, ts.qdot = r.qdot, ts.qddot = r.qddot;
+  ts.forces = r.forces;
+  reduced::add_joint_outputs(scene, model, ts);
+  r.force_names = ts.force_names;
+  r.forces = ts.forces;
+  r.column_names = ts.column_names;
+  r.columns = ts.columns;
   return r;
 }
 

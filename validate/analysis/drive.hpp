@@ -48,6 +48,10 @@ struct DriveRecord {
   std::vector<double> power;  // drive·q̇ [W]
   std::vector<std::string> force_names;
   std::vector<std::vector<double>> forces;  // [force][row] F_E [N]
+  // The scene's joint outputs (models::joint_output_names: reactions, shaking, joint motions)
+  // along the motion; the reduced model's: those it gives (reduced::split_reduced_reactions).
+  std::vector<std::string> column_names;
+  std::vector<std::vector<double>> columns;  // [column][row]
   double wall_s = 0.0;
 };
 
@@ -57,6 +61,10 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
 // The reduced model's inverse Eksergian equation along the motion. Throws reduced::TableError
 // where the motion leaves the table's range.
 DriveRecord calc_drive_reduced(const reduced::ReducedModel& model, const PrescribedMotion& motion);
+// The same with the joint outputs of `scene` (whose reactions the reduced model gives), the model
+// built from reduced::with_reaction_requests(scene): its internal lines become the columns.
+DriveRecord calc_drive_reduced(const models::Scene& scene, const reduced::ReducedModel& model,
+                               const PrescribedMotion& motion);
 
 struct DriveStats {
   double rms = 0.0, peak = 0.0, mean = 0.0;  // of the drive (peak: largest |drive|)

@@ -1,5 +1,7 @@
 #include "validate/cli/drive_command.hpp"
 
+#include "reduced/joint_outputs.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,11 +31,14 @@ DriveRecord every_kth_row(const DriveRecord& r, long k) {
   DriveRecord o;
   o.force_names = r.force_names;
   o.forces.assign(r.forces.size(), {});
+  o.column_names = r.column_names;
+  o.columns.assign(r.columns.size(), {});
   for (size_t i = 0; i < r.t.size(); ++i) {
     if (i % static_cast<size_t>(k) != 0 && i + 1 != r.t.size()) continue;
     o.t.push_back(r.t[i]), o.q.push_back(r.q[i]), o.qdot.push_back(r.qdot[i]), o.qddot.push_back(r.qddot[i]);
     o.drive.push_back(r.drive[i]), o.power.push_back(r.power[i]);
     for (size_t c = 0; c < r.forces.size(); ++c) o.forces[c].push_back(r.forces[c][i]);
+    for (size_t c = 0; c < r.columns.size(); ++c) o.columns[c].push_back(r.columns[c][i]);
   }
   return o;
 }
@@ -42,11 +47,13 @@ void write_drive_csv(const std::string& path, const DriveRecord& r, bool revolut
   TextSink sink(path);
   std::string header = revolute ? "t,q,qdot,qddot,drive_Nm,drive_W" : "t,q,qdot,qddot,drive_N,drive_W";
   for (const auto& n : r.force_names) header += ",F_" + n;  // names are checked by the scene reader
+  for (const auto& n : r.column_names) header += "," + n;
   sink.add(header + "\n");
   for (size_t i = 0; i < r.t.size(); ++i) {
     std::string row = fmt::format("{:.10g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.t[i], r.q[i], r.qdot[i],
                                   r.qddot[i], r.drive[i], r.power[i]);
     for (const auto& c : r.forces) row += fmt::format(",{:.17g}", c[i]);
+    for (const auto& c : r.columns) row += fmt::format(",{:.17g}", c[i]);
     sink.add(row + "\n");
   }
   sink.close();
@@ -152,9 +159,24 @@ DriveMotion calc_drive_motion(const DriveArgs& a, const models::Scene& scene, bo
 DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, const PrescribedMotion& motion,
                               nlohmann::json& run) {
   if (a.model == "full") return calc_drive_full(scene, motion);
-  auto e = extract_from_full(scene, a.grid_deg, reduced::Method::Kinetostatic);
-  const auto model = reduced::make_reduced_model(e.samples, scene, reduced::parse_interpolation(a.interpolation));
-  DriveRecord r = calc_drive_reduced(model, motion);
+  // Joint outputs as `simulate --model reduced` gives them: `reactions: all` those it can (the
+  // others named), listed ones or refused.
+  const auto split = scene.outputs.reactions_all ? reduced::split_reduced_reactions(scene)
+                                                 : reduced::ReducedReactions{scene, {}};
+  if (!split.not_given.empty()) {
+    auto ng = nlohmann::json::array();
+    for (const auto& [name, why] : split.not_given) {
+      std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
+                   name.c_str(), why.c_str());
+      ng.push_back({{"reaction", name}, {"why", why}});
+    }
+    run["reactions_not_given"] = ng;
+  }
+  const models::Scene& oscene = split.scene;
+  const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
+  auto e = extract_from_full(rscene, a.grid_deg, reduced::Method::Kinetostatic);
+  const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
+  DriveRecord r = calc_drive_reduced(oscene, model, motion);
   run.update({{"grid_deg", a.grid_deg}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
   return r;
 }
@@ -175,6 +197,15 @@ void add_drive_results(nlohmann::json& run, const PrescribedMotion& motion, cons
   nlohmann::json peaks = nlohmann::json::object();
   for (size_t c = 0; c < r.force_names.size(); ++c) peaks[r.force_names[c]] = st.force_peaks[c];
   run["constraint_force_peaks_N"] = peaks;
+  // Each joint output's largest |value| along the motion (a reaction's peak for bearing sizing;
+  // units as the column's: N, N·m, rad …).
+  nlohmann::json joint_peaks = nlohmann::json::object();
+  for (size_t c = 0; c < r.column_names.size(); ++c) {
+    double pk = 0.0;
+    for (double v : r.columns[c]) pk = std::max(pk, std::abs(v));
+    joint_peaks[r.column_names[c]] = pk;
+  }
+  if (!r.column_names.empty()) run["joint_output_peaks"] = joint_peaks;
   run["statistics_rows"] = r.t.size();
   if (mc)
     run["motor_check"] = {{"stall", mc->stall},

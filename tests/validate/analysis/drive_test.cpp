@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "models/scene_yaml.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "tests/validate/run_rdyn.hpp"
 #include "validate/analysis/build_reduced.hpp"
@@ -50,6 +51,27 @@ TEST(Drive, ParallelogramAtConstantRateHoldsGravityOnly) {
   EXPECT_NEAR(st.mean_power_W, 0.0, 1e-6 * k * motion.qdot[0]);
   EXPECT_NEAR(st.rms, k / std::sqrt(2.0), 1e-4 * k);
   EXPECT_NEAR(st.peak, k, 1e-3 * k);  // rows 3.6° apart: the sampled peak is within 1 − cos 1.8°
+}
+
+// The shaking load of the parallelogram turned at a constant rate ω, in closed form: every
+// centre of mass moves on a circle about its pivot (the coupler translates), so Σ m a_com =
+// −ω² (0.5·0.05 + 1.2·0.1 + 0.7·0.05) (cos q, sin q) and the load on the ground is
+// Σ m g − Σ m a_com = (0.18 ω² cos q, −2.4 g + 0.18 ω² sin q). Both models give it as a column of
+// the drive, through the aligned positions.
+TEST(Drive, JointOutputsOfTheParallelogramAtConstantRateAreItsClosedForm) {
+  auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml", {{"outputs.shaking", "true"}});
+  const double w = 2 * M_PI * 2.0, c = 0.5 * 0.05 + 1.2 * 0.1 + 0.7 * 0.05, g = 9.81;
+  const auto motion = constant_rate_motion(scene.initial.q, w, 1.0, 0.005);
+  const auto full = calc_drive_full(scene, motion);
+  const auto red = calc_drive_reduced(scene, reduced_of(reduced::with_reaction_requests(scene), 10), motion);
+  for (const auto* r : {&full, &red}) {
+    ASSERT_EQ(r->column_names, (std::vector<std::string>{"shaking_x", "shaking_y", "shaking_M"}));
+    for (size_t i = 0; i < motion.t.size(); ++i) {
+      const double q = motion.q[i];
+      EXPECT_NEAR(r->columns[0][i], c * w * w * std::cos(q), 1e-6 * c * w * w) << motion.t[i];
+      EXPECT_NEAR(r->columns[1][i], -2.4 * g + c * w * w * std::sin(q), 1e-6 * c * w * w) << motion.t[i];
+    }
+  }
 }
 
 // A motor line against the parallelogram's drive k cos q at a constant rate ω: the line gives
