@@ -328,7 +328,12 @@ void write_outputs(Writer& w, const Scene& s) {
   }
   w.line("  bodies: " + names(o.bodies));
   w.line("  joints: " + names(o.joints));
-  w.line("  reactions: " + (o.reactions_all ? std::string("all") : names(o.reactions)));
+  // `all` stays `all` while the list is what it stands for (every joint, then every loop): it
+  // tells the reduced model to leave out the reactions it cannot give rather than refuse them.
+  std::vector<std::string> all;
+  for (const auto& j : s.joints) all.push_back(j.name);
+  for (const auto& l : s.loops) all.push_back(l.name);
+  w.line("  reactions: " + (o.reactions_all && o.reactions == all ? std::string("all") : names(o.reactions)));
   w.line(std::string("  shaking: ") + (o.shaking ? "true" : "false"));
 }
 

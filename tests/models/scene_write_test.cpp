@@ -159,6 +159,7 @@ std::string dump(const Scene& s) {
     d.count("list", *list);
     for (const auto& n : *list) d.str("item", n);
   }
+  d.integer("reactions_all", s.outputs.reactions_all ? 1 : 0);
   d.integer("shaking", s.outputs.shaking ? 1 : 0);
   d.num("q0", s.initial.q).num("qdot0", s.initial.qdot);
   d.num("duration", s.simulation.duration_s)
@@ -294,9 +295,11 @@ TEST(SceneWrite, EveryKindOfFieldReadsBackEqual) {
   ASSERT_EQ(s.outputs.reactions.size(), 5u);  // four joints, then the loop
   expect_round_trip(s, "slider");
   const std::string yaml = scene_to_yaml(s);
-  // The expanded forms: `all` as the list it stands for, named points as coordinates, radians.
+  // The expanded forms: `joints: all` as the list it stands for (`reactions: all` stays: it
+  // also says how the reduced model treats reactions it cannot give), named points as
+  // coordinates, radians.
   EXPECT_NE(yaml.find("joints: [crank, rod, slider, fly]"), std::string::npos) << yaml;
-  EXPECT_NE(yaml.find("reactions: [crank, rod, slider, fly, pin]"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("reactions: all"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("parent_point: [0.2, 0.1]"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("force_N: -1.5"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("stall_force_N: 20, no_load_speed_m_s: 0.7"), std::string::npos) << yaml;
@@ -491,7 +494,8 @@ TEST(SceneWrite, EveryFieldIsWrittenAndCompared) {
       {"gravity off", [](Scene& s) { s.gravity.enabled = false; }},
       {"outputs.bodies", [](Scene& s) { s.outputs.bodies.clear(); }},
       {"outputs.joints", [](Scene& s) { s.outputs.joints.pop_back(); }},
-      {"outputs.reactions", [](Scene& s) { s.outputs.reactions = {"pin"}; }},
+      {"outputs.reactions", [](Scene& s) { s.outputs.reactions = {"pin"}, s.outputs.reactions_all = false; }},
+      {"reactions listed", [](Scene& s) { s.outputs.reactions_all = false; }},  // the same list, by name
       {"shaking", [](Scene& s) { s.outputs.shaking = false; }},
       {"qdot", [](Scene& s) { s.initial.qdot = 0.3; }},
       {"duration", [](Scene& s) { s.simulation.duration_s = 2; }},
