@@ -143,6 +143,7 @@ double record_passage(const FullModel& model, BranchGuard& guard, const Independ
   kinetic_J = 0.0;
   for (const double x : stencil.x) row_at(x, LimitStencil{});
   combine_last_rows(ts, stencil);
+  ++ts.stats.interpolated_rows;
   ts.t.back() = p.t, ts.q.back() = p.q, ts.qdot.back() = p.qdot, ts.work.back() = p.work;
   follow_branch(model, guard.ws, p.q, guard.max_move, guard.max_correction);
   return kinetic_J;

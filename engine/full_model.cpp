@@ -576,9 +576,18 @@ bool assemble_by_continuation(const FullModel::Impl& m, State& s) {
   // flat configuration came out folded). A minimum of the conditioning below kSingularWindow with
   // a rise after it is such a passage: the walk gives up. An approach to the target is not.
   constexpr double kSingularWindow = 1e-2;
+  // Toward a singular configuration the other branch comes within ~2× the distance to it: a
+  // move longer than about a third of that distance may land there (a chain walked from 2° to
+  // 0.003° in one move came out folded). The conditioning falls like the distance, so moves are
+  // kept below max_move·κ/kFarConditioning.
+  constexpr double kFarConditioning = 0.05;
   double q = q_from, move = max_move, lowest = calc_loop_conditioning(m, s);
   for (int it = 0; it < 4000 && q != q_to && move >= 1e-6 * max_move; ++it) {
-    const double q_next = std::abs(q_to - q) <= move ? q_to : q + std::copysign(move, q_to - q);
+    const double step = std::min(move, max_move * std::max(1e-6, std::min(1.0, lowest / kFarConditioning)));
+    // Steps shrinking far from the target: a singular configuration lies between (a walk from
+    // 90° to 270° through a chain's flat position at 180°); do not creep up to it.
+    if (step < 1e-3 * std::abs(q_to - q)) return false;
+    const double q_next = std::abs(q_to - q) <= step ? q_to : q + std::copysign(step, q_to - q);
     State next = s;
     m.joint_mobod[m.independent].setOneQ(next, MobilizerQIndex(0), q_next);
     m.set_law(next, 0, poly_law(q_next, 0.0, 0.0));  // the prescribed position the assembly keeps

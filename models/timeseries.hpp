@@ -18,6 +18,9 @@ struct RunStats {
   double max_constraint_error = 0.0;  // largest loop-closure violation seen [m] (full model)
   double wall_time_s = 0.0;
   long singular_passages = 0;  // windows of rank loss crossed in the partitioned formulation (full model)
+  // Output rows within ~1e-4 rad of rank loss, where the rates (and the constraint forces) are not
+  // determined: their values are the limit stencil's interpolation (full model).
+  long interpolated_rows = 0;
 };
 
 struct TimeSeries {

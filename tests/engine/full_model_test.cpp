@@ -292,7 +292,7 @@ TEST(FullModelBranch, GuessesOfTheOtherBranchFailNamingTheLoop) {
 // within half a turn of its guess. Across the flat configuration from the guesses (−0.1°) the
 // walk does not go (the branch would be an accident): refused, naming the guesses.
 TEST(FullModelAssembly, FarGuessesNearAFlatConfigurationWalkToTheStart) {
-  for (double deg : {0.5, 0.1, 0.01, 179.9, 45.0, 270.0}) {
+  for (double deg : {0.5, 0.1, 0.01, 0.003, 179.9, 45.0, 270.0}) {
     const auto scene =
         models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", fmt::format("{}", deg)}});
     const Inspection a = calc_assembly(FullModel(scene));

@@ -135,7 +135,15 @@ int run_simulate(const SimulateArgs& a) {
                 {"max_loop_gap_m", ts.stats.max_constraint_error},
                 // Windows of rank loss crossed in the partitioned formulation (docs/theory.md §7a).
                 {"singular_passages", ts.stats.singular_passages},
+                {"rows_interpolated_at_rank_loss", ts.stats.interpolated_rows},
                 {"events", ts.stats.events}});
+    if (ts.stats.interpolated_rows > 0)
+      std::fprintf(stderr,
+                   "rdyn: warning: %ld output row(s) lie within ~1e-4 rad of a configuration where the loop Jacobian "
+                   "loses rank: there the constraint forces and reactions are not determined, and those rows give the "
+                   "interpolation of rows around it (a force that grows without bound toward it is not followed); "
+                   "run.json: rows_interpolated_at_rank_loss\n",
+                   ts.stats.interpolated_rows);
   } else {
     // Joint outputs: the table and the model carry one constraint line per reaction component.
     // `reactions: all` gives those the reduced model can and names the others.

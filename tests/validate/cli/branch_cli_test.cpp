@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "tests/validate/run_rdyn.hpp"
 
 namespace rdyn::validate {
@@ -114,6 +116,38 @@ simulation: {duration_s: 2, output_interval_s: 0.01}
     EXPECT_NE(r.err.find("spring.yaml:9: field 'loads.k.point_b': spring 'k'"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "o"));
   }
+}
+
+}  // namespace
+}  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// A row that lands within ~1e-4 rad of a chain's flat configuration, where the constraint forces
+// are not determined, is the limit stencil's interpolation: the run says so (a warning and
+// run.json's rows_interpolated_at_rank_loss), and a run whose rows stay clear of it does not.
+TEST(BranchCliRows, RowsInterpolatedAtRankLossAreCountedAndSaid) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_interp_rows_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string chain = std::string(RDYN_SCENES) + "/chains/chain-1.yaml";
+  // From 0.003° toward 0 at 0.01 rad/s: |q| < 3e-5 rad for a few ms around t = 5 ms.
+  const auto near = test::run_rdyn({"simulate", chain, "--model", "full", "--set", "initial.q_deg=0.003", "--set",
+                                    "initial.qdot=-0.01", "--duration", "0.02", "--dt-out", "0.001", "--out", "near"},
+                                   dir);
+  ASSERT_EQ(near.status, 0) << near.err;
+  EXPECT_NE(near.err.find("lie within ~1e-4 rad of a configuration where the loop Jacobian loses rank"),
+            std::string::npos)
+      << near.err;
+  EXPECT_GE(nlohmann::json::parse(test::slurp(dir / "near/run.json")).at("rows_interpolated_at_rank_loss").get<long>(),
+            1);
+  const auto clear = test::run_rdyn({"simulate", chain, "--model", "full", "--duration", "0.5", "--out", "clear"}, dir);
+  ASSERT_EQ(clear.status, 0) << clear.err;
+  EXPECT_EQ(clear.err.find("loses rank"), std::string::npos) << clear.err;
+  EXPECT_EQ(nlohmann::json::parse(test::slurp(dir / "clear/run.json")).at("rows_interpolated_at_rank_loss"), 0);
+  fs::remove_all(dir);
 }
 
 }  // namespace
