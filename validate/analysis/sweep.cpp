@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "models/scene_hash.hpp"
+#include "models/scene_write.hpp"
 #include "models/scene_yaml.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/io/escape.hpp"
@@ -18,11 +20,37 @@
 
 namespace rdyn::validate {
 
-SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
+namespace {
+
+// The text the sweep's fingerprint is taken of: everything that decides its rows. The scene is
+// its expanded YAML without the file it came from (a node may see the same scene at another
+// path); numbers are C99 hex floats (exact); strings are length-prefixed.
+std::string sweep_defining_text(const models::Scene& base, const SweepPlan& p) {
+  models::Scene scene = base;
+  scene.source_file.clear();
+  std::string t = "rdyn-sweep v1\n" + models::scene_to_yaml(scene);
+  auto str = [&](const std::string& s) { t += fmt::format("{}:{}\n", s.size(), s); };
+  for (const auto& a : p.opt.axes) {
+    str(a.key);
+    for (const double v : a.values) t += fmt::format("{:a} ", v);
+    t += "\n";
+  }
+  const CalibrationOptions& c = p.calibration;
+  t += fmt::format("cadence {:a} power {:a} grid {:a}\n", c.cadence_hz, c.power_w, c.grid_deg);
+  str(p.opt.load);
+  str(p.header);
+  return t;
+}
+
+}  // namespace
+
+SweepPlan plan_sweep(const SweepOptions& opt) {
   if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
     throw models::SceneError("", 0, "--shard", "expected i/N with 0 ≤ i < N");
-  std::vector<models::Override> fixed;
-  for (const auto& s : opt.sets) fixed.push_back(models::parse_override(s));
+  SweepPlan plan;
+  plan.opt = opt;
+  for (const auto& s : opt.sets) plan.fixed.push_back(models::parse_override(s));
+  const auto& fixed = plan.fixed;
   // The base scene must load (fails early, before any thread starts).
   const models::Scene base = models::load_scene(opt.scene, fixed);
   // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
@@ -53,16 +81,32 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
     if (total > kMaxCases)
       throw models::SceneError("", 0, "--vary", fmt::format("more than {} cases in all", kMaxCases));
   }
-  const long per = (total + opt.shards - 1) / opt.shards;
-  const long first = std::min(total, per * opt.shard), last = std::min(total, first + per);
-  const long n = last - first;
+  plan.calibration = copt;
+  plan.force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
+  plan.header = "case";
+  for (const auto& a : opt.axes) plan.header += "," + csv_field(a.key);
+  plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error",
+                             load_value_column(base, copt), plan.force.empty() ? "constraint" : plan.force);
+  plan.id.total = total;
+  plan.id.scene_hex = models::scene_hash_hex(models::scene_hash(base));
+  plan.id.sweep_hex = models::scene_hash_hex(models::fnv1a64(sweep_defining_text(base, plan)));
+  plan.range = shard_range(total, opt.shard, opt.shards);
+  return plan;
+}
+
+SweepResult run_sweep(const SweepOptions& opt) { return run_sweep(plan_sweep(opt), nullptr); }
+
+SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
+  const SweepOptions& opt = plan.opt;
+  const auto& fixed = plan.fixed;
+  const CalibrationOptions& copt = plan.calibration;
+  const std::string& force = plan.force;
+  const long first = plan.range.first;
+  const long n = plan.range.end - plan.range.first;
+  const auto t0 = std::chrono::steady_clock::now();
 
   std::vector<std::string> rows(n);
   std::atomic<long> next{0}, done{0}, failed{0};
-  std::mutex progress_mutex;
-  Progress progress(show_progress);
-  const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
-  const std::string value_column = load_value_column(base, copt);
   auto work = [&] {
     Progress quiet(false);
     // The last table this thread extracted, by scene hash: cases that differ only in load
@@ -103,8 +147,7 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
       }
       rows[k] = row;
       const long d = ++done;
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      progress.count("sweep", d, n);
+      if (progress) progress->done(d);
     }
   };
   const int threads = static_cast<int>(std::clamp<long>(
@@ -113,15 +156,13 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();
 
-  std::string csv;
-  if (opt.shard == 0) {
-    csv = "case";
-    for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
-    csv += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n", value_column,
-                       force.empty() ? "constraint" : force);
-  }
-  for (const auto& r : rows) csv += r + "\n";
-  return {csv, n, failed.load()};
+  SweepResult r;
+  r.csv = sweep_csv(plan.id, plan.range, plan.header, rows);
+  r.cases = n;
+  r.failed = failed.load();
+  r.threads = threads;
+  r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 }  // namespace rdyn::validate

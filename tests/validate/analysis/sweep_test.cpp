@@ -23,21 +23,35 @@
 namespace rdyn::validate {
 namespace {
 
-TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
+// The shards, run apart (one thread each, in reverse order) and merged, are the whole sweep
+// run at once in two threads, byte for byte; each shard's file names the sweep and its cases.
+TEST(Sweep, MergedShardsAreTheWholeSweep) {
   SweepOptions o;
   o.scene = "bicycle";
   o.axes = {parse_sweep_axis("bicycle_leg.hip_torque_Nm=60:60:1"), parse_sweep_axis("bicycle_leg.crank_length_m=0.16:0.18:3")};
   o.threads = 2;
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   const std::string& whole = r.csv;
   EXPECT_EQ(r.cases, 3);
   EXPECT_EQ(r.failed, 0);
-  std::string parts;
+  std::vector<SweepPart> parts;
   o.shards = 2;
-  for (o.shard = 0; o.shard < 2; ++o.shard) parts += run_sweep(o, false).csv;
-  EXPECT_EQ(parts, whole);
-  // header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
-  EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 4);
+  o.threads = 1;
+  for (o.shard = 1; o.shard >= 0; --o.shard) {
+    const SweepResult s = run_sweep(o);
+    EXPECT_EQ(s.cases, o.shard == 0 ? 2 : 1);
+    parts.push_back(parse_sweep_part(s.csv, fmt::format("part{}.csv", o.shard)));
+    EXPECT_TRUE(parts.back().complete());
+  }
+  EXPECT_EQ(parts[1].id.sweep_hex, parts[0].id.sweep_hex);
+  EXPECT_NE(parts[1].id.sweep_hex, parts[1].id.scene_hex);
+  const MergedSweep m = merge_sweep_parts(parts);
+  EXPECT_EQ(m.csv, whole);
+  EXPECT_EQ(m.cases, 3);
+  // metadata + header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
+  EXPECT_EQ(whole.find("# rdyn-sweep v1 sweep="), 0u) << whole;
+  EXPECT_NE(whole.find(" shard=0/1 cases=0-3/3\ncase,"), std::string::npos) << whole;
+  EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 5);
   EXPECT_EQ(whole.find("error"), whole.find("error\n"));  // only the header's column name
   EXPECT_NE(whole.find(",status,drive_torque_Nm,"), std::string::npos) << whole;
   EXPECT_NE(whole.find(",peak_knee_force_N,"), std::string::npos) << whole;  // the scene's force name
@@ -45,6 +59,7 @@ TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   std::vector<double> torque;
   std::istringstream lines(whole);
   std::string line;
+  std::getline(lines, line);  // metadata
   std::getline(lines, line);  // header
   while (std::getline(lines, line)) {
     std::istringstream cells(line);
@@ -70,9 +85,9 @@ TEST(Sweep, UnknownKeysAndOutOfRangeEndsFailBeforeWork) {
   o.cadence_hz = 1.0;
   o.power_w = 1.0;
   o.axes = {parse_sweep_axis("no_such.key=1:2:3")};
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
   o.axes = {parse_sweep_axis("bodies.crank.mass_kg=1:-1:3")};  // the far end is not a mass
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
 }
 
 // A scene that cannot be calibrated at all (the four-bar has no drive torque) fails before
@@ -83,7 +98,7 @@ TEST(Sweep, UncalibratableSceneFailsBeforeWork) {
   o.cadence_hz = 1.0;
   o.power_w = 1.0;
   o.axes = {parse_sweep_axis("bodies.crank.mass_kg=0.4:0.6:3")};
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
 }
 
 // Removes a temporary scene file however the test ends (a throwing run_sweep included).
@@ -115,23 +130,28 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
   o.sets = {"gravity.enabled=false"};  // no stall: the torque–cadence map is monotonic
   o.axes = {parse_sweep_axis("ground_points.D.0=0.30:3.0:2")};
   o.threads = 2;
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   EXPECT_EQ(r.cases, 2);
   EXPECT_EQ(r.failed, 1) << r.csv;
-  const auto lines = r.csv.substr(r.csv.find('\n') + 1);
+  const auto header = r.csv.find('\n') + 1;  // after the metadata line
+  const auto lines = r.csv.substr(r.csv.find('\n', header) + 1);
   EXPECT_EQ(lines.find("0,0.3,ok,"), 0u) << r.csv;                 // the first case calibrates
   EXPECT_NE(lines.find("1,3,error,,,,,,"), std::string::npos) << r.csv;  // the second names its loop
 }
 
 // A named load through the sweep: a flywheel's motor against viscous drag c, calibrated to a
 // mean speed (no power): each row holds s = c·ω/(1 − ω/ω0) in a column named for the load's kind.
-// The sweep's CSV lines (the header first), with every case expected to succeed.
+// The sweep's CSV lines after the metadata line (the header first), with every case expected
+// to succeed.
 std::vector<std::string> successful_rows(const SweepOptions& o) {
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   EXPECT_EQ(r.failed, 0) << r.csv;
   std::vector<std::string> rows;
   std::istringstream lines(r.csv);
-  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line.find("# rdyn-sweep v1 "), 0u) << line;
+  while (std::getline(lines, line)) rows.push_back(line);
   return rows;
 }
 
@@ -191,11 +211,12 @@ TEST(Sweep, ABranchCheckIsNeverSkippedByAReusedTable) {
   o.threads = 1;
   for (const char* axis : {"loops.C.branch.sign=1:-1:2", "loops.C.branch.sign=-1:1:2"}) {
     o.axes = {parse_sweep_axis(axis)};
-    const SweepResult r = run_sweep(o, false);
+    const SweepResult r = run_sweep(o);
     EXPECT_EQ(r.failed, 1) << axis << "\n" << r.csv;
     std::istringstream lines(r.csv);
     std::string line;
-    std::getline(lines, line);
+    std::getline(lines, line);  // metadata
+    std::getline(lines, line);  // header
     while (std::getline(lines, line)) {
       const bool negative = line.find(",-1,") != std::string::npos;
       EXPECT_EQ(line.find(",error,") != std::string::npos, negative) << axis << ": " << line;
