@@ -10,20 +10,15 @@ namespace rdyn::validate {
 
 namespace {
 double steady_now_s() {
-  return std::chrono::duration<double>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
-} // namespace
+}  // namespace
 
 std::string format_duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0)
-    return "unknown";
+  if (!std::isfinite(seconds) || seconds < 0) return "unknown";
   const long s = std::lround(seconds);
-  if (s < 60)
-    return fmt::format("{} s", s);
-  if (s < 3600)
-    return fmt::format("{} min {:02} s", s / 60, s % 60);
+  if (s < 60) return fmt::format("{} s", s);
+  if (s < 3600) return fmt::format("{} min {:02} s", s / 60, s % 60);
   return fmt::format("{} h {:02} min", s / 3600, (s % 3600) / 60);
 }
 
@@ -31,19 +26,13 @@ ProgressMeter::ProgressMeter(std::string label, long total, bool terminal)
     : label_(std::move(label)), total_(total), terminal_(terminal) {}
 
 std::string ProgressMeter::text(long done, double now_s) const {
-  std::string t =
-      fmt::format("{}: {}/{} cases ({:.0f} %)", label_, done, total_,
-                  total_ > 0 ? 100.0 * static_cast<double>(done) /
-                                   static_cast<double>(total_)
-                             : 100.0);
-  // A rate needs a case done and time measured; before that there is nothing to
-  // extrapolate.
+  std::string t = fmt::format("{}: {}/{} cases ({:.0f} %)", label_, done, total_,
+                              total_ > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0);
+  // A rate needs a case done and time measured; before that there is nothing to extrapolate.
   if (done > 0 && now_s > 0) {
     const double rate = static_cast<double>(done) / now_s;
     t += fmt::format(", {:.3g} cases/s", rate);
-    if (done < total_)
-      t += ", " + format_duration(static_cast<double>(total_ - done) / rate) +
-           " left";
+    if (done < total_) t += ", " + format_duration(static_cast<double>(total_ - done) / rate) + " left";
   }
   return t;
 }
@@ -51,15 +40,11 @@ std::string ProgressMeter::text(long done, double now_s) const {
 std::optional<std::string> ProgressMeter::line_due(long done, double now_s) {
   const bool last = done >= total_;
   const double interval = terminal_ ? kTerminalInterval_s : kLogInterval_s;
-  // In a log, the end is the summary line's to report; on a terminal the
-  // counter is completed.
-  if (!terminal_ && last)
-    return std::nullopt;
-  if (!last && now_s - last_s_ < interval)
-    return std::nullopt;
+  // In a log, the end is the summary line's to report; on a terminal the counter is completed.
+  if (!terminal_ && last) return std::nullopt;
+  if (!last && now_s - last_s_ < interval) return std::nullopt;
   last_s_ = now_s;
-  if (terminal_)
-    return "\r\033[K" + text(done, now_s) + (last ? "\n" : "");
+  if (terminal_) return "\r\033[K" + text(done, now_s) + (last ? "\n" : "");
   return text(done, now_s) + "\n";
 }
 
@@ -76,4 +61,4 @@ void StderrProgress::done(long count) {
   }
 }
 
-} // namespace rdyn::validate
+}  // namespace rdyn::validate
