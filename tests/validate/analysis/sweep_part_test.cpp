@@ -168,5 +168,31 @@ TEST(SweepPart, PartsOfAnotherSweepMissingOrDoubledAreRefused) {
   EXPECT_EQ(field_of({p0, file_of("1/3", "2-4/5", 2, 4), file_of("2/3", "4-5/5", 4, 5)}), "cases in p1");
 }
 
+
+// Every prefix of a part and every byte of it replaced by a comma, a quote, a line break or a
+// letter: read as a part or refused with a SceneError, never another exception or a crash.
+TEST(SweepPart, DamagedPartsAreReadOrRefusedNeverCrash) {
+  const std::string good = file_of("0/1", "0-5/5", 0, 5);
+  long refused = 0, read = 0;
+  auto attempt = [&](const std::string& text) {
+    try {
+      const SweepPart p = parse_sweep_part(text, "p.csv");
+      EXPECT_LE(p.rows.size(), 5u);
+      ++read;
+    } catch (const models::SceneError&) {
+      ++refused;
+    }
+  };
+  for (size_t n = 0; n < good.size(); ++n) attempt(good.substr(0, n));
+  for (size_t i = 0; i < good.size(); ++i)
+    for (const char c : {',', '"', '\n', 'x', '9'}) {
+      std::string t = good;
+      t[i] = c;
+      attempt(t);
+    }
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(read, 0);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
