@@ -42,6 +42,7 @@ struct SweepPlan {
   SweepIdentity id;                     // the whole sweep: its fingerprint, scene hash and cases
   SweepRange range;                     // this shard's cases
   std::string header;                   // the CSV's column header (no line break)
+  std::vector<bool> changes_mechanism;  // per axis: its two ends need two tables (run first)
 };
 
 // Loads the base scene and checks everything before work: every axis key is applied at both
@@ -54,12 +55,14 @@ struct SweepResult {
   long cases = 0;          // in this shard
   long failed = 0;         // rows with status "error"
   int threads = 0;         // worker threads used
+  long tables = 0;         // reduced tables extracted (a thread reuses its last one)
   double elapsed_s = 0.0;  // wall time of the cases
 };
 
 // Runs the cases of the plan's shard, reporting each done case to `progress` (may be null). A
 // failing case gives a row with status "error" and its message (RFC 4180-quoted), and does not
-// stop the others.
+// stop the others. The cases run with the axes that change the mechanism varying slowest (so a
+// thread's next case mostly reuses its table); the rows are in case order.
 SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress);
 
 // plan_sweep then run_sweep without progress.

@@ -442,7 +442,9 @@ int run_sweep_command(const SweepArgs& a) {
   out.commit();
   const double rate = r.elapsed_s > 0 ? static_cast<double>(r.cases) / r.elapsed_s : 0.0;
   return report_sweep(
-      what, fmt::format("{} cases in {:.3g} s ({:.3g} cases/s, {} threads)", r.cases, r.elapsed_s, rate, r.threads),
+      what,
+      fmt::format("{} cases in {:.3g} s ({:.3g} cases/s, {} threads, {} tables)", r.cases, r.elapsed_s, rate, r.threads,
+                  r.tables),
       r.failed, a.out);
 }
 

@@ -72,6 +72,7 @@ TEST(Sweep, MergedShardsAreTheWholeSweep) {
   EXPECT_GT(torque[1], torque[2]);
 }
 
+
 }  // namespace
 }  // namespace rdyn::validate
 
@@ -249,6 +250,41 @@ TEST(Sweep, ReusedTableGivesTheCaseItsOwnCalibration) {
       EXPECT_NE(line.find(fmt::format(",ok,{:.10g},", own.load_value)), std::string::npos)
           << line << " vs " << own.load_value;
     }
+}
+
+
+// The cases of one mechanism run one after the other whatever the order of --vary: with the
+// rider's height (a new table) as the last, fastest axis, one thread extracts two tables for
+// four cases, not four, and each row holds what the other axis order gives for its case.
+TEST(Sweep, CasesOfOneMechanismRunTogetherWhateverTheAxisOrder) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.threads = 1;
+  o.axes = {parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:2"),
+            parse_sweep_axis("bicycle_leg.subject.height_m=1.7:1.8:2")};
+  const SweepPlan plan = plan_sweep(o);
+  EXPECT_EQ(plan.changes_mechanism, (std::vector<bool>{false, true}));
+  const SweepResult height_last = run_sweep(plan, nullptr);
+  EXPECT_EQ(height_last.tables, 2);
+  EXPECT_EQ(height_last.failed, 0) << height_last.csv;
+  std::swap(o.axes[0], o.axes[1]);
+  const SweepResult height_first = run_sweep(o);
+  EXPECT_EQ(height_first.tables, 2);
+  // Row (p, h) of the first against row (h, p) of the second, from the status on.
+  auto rows_of = [](const std::string& csv) {
+    std::vector<std::string> rows;
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line);  // metadata
+    std::getline(lines, line);  // header
+    while (std::getline(lines, line)) rows.push_back(line.substr(line.find(",ok,")));
+    return rows;
+  };
+  const auto a = rows_of(height_last.csv), b = rows_of(height_first.csv);
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  for (int p = 0; p < 2; ++p)
+    for (int h = 0; h < 2; ++h) EXPECT_EQ(a[2 * p + h], b[2 * h + p]) << p << " " << h;
 }
 
 }  // namespace

@@ -41,7 +41,8 @@ TEST_F(SweepCli, ShardsResumeAndMergeIntoTheOneProcessSweep) {
   const auto whole = sweep({"--threads", "2", "--out", "whole.csv"});
   ASSERT_EQ(whole.status, 0) << whole.err;
   EXPECT_NE(whole.err.find("rdyn: sweep shard 0/1: 6 cases in "), std::string::npos) << whole.err;
-  EXPECT_NE(whole.err.find("2 threads); wrote whole.csv"), std::string::npos) << whole.err;
+  EXPECT_NE(whole.err.find("2 threads, "), std::string::npos) << whole.err;
+  EXPECT_NE(whole.err.find(" tables); wrote whole.csv"), std::string::npos) << whole.err;
   for (const char* shard : {"2/3", "0/3", "1/3"}) {
     const std::string name = std::string("part") + shard[0] + ".csv";
     const auto r = sweep({"--threads", "1", "--shard", shard, "--resume", "--out", name});
