@@ -51,20 +51,24 @@ std::string table_key(const models::Scene& scene) {
   return key;
 }
 
-// The order the shard's cases run in: the axes that change the mechanism vary slowest, so the
-// cases that share a table follow each other whatever the order of --vary (a table is ~85 % of
-// a case that extracts). A stable sort of the case indices by their axis digits, mechanism
-// axes first; the rows are still written in case order.
-std::vector<long> run_order(const SweepPlan& plan) {
+// The order the shard's cases run in, cut into the chunks a thread takes at once: the axes that
+// change the mechanism vary slowest (a stable sort of the case indices by their axis digits,
+// mechanism axes first), so the cases that share a table follow each other whatever the order
+// of --vary (a table is ~85 % of a case that extracts); a chunk holds cases of one mechanism
+// only, at most 1/(4·threads) of the shard, so one thread extracts each table and the threads
+// still share the work when there are few mechanisms. The rows are still written in case order.
+struct RunOrder {
+  std::vector<long> cases;   // case indices in run order
+  std::vector<long> chunks;  // offsets into `cases` where each chunk starts, then cases.size()
+};
+
+RunOrder run_order(const SweepPlan& plan, int threads) {
   const auto& axes = plan.opt.axes;
   const long first = plan.range.first, n = plan.range.end - plan.range.first;
-  std::vector<long> order(n);
-  for (long k = 0; k < n; ++k) order[k] = first + k;
-  if (std::none_of(plan.changes_mechanism.begin(), plan.changes_mechanism.end(), [](bool b) { return b; }))
-    return order;
+  // Per case: the mechanism axes' digits, then the others' (last axis varies fastest).
   auto digits = [&](long index) {
     std::vector<long> d(axes.size());
-    for (size_t i = axes.size(); i-- > 0;) {  // last axis varies fastest
+    for (size_t i = axes.size(); i-- > 0;) {
       d[i] = index % static_cast<long>(axes[i].values.size());
       index /= static_cast<long>(axes[i].values.size());
     }
@@ -74,12 +78,23 @@ std::vector<long> run_order(const SweepPlan& plan) {
         if (plan.changes_mechanism[i] == (pass == 0)) key.push_back(d[i]);
     return key;
   };
+  const auto mechanism_digits = static_cast<std::ptrdiff_t>(
+      std::count(plan.changes_mechanism.begin(), plan.changes_mechanism.end(), true));
   std::vector<std::pair<std::vector<long>, long>> keyed;
   keyed.reserve(n);
-  for (const long index : order) keyed.emplace_back(digits(index), index);
+  for (long k = 0; k < n; ++k) keyed.emplace_back(digits(first + k), first + k);
   std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (long k = 0; k < n; ++k) order[k] = keyed[k].second;
-  return order;
+  RunOrder r;
+  const long most = std::max(1L, n / (4L * std::max(1, threads)));
+  for (long k = 0; k < n; ++k) {
+    const bool same_mechanism =
+        k > 0 && std::equal(keyed[k].first.begin(), keyed[k].first.begin() + mechanism_digits,
+                            keyed[k - 1].first.begin());
+    if (!same_mechanism || k - r.chunks.back() >= most) r.chunks.push_back(k);
+    r.cases.push_back(keyed[k].second);
+  }
+  r.chunks.push_back(n);
+  return r;
 }
 
 }  // namespace
@@ -147,7 +162,10 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   const long first = plan.range.first;
   const long n = plan.range.end - plan.range.first;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<long> order = run_order(plan);
+  const int threads = static_cast<int>(std::clamp<long>(
+      opt.threads > 0 ? opt.threads : static_cast<long>(std::thread::hardware_concurrency()), 1, std::max(1L, n)));
+  const RunOrder order = run_order(plan, threads);
+  const long chunks = static_cast<long>(order.chunks.size()) - 1;
 
   std::vector<std::string> rows(n);
   std::atomic<long> next{0}, done{0}, failed{0}, tables{0};
@@ -157,42 +175,42 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
     // values, resistance coefficients, cadence or power share it (calibrate's extraction and
     // fit are 3/4 of a case; run_order puts the cases of one mechanism next to each other).
     std::optional<std::pair<std::string, CalibrationTable>> last;
-    for (long k; (k = next.fetch_add(1)) < n;) {
-      const long index = order[k];
-      std::vector<models::Override> o = fixed;
-      std::string params;
-      long rest = index;
-      for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
-        const double v = it->values[rest % it->values.size()];
-        rest /= static_cast<long>(it->values.size());
-        o.push_back({it->key, fmt::format("{:.17g}", v)});
-        params = fmt::format(",{:.10g}", v) + params;
-      }
-      std::string row;
-      try {
-        const auto scene = models::load_scene(opt.scene, o);
-        const std::string key = table_key(scene);
-        if (!last || last->first != key) {
-          last.reset();  // a failed extraction leaves none
-          ++tables;
-          last.emplace(key, extract_calibration_table(scene, copt));
+    for (long c; (c = next.fetch_add(1)) < chunks;) {
+      for (long k = order.chunks[c]; k < order.chunks[c + 1]; ++k) {
+        const long index = order.cases[k];
+        std::vector<models::Override> o = fixed;
+        std::string params;
+        long rest = index;
+        for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
+          const double v = it->values[rest % it->values.size()];
+          rest /= static_cast<long>(it->values.size());
+          o.push_back({it->key, fmt::format("{:.17g}", v)});
+          params = fmt::format(",{:.10g}", v) + params;
         }
-        const auto r = calibrate(scene, last->second, copt, quiet);
-        // No constraint force requested: an empty field, never NaN.
-        const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
-        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
-                          r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
-      } catch (const std::exception& e) {
-        row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
-        ++failed;
+        std::string row;
+        try {
+          const auto scene = models::load_scene(opt.scene, o);
+          const std::string key = table_key(scene);
+          if (!last || last->first != key) {
+            last.reset();  // a failed extraction leaves none
+            ++tables;
+            last.emplace(key, extract_calibration_table(scene, copt));
+          }
+          const auto r = calibrate(scene, last->second, copt, quiet);
+          // No constraint force requested: an empty field, never NaN.
+          const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
+          row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
+                            r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
+        } catch (const std::exception& e) {
+          row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
+          ++failed;
+        }
+        rows[index - first] = row;
+        const long d = ++done;
+        if (progress) progress->done(d);
       }
-      rows[index - first] = row;
-      const long d = ++done;
-      if (progress) progress->done(d);
     }
   };
-  const int threads = static_cast<int>(std::clamp<long>(
-      opt.threads > 0 ? opt.threads : static_cast<long>(std::thread::hardware_concurrency()), 1, std::max(1L, n)));
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();

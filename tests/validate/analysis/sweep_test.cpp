@@ -287,5 +287,24 @@ TEST(Sweep, CasesOfOneMechanismRunTogetherWhateverTheAxisOrder) {
     for (int h = 0; h < 2; ++h) EXPECT_EQ(a[2 * p + h], b[2 * h + p]) << p << " " << h;
 }
 
+// Two threads take whole mechanisms while there are at least 4 per thread (3 powers × 8 heights:
+// chunks of up to 24/8 = 3 cases): each of the 8 tables is extracted once, and the file is the
+// one thread's, byte for byte.
+TEST(Sweep, ThreadsTakeWholeMechanismsAndWriteTheSameFile) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:3"),
+            parse_sweep_axis("bicycle_leg.subject.height_m=1.6:1.9:8")};
+  o.threads = 2;
+  const SweepResult two = run_sweep(o);
+  EXPECT_EQ(two.threads, 2);
+  EXPECT_EQ(two.tables, 8);
+  EXPECT_EQ(two.failed, 0) << two.csv;
+  o.threads = 1;
+  const SweepResult one = run_sweep(o);
+  EXPECT_EQ(one.tables, 8);
+  EXPECT_EQ(two.csv, one.csv);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
