@@ -143,19 +143,22 @@ axes=(bicycle --vary bicycle_leg.subject.height_m=1.6:1.9:3 --vary bicycle_leg.r
 "$rdyn" sweep "${axes[@]}" --threads 2 --out "$work/whole.csv" || fail "the one-process sweep failed"
 
 # ...and as a job array of four tasks (one of them runs cases 6-6: none), then the merge job.
+# Every wait is bounded (30 s for the node, then 300 + 120 + 120 s of jobs, each job --time=5
+# min), so the script ends, and its trap stops the daemons, before ctest's 900 s timeout would
+# kill it without its trap.
 export RDYN=$rdyn
 cd "$work" || fail "cd $work"
-timeout 600 sbatch --wait --array=0-3 --cpus-per-task=1 --output="$work/logs/sweep-%A_%a.log" \
+timeout 300 sbatch --wait --array=0-3 --cpus-per-task=1 --time=5 --output="$work/logs/sweep-%A_%a.log" \
   "$src/examples/slurm/sweep.sbatch" "$work/parts" "${axes[@]}" ||
   { cat "$work"/logs/*.log; fail "the sweep array failed"; }
-timeout 120 sbatch --wait --output="$work/logs/merge.log" "$src/examples/slurm/merge.sbatch" "$work/parts" ||
+timeout 120 sbatch --wait --time=5 --output="$work/logs/merge.log" "$src/examples/slurm/merge.sbatch" "$work/parts" ||
   { cat "$work"/logs/*.log; fail "the merge job failed"; }
 cat "$work"/logs/*.log
 cmp "$work/whole.csv" "$work/parts/sweep.csv" ||
   { diff "$work/whole.csv" "$work/parts/sweep.csv"; fail "the merged array differs from the one-process sweep"; }
 
 # Resubmitted, every task finds its part complete and skips it.
-timeout 120 sbatch --wait --array=0-3 --cpus-per-task=1 --output="$work/logs/again-%A_%a.log" \
+timeout 120 sbatch --wait --array=0-3 --cpus-per-task=1 --time=5 --output="$work/logs/again-%A_%a.log" \
   "$src/examples/slurm/sweep.sbatch" "$work/parts" "${axes[@]}" || fail "the resubmitted array failed"
 skipped=$(cat "$work"/logs/again-*.log | grep -c "already complete: skipped")
 [ "$skipped" = 4 ] || { cat "$work"/logs/again-*.log; fail "$skipped of 4 resubmitted tasks skipped their part"; }
