@@ -427,7 +427,8 @@ int run_sweep_command(const SweepArgs& a) {
   for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
   const std::string what = "sweep shard " + a.shard;
   const SweepPlan plan = plan_sweep(o);
-  if (a.resume && std::filesystem::exists(a.out)) {
+  // Only a file can hold a finished part: a device or FIFO at --out (/dev/stdout) is written.
+  if (a.resume && std::filesystem::is_regular_file(a.out)) {
     SweepPart part;
     const std::string why = why_not_complete(a.out, plan, part);
     if (why.empty())
