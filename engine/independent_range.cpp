@@ -184,6 +184,8 @@ IndependentDomain calc_domain_edges(const FullModel& model) {
 
 }  // namespace
 
+IndependentDomain calc_independent_domain_edges(const FullModel& model) { return calc_domain_edges(model); }
+
 IndependentDomain calc_independent_domain(const FullModel& model) {
   IndependentDomain d = calc_domain_edges(model);
   d.singular = calc_singular_points(model, d);

@@ -54,6 +54,13 @@ struct IndependentDomain {
 // the margin of a dead point, models::NumericalError when the walk exceeds its budget of moves.
 IndependentDomain calc_independent_domain(const FullModel& model);
 
+// calc_independent_domain without the scan for singular points (domain.singular stays empty):
+// the walk alone, which decides periodic, the edges and the dead points. For callers that only
+// ask whether the coordinate turns fully (calibration and sweeps, once per table): the scan
+// samples the loop Jacobian's conditioning every kScanMove over the turn, ~20× the walk's cost
+// on the bicycle (55 of 60 ms per sweep case over the rider's height, issue #28).
+IndependentDomain calc_independent_domain_edges(const FullModel& model);
+
 // Size of the mechanism [m]: the largest distance of any point (ground points, body points,
 // centres of mass, joint locations) from its frame's origin, and the travel of prismatic joints (guesses; the independent one's initial q and declared range); at least 1 mm. Sets the
 // continuation moves of a prismatic coordinate.

@@ -107,14 +107,16 @@ std::string canonical_scene_text(const Scene& s) {
   return c.text();
 }
 
-std::uint64_t scene_hash(const Scene& scene) {
+std::uint64_t fnv1a64(const std::string& text) {
   std::uint64_t h = 14695981039346656037ull;  // FNV-1a 64-bit offset basis
-  for (const unsigned char ch : canonical_scene_text(scene)) {
+  for (const unsigned char ch : text) {
     h ^= ch;
     h *= 1099511628211ull;  // FNV 64-bit prime
   }
   return h;
 }
+
+std::uint64_t scene_hash(const Scene& scene) { return fnv1a64(canonical_scene_text(scene)); }
 
 std::string scene_hash_hex(std::uint64_t hash) {
   char buf[17];

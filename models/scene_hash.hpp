@@ -32,6 +32,10 @@ std::string canonical_scene_text(const Scene& scene);
 // 1099511628211 — Fowler, Noll, Vo; IETF draft-eastlake-fnv, section 2).
 std::uint64_t scene_hash(const Scene& scene);
 
+// 64-bit FNV-1a of any text (the same function scene_hash applies to the canonical text; sweeps
+// fingerprint their options with it).
+std::uint64_t fnv1a64(const std::string& text);
+
 // The hash as 16 lowercase hexadecimal digits (what a table header records).
 std::string scene_hash_hex(std::uint64_t hash);
 

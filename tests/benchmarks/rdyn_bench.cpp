@@ -23,6 +23,8 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
+#include "engine/independent_range.hpp"
+#include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
 
 namespace {
@@ -299,6 +301,57 @@ void BM_CalibrationWithoutFullCheck(benchmark::State& st) {
   st.counters["passes"] = r.evaluations;
 }
 BENCHMARK(BM_CalibrationWithoutFullCheck)->Unit(benchmark::kMillisecond);
+
+// What one `rdyn sweep` case costs when it changes the mechanism (issue #28 item 3), by stage,
+// CPU time per case, medians and ranges over a sweep of 20 rider heights (1.6–1.9 m, each a new
+// table) in one thread, as the sweep runs it: the scene (load_scene with the override, the
+// bicycle-leg generator), the Simbody system build, the dead-point walk (assembly and
+// calc_independent_domain), the 10° extraction, the table fit and the reduced calibration.
+void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
+  auto now = [] {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+  };
+  const std::vector<std::string> names{"scene", "build", "walk", "extraction", "fit", "reduced", "case"};
+  std::vector<std::vector<double>> ms(names.size());
+  constexpr int kCases = 20;
+  for (auto _ : st)
+    for (int k = 0; k < kCases; ++k) {
+      const double h = 1.6 + 0.3 * k / (kCases - 1);
+      double t[7];
+      t[0] = now();
+      const auto scene = models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", std::to_string(h)}});
+      validate::CalibrationOptions o = validate::calibration_options_of(scene, 0.0, 0.0, "");
+      o.full_max_s = 0.0;
+      t[1] = now();
+      const engine::FullModel model(scene);
+      t[2] = now();
+      { const engine::FullWorkspace assembled(model); }
+      benchmark::DoNotOptimize(st.range(0) == 0 ? engine::calc_independent_domain(model).periodic
+                                                : engine::calc_independent_domain_edges(model).periodic);
+      t[3] = now();
+      auto e = validate::extract_from_full(model, o.grid_deg, reduced::Method::Kinetostatic);
+      t[4] = now();
+      validate::CalibrationTable table;
+      table.table = reduced::build_table(e.samples, reduced::parse_interpolation(o.interpolation));
+      table.samples = std::move(e.samples);
+      t[5] = now();
+      validate::Progress quiet(false);
+      benchmark::DoNotOptimize(validate::calibrate(scene, table, o, quiet).load_value);
+      t[6] = now();
+      for (size_t i = 0; i + 1 < names.size(); ++i) ms[i].push_back(t[i + 1] - t[i]);
+      ms.back().push_back(t[6] - t[0]);
+    }
+  for (size_t i = 0; i < names.size(); ++i) {
+    auto v = ms[i];
+    std::sort(v.begin(), v.end());
+    st.counters[names[i] + "_ms_median"] = v[v.size() / 2];
+    st.counters[names[i] + "_ms_min"] = v.front();
+    st.counters[names[i] + "_ms_max"] = v.back();
+  }
+}
+BENCHMARK(BM_SweepCaseStagesOverHeight)->Arg(0)->Arg(1)->Iterations(3)->Unit(benchmark::kMillisecond);
 
 // Building the fused table with `fourier` interpolation (trigonometric interpolant resampled
 // at ≤ 0.25° into the cubic table) from synthetic samples with the bicycle's 21 columns; the

@@ -115,3 +115,30 @@ TEST(IndependentRange, AnInitialPositionNextToADeadPointIsRefused) {
 
 }  // namespace
 }  // namespace rdyn::engine
+
+namespace rdyn::engine {
+namespace {
+
+// The walk alone (calibration's check for a full turn): the rocker's dead points at their closed
+// form as above, and the parallelogram turns fully with its aligned positions left unscanned,
+// where the whole domain finds them.
+TEST(IndependentRange, TheWalkAloneFindsEdgesWithoutScanningForSingularPoints) {
+  const FullModel rocker(models::load_scene("fourbar-rocker"));
+  const auto r = calc_independent_domain_edges(rocker);
+  ASSERT_FALSE(r.periodic);
+  ASSERT_TRUE(r.dead_min && r.dead_max);
+  const double a = 0.08, b = 0.28, c = 0.20, g = 0.30;
+  auto psi = [&](double AC) { return std::acos((AC * AC - g * g - c * c) / (2 * g * c)); };
+  EXPECT_NEAR(*r.dead_min, psi(b + a), 1e-8);
+  EXPECT_NEAR(*r.dead_max, psi(b - a), 1e-8);
+  const FullModel parallelogram(models::load_scene(std::string(RDYN_SCENES) + "/hard/parallelogram.yaml"));
+  const auto walk = calc_independent_domain_edges(parallelogram);
+  EXPECT_TRUE(walk.periodic);
+  EXPECT_TRUE(walk.singular.empty());
+  const auto whole = calc_independent_domain(parallelogram);
+  EXPECT_TRUE(whole.periodic);
+  EXPECT_FALSE(whole.singular.empty());
+}
+
+}  // namespace
+}  // namespace rdyn::engine

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "models/scene_hash.hpp"
+#include "models/scene_write.hpp"
 #include "models/scene_yaml.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/io/escape.hpp"
@@ -18,11 +20,92 @@
 
 namespace rdyn::validate {
 
-SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
+namespace {
+
+// The text the sweep's fingerprint is taken of: everything that decides its rows. The scene is
+// its expanded YAML without the file it came from (a node may see the same scene at another
+// path); numbers are C99 hex floats (exact); strings are length-prefixed.
+std::string sweep_defining_text(const models::Scene& base, const SweepPlan& p) {
+  models::Scene scene = base;
+  scene.source_file.clear();
+  std::string t = "rdyn-sweep v1\n" + models::scene_to_yaml(scene);
+  auto str = [&](const std::string& s) { t += fmt::format("{}:{}\n", s.size(), s); };
+  for (const auto& a : p.opt.axes) {
+    str(a.key);
+    for (const double v : a.values) t += fmt::format("{:a} ", v);
+    t += "\n";
+  }
+  const CalibrationOptions& c = p.calibration;
+  t += fmt::format("cadence {:a} power {:a} grid {:a}\n", c.cadence_hz, c.power_w, c.grid_deg);
+  str(p.opt.load);
+  str(p.header);
+  return t;
+}
+
+// What a calibration table depends on: the scene hash, and the loops' branch checks, which the
+// hash leaves out (they only refuse an assembly, which a reused table would skip).
+std::string table_key(const models::Scene& scene) {
+  std::string key = models::scene_hash_hex(models::scene_hash(scene));
+  for (const auto& l : scene.loops)
+    if (l.branch) key += fmt::format("|{}:{}:{}", l.name, l.branch->joint, l.branch->sign);
+  return key;
+}
+
+// The order the shard's cases run in, cut into the chunks a thread takes at once: the axes that
+// change the mechanism vary slowest (a stable sort of the case indices by their axis digits,
+// mechanism axes first), so the cases that share a table follow each other whatever the order
+// of --vary (a table is ~85 % of a case that extracts); a chunk holds cases of one mechanism
+// only, at most 1/(4·threads) of the shard, so one thread extracts each table and the threads
+// still share the work when there are few mechanisms. The rows are still written in case order.
+struct RunOrder {
+  std::vector<long> cases;   // case indices in run order
+  std::vector<long> chunks;  // offsets into `cases` where each chunk starts, then cases.size()
+};
+
+RunOrder run_order(const SweepPlan& plan, int threads) {
+  const auto& axes = plan.opt.axes;
+  const long first = plan.range.first, n = plan.range.end - plan.range.first;
+  // Per case: the mechanism axes' digits, then the others' (last axis varies fastest).
+  auto digits = [&](long index) {
+    std::vector<long> d(axes.size());
+    for (size_t i = axes.size(); i-- > 0;) {
+      d[i] = index % static_cast<long>(axes[i].values.size());
+      index /= static_cast<long>(axes[i].values.size());
+    }
+    std::vector<long> key;
+    for (int pass = 0; pass < 2; ++pass)
+      for (size_t i = 0; i < axes.size(); ++i)
+        if (plan.changes_mechanism[i] == (pass == 0)) key.push_back(d[i]);
+    return key;
+  };
+  const auto mechanism_digits = static_cast<std::ptrdiff_t>(
+      std::count(plan.changes_mechanism.begin(), plan.changes_mechanism.end(), true));
+  std::vector<std::pair<std::vector<long>, long>> keyed;
+  keyed.reserve(n);
+  for (long k = 0; k < n; ++k) keyed.emplace_back(digits(first + k), first + k);
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  RunOrder r;
+  const long most = std::max(1L, n / (4L * std::max(1, threads)));
+  for (long k = 0; k < n; ++k) {
+    const bool same_mechanism =
+        k > 0 && std::equal(keyed[k].first.begin(), keyed[k].first.begin() + mechanism_digits,
+                            keyed[k - 1].first.begin());
+    if (!same_mechanism || k - r.chunks.back() >= most) r.chunks.push_back(k);
+    r.cases.push_back(keyed[k].second);
+  }
+  r.chunks.push_back(n);
+  return r;
+}
+
+}  // namespace
+
+SweepPlan plan_sweep(const SweepOptions& opt) {
   if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
     throw models::SceneError("", 0, "--shard", "expected i/N with 0 ≤ i < N");
-  std::vector<models::Override> fixed;
-  for (const auto& s : opt.sets) fixed.push_back(models::parse_override(s));
+  SweepPlan plan;
+  plan.opt = opt;
+  for (const auto& s : opt.sets) plan.fixed.push_back(models::parse_override(s));
+  const auto& fixed = plan.fixed;
   // The base scene must load (fails early, before any thread starts).
   const models::Scene base = models::load_scene(opt.scene, fixed);
   // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
@@ -34,13 +117,16 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
                              "give it, or a validation.calibrate block in the scene");
   check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
   // Every axis at both ends of its range on the base scene: unknown keys and values out of
-  // range fail here, before any thread starts.
-  for (const auto& a : opt.axes)
+  // range fail here, before any thread starts. Ends of two tables: the axis changes the mechanism.
+  for (const auto& a : opt.axes) {
+    std::vector<std::string> keys;
     for (double v : {a.values.front(), a.values.back()}) {
       std::vector<models::Override> o = fixed;
       o.push_back({a.key, fmt::format("{:.17g}", v)});
-      models::load_scene(opt.scene, o);
+      keys.push_back(table_key(models::load_scene(opt.scene, o)));
     }
+    plan.changes_mechanism.push_back(keys[0] != keys[1]);
+  }
 
   for (size_t i = 0; i < opt.axes.size(); ++i)
     for (size_t j = 0; j < i; ++j)
@@ -53,75 +139,90 @@ SweepResult run_sweep(const SweepOptions& opt, bool show_progress) {
     if (total > kMaxCases)
       throw models::SceneError("", 0, "--vary", fmt::format("more than {} cases in all", kMaxCases));
   }
-  const long per = (total + opt.shards - 1) / opt.shards;
-  const long first = std::min(total, per * opt.shard), last = std::min(total, first + per);
-  const long n = last - first;
+  plan.calibration = copt;
+  plan.force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
+  plan.header = "case";
+  for (const auto& a : opt.axes) plan.header += "," + csv_field(a.key);
+  plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error",
+                             load_value_column(base, copt), plan.force.empty() ? "constraint" : plan.force);
+  plan.id.total = total;
+  plan.id.scene_hex = models::scene_hash_hex(models::scene_hash(base));
+  plan.id.sweep_hex = models::scene_hash_hex(models::fnv1a64(sweep_defining_text(base, plan)));
+  plan.range = shard_range(total, opt.shard, opt.shards);
+  return plan;
+}
 
-  std::vector<std::string> rows(n);
-  std::atomic<long> next{0}, done{0}, failed{0};
-  std::mutex progress_mutex;
-  Progress progress(show_progress);
-  const std::string force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
-  const std::string value_column = load_value_column(base, copt);
-  auto work = [&] {
-    Progress quiet(false);
-    // The last table this thread extracted, by scene hash: cases that differ only in load
-    // values, resistance coefficients, cadence or power share it (calibrate's extraction and
-    // fit are 3/4 of a case; cases take consecutive indices and the last axis varies fastest).
-    std::optional<std::pair<std::string, CalibrationTable>> last;
-    for (long k; (k = next.fetch_add(1)) < n;) {
-      const long index = first + k;
-      std::vector<models::Override> o = fixed;
-      std::string params;
-      long rest = index;
-      for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
-        const double v = it->values[rest % it->values.size()];
-        rest /= static_cast<long>(it->values.size());
-        o.push_back({it->key, fmt::format("{:.17g}", v)});
-        params = fmt::format(",{:.10g}", v) + params;
-      }
-      std::string row;
-      try {
-        const auto scene = models::load_scene(opt.scene, o);
-        // The scene hash leaves out the loops' branch checks (they only refuse an assembly, which
-        // a reused table would skip): they are part of the key.
-        std::string key = models::scene_hash_hex(models::scene_hash(scene));
-        for (const auto& l : scene.loops)
-          if (l.branch) key += fmt::format("|{}:{}:{}", l.name, l.branch->joint, l.branch->sign);
-        if (!last || last->first != key) {
-          last.reset();  // a failed extraction leaves none
-          last.emplace(key, extract_calibration_table(scene, copt));
-        }
-        const auto r = calibrate(scene, last->second, copt, quiet);
-        // No constraint force requested: an empty field, never NaN.
-        const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
-        row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
-                          r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
-      } catch (const std::exception& e) {
-        row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
-        ++failed;
-      }
-      rows[k] = row;
-      const long d = ++done;
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      progress.count("sweep", d, n);
-    }
-  };
+SweepResult run_sweep(const SweepOptions& opt) { return run_sweep(plan_sweep(opt), nullptr); }
+
+SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
+  const SweepOptions& opt = plan.opt;
+  const auto& fixed = plan.fixed;
+  const CalibrationOptions& copt = plan.calibration;
+  const std::string& force = plan.force;
+  const long first = plan.range.first;
+  const long n = plan.range.end - plan.range.first;
+  const auto t0 = std::chrono::steady_clock::now();
   const int threads = static_cast<int>(std::clamp<long>(
       opt.threads > 0 ? opt.threads : static_cast<long>(std::thread::hardware_concurrency()), 1, std::max(1L, n)));
+  const RunOrder order = run_order(plan, threads);
+  const long chunks = static_cast<long>(order.chunks.size()) - 1;
+
+  std::vector<std::string> rows(n);
+  std::atomic<long> next{0}, done{0}, failed{0}, tables{0};
+  auto work = [&] {
+    Progress quiet(false);
+    // The last table this thread extracted, by table_key: cases that differ only in load
+    // values, resistance coefficients, cadence or power share it (calibrate's extraction and
+    // fit are 3/4 of a case; run_order puts the cases of one mechanism next to each other).
+    std::optional<std::pair<std::string, CalibrationTable>> last;
+    for (long c; (c = next.fetch_add(1)) < chunks;) {
+      for (long k = order.chunks[c]; k < order.chunks[c + 1]; ++k) {
+        const long index = order.cases[k];
+        std::vector<models::Override> o = fixed;
+        std::string params;
+        long rest = index;
+        for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
+          const double v = it->values[rest % it->values.size()];
+          rest /= static_cast<long>(it->values.size());
+          o.push_back({it->key, fmt::format("{:.17g}", v)});
+          params = fmt::format(",{:.10g}", v) + params;
+        }
+        std::string row;
+        try {
+          const auto scene = models::load_scene(opt.scene, o);
+          const std::string key = table_key(scene);
+          if (!last || last->first != key) {
+            last.reset();  // a failed extraction leaves none
+            ++tables;
+            last.emplace(key, extract_calibration_table(scene, copt));
+          }
+          const auto r = calibrate(scene, last->second, copt, quiet);
+          // No constraint force requested: an empty field, never NaN.
+          const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
+          row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
+                            r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
+        } catch (const std::exception& e) {
+          row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
+          ++failed;
+        }
+        rows[index - first] = row;
+        const long d = ++done;
+        if (progress) progress->done(d);
+      }
+    }
+  };
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
   for (auto& t : pool) t.join();
 
-  std::string csv;
-  if (opt.shard == 0) {
-    csv = "case";
-    for (const auto& a : opt.axes) csv += "," + csv_field(a.key);
-    csv += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error\n", value_column,
-                       force.empty() ? "constraint" : force);
-  }
-  for (const auto& r : rows) csv += r + "\n";
-  return {csv, n, failed.load()};
+  SweepResult r;
+  r.csv = sweep_csv(plan.id, plan.range, plan.header, rows);
+  r.cases = n;
+  r.failed = failed.load();
+  r.threads = threads;
+  r.tables = tables.load();
+  r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 }  // namespace rdyn::validate

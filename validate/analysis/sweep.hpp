@@ -1,11 +1,17 @@
 // Population sweeps: many reduced-model cases in parallel threads, one CSV row per case
 // (parameters, calibrated drive load, peak constraint force, speed fluctuation), shardable
 // across machines (Slurm job arrays, GNU parallel): `--shard i/N` runs the i-th of N
-// contiguous blocks of cases, and the shards' CSVs concatenate (only shard 0 writes the header).
+// contiguous blocks of cases; each shard's CSV says which sweep and cases it holds, and
+// merge_sweep_parts (sweep_part.hpp) joins them into what one process would have written.
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "models/scene.hpp"
+#include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/sweep_part.hpp"
+#include "validate/io/progress_meter.hpp"
 
 namespace rdyn::validate {
 
@@ -27,16 +33,39 @@ struct SweepOptions {
   double grid_deg = 10.0;
 };
 
-struct SweepResult {
-  std::string csv;  // header only on shard 0
-  long cases = 0;   // in this shard
-  long failed = 0;  // rows with status "error"
+// A sweep checked and described before any case runs.
+struct SweepPlan {
+  SweepOptions opt;
+  std::vector<models::Override> fixed;  // opt.sets, parsed
+  CalibrationOptions calibration;       // the command line's, else the scene's validation.calibrate
+  std::string force;                    // the first requested constraint force ("" none)
+  SweepIdentity id;                     // the whole sweep: its fingerprint, scene hash and cases
+  SweepRange range;                     // this shard's cases
+  std::string header;                   // the CSV's column header (no line break)
+  std::vector<bool> changes_mechanism;  // per axis: its two ends need two tables (run first)
 };
 
-// Runs the cases of this shard. Every axis key is first applied at both ends of its range to
-// the base scene, so an unknown key or an out-of-range value is a SceneError before any work.
-// A failing case gives a row with status "error" and its message (RFC 4180-quoted), and
-// does not stop the others.
-SweepResult run_sweep(const SweepOptions& opt, bool show_progress);
+// Loads the base scene and checks everything before work: every axis key is applied at both
+// ends of its range to the base scene, so an unknown key or an out-of-range value is a
+// SceneError here; the scene must be calibratable; at most 1e6 cases.
+SweepPlan plan_sweep(const SweepOptions& opt);
+
+struct SweepResult {
+  std::string csv;         // sweep_csv: metadata line, header, this shard's rows
+  long cases = 0;          // in this shard
+  long failed = 0;         // rows with status "error"
+  int threads = 0;         // worker threads used
+  long tables = 0;         // reduced tables extracted (a thread reuses its last one)
+  double elapsed_s = 0.0;  // wall time of the cases
+};
+
+// Runs the cases of the plan's shard, reporting each done case to `progress` (may be null). A
+// failing case gives a row with status "error" and its message (RFC 4180-quoted), and does not
+// stop the others. The cases run with the axes that change the mechanism varying slowest (so a
+// thread's next case mostly reuses its table); the rows are in case order.
+SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress);
+
+// plan_sweep then run_sweep without progress.
+SweepResult run_sweep(const SweepOptions& opt);
 
 }  // namespace rdyn::validate

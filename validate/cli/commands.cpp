@@ -86,8 +86,9 @@ bool is_rdyn_table(const std::string& head) { return head.rfind("# rdyn-table", 
 bool is_rdyn_mjcf(const std::string& head) { return head.rfind("<mujoco model=", 0) == 0; }
 bool is_rdyn_calibrated_scene(const std::string& head) { return head.rfind("# Calibrated by `rdyn calibrate`", 0) == 0; }
 bool is_rdyn_sweep(const std::string& head) {
-  // Shard 0 starts with the header; other shards with a case row "<index>,...,ok|error,".
-  if (head.rfind("case,", 0) == 0) return true;
+  // Since issue #28 every part starts with its metadata line; before, shard 0 started with the
+  // header and other shards with a case row "<index>,...,ok|error,".
+  if (head.rfind("# rdyn-sweep ", 0) == 0 || head.rfind("case,", 0) == 0) return true;
   const std::string first = head.substr(0, head.find('\n'));
   return !first.empty() && std::isdigit(static_cast<unsigned char>(first[0])) &&
          (first.find(",ok,") != std::string::npos || first.find(",error,") != std::string::npos);
@@ -363,9 +364,76 @@ std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
 
 }  // namespace
 
+namespace {
+
+// A sweep part's text, read whole: a part holds at most 1e6 rows of a few hundred bytes, so a
+// larger file is not one (and is not read into memory).
+constexpr std::uintmax_t kMaxPartBytes = std::uintmax_t{1} << 30;
+
+std::string read_sweep_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw models::SceneError(path, 0, "file", "cannot read: no such file");
+  if (!fs::is_regular_file(st)) throw models::SceneError(path, 0, "file", "not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec || size > kMaxPartBytes)
+    throw models::SceneError(path, 0, "file", "larger than 1 GiB: not a part of an rdyn sweep");
+  std::ifstream f(path, std::ios::binary);
+  std::string text(static_cast<size_t>(size), '\0');
+  if (!f.read(text.data(), static_cast<std::streamsize>(size)))
+    throw models::SceneError(path, 0, "file", "cannot read it");
+  return text;
+}
+
+// Why the file at `path` does not already hold the plan's shard complete ("" when it does).
+std::string why_not_complete(const std::string& path, const SweepPlan& plan, SweepPart& part) {
+  try {
+    part = parse_sweep_part(read_sweep_file(path), path);
+  } catch (const models::SceneError& e) {
+    return e.what();
+  }
+  if (part.id.sweep_hex != plan.id.sweep_hex || part.id.total != plan.id.total || part.header != plan.header)
+    return "it holds another sweep (scene, axes or options differ)";
+  if (part.range.shard != plan.range.shard || part.range.shards != plan.range.shards)
+    return fmt::format("it holds shard {}/{}", part.range.shard, part.range.shards);
+  if (!part.complete()) return fmt::format("it is partial (case {} is missing)", part.first_missing());
+  return "";
+}
+
+// The line that ends a sweep shard, its merge or its skip: `done` says what was done; exit 1
+// when cases failed (their rows are in `out`).
+int report_sweep(const std::string& what, const std::string& done, long failed, const std::string& out) {
+  if (failed > 0) {
+    std::fprintf(stderr, "rdyn: %s: %s; %ld failed (rows with status 'error' in %s)\n", what.c_str(), done.c_str(),
+                 failed, out.c_str());
+    return 1;
+  }
+  std::fprintf(stderr, "rdyn: %s: %s; wrote %s\n", what.c_str(), done.c_str(), out.c_str());
+  return 0;
+}
+
+int run_sweep_merge(const SweepArgs& a) {
+  if (a.inputs.empty()) throw ArgumentError("--merge: give the part CSVs after OUT.csv");
+  OutputFile out(a.merge, a.force, is_rdyn_sweep);  // fails early on an unusable destination
+  std::vector<SweepPart> parts;
+  for (const auto& path : a.inputs) parts.push_back(parse_sweep_part(read_sweep_file(path), path));
+  const MergedSweep m = merge_sweep_parts(parts);
+  out.write(m.csv);
+  out.commit();
+  return report_sweep("sweep merge", fmt::format("{} cases from {} parts", m.cases, parts.size()), m.failed, a.merge);
+}
+
+}  // namespace
+
 int run_sweep_command(const SweepArgs& a) {
+  if (!a.merge.empty()) return run_sweep_merge(a);
+  if (a.inputs.size() != 1)
+    throw ArgumentError(fmt::format("sweep: give one scene (got {}); several files are for --merge OUT.csv PART...",
+                                    a.inputs.size()));
+  if (a.out.empty()) throw ArgumentError("--out: give the output CSV file");
   SweepOptions o;
-  o.scene = a.scene;
+  o.scene = a.inputs.front();
   o.sets = a.sets;
   o.cadence_hz = a.cadence_hz.value_or(0.0);  // SweepOptions: 0 is the scene's
   o.power_w = a.power_w.value_or(0.0);
@@ -386,17 +454,28 @@ int run_sweep_command(const SweepArgs& a) {
   }
   if (a.vary.empty()) throw ArgumentError("--vary: give at least one key=a:b:n");
   for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
+  const std::string what = "sweep shard " + a.shard;
+  const SweepPlan plan = plan_sweep(o);
+  // Only a file can hold a finished part: a device or FIFO at --out (/dev/stdout) is written.
+  if (a.resume && std::filesystem::is_regular_file(a.out)) {
+    SweepPart part;
+    const std::string why = why_not_complete(a.out, plan, part);
+    if (why.empty())
+      return report_sweep(what, fmt::format("{} cases already complete: skipped", plan.range.end - plan.range.first),
+                          part.failed, a.out);
+    std::fprintf(stderr, "rdyn: %s: running it again: %s\n", what.c_str(), why.c_str());
+  }
   OutputFile out(a.out, a.force, is_rdyn_sweep);  // fails early on an unusable destination
-  const SweepResult r = run_sweep(o, Progress().enabled());
+  StderrProgress progress(what, plan.range.end - plan.range.first, Progress().enabled());
+  const SweepResult r = run_sweep(plan, &progress);
   out.write(r.csv);
   out.commit();
-  if (r.failed > 0) {
-    std::fprintf(stderr, "rdyn: sweep shard %s: %ld of %ld cases failed (rows with status 'error' in %s)\n",
-                 a.shard.c_str(), r.failed, r.cases, a.out.c_str());
-    return 1;
-  }
-  std::fprintf(stderr, "rdyn: sweep shard %s: %ld cases; wrote %s\n", a.shard.c_str(), r.cases, a.out.c_str());
-  return 0;
+  const double rate = r.elapsed_s > 0 ? static_cast<double>(r.cases) / r.elapsed_s : 0.0;
+  return report_sweep(
+      what,
+      fmt::format("{} cases in {:.3g} s ({:.3g} cases/s, {} threads, {} tables)", r.cases, r.elapsed_s, rate, r.threads,
+                  r.tables),
+      r.failed, a.out);
 }
 
 namespace {

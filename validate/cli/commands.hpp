@@ -81,7 +81,7 @@ struct ReportArgs {
 int run_report(const ReportArgs& args);
 
 struct SweepArgs {
-  std::string scene;
+  std::vector<std::string> inputs;  // the scene; with --merge, the part CSVs
   std::vector<std::string> vary;
   std::vector<std::string> sets;
   std::string out;
@@ -91,6 +91,8 @@ struct SweepArgs {
   std::string load;  // --load, as for calibrate
   double grid_deg = 10.0;
   bool force = false;
+  bool resume = false;  // skip when --out already holds this shard complete
+  std::string merge;    // OUT.csv of `--merge OUT.csv PART...` ("" runs a sweep)
 };
 int run_sweep_command(const SweepArgs& args);
 

@@ -150,24 +150,42 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
       "One CSV row per case: the varied parameters, the calibrated drive load, the peak of the first constraint "
       "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
-      "(Slurm job arrays, GNU parallel); only shard 0 writes the header, so the shards' CSVs concatenate.");
-  sweep->add_option("scene", sw.scene, "Scene name or YAML file")->required();
-  sweep->add_option("--vary", sw.vary, "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)")
-      ->required();
-  sweep->add_option("--set", sw.sets, "Fixed override key.path=value (repeatable)");
-  sweep->add_option("--out", sw.out, "Output CSV file")->required();
+      "(Slurm job arrays, GNU parallel), each CSV naming its sweep and cases; `rdyn sweep --merge OUT.csv PART...` "
+      "checks the parts are one whole sweep and writes what one process would have.");
+  sweep->add_option("scene", sw.inputs, "Scene name or YAML file (with --merge: the part CSVs)")->required();
+  auto* vary = sweep->add_option("--vary", sw.vary,
+                                 "key=a:b:n: n values of a scene key from a to b (repeatable: all combinations)");
+  auto* set = sweep->add_option("--set", sw.sets, "Fixed override key.path=value (repeatable)");
+  auto* out = sweep->add_option("--out", sw.out, "Output CSV file (required unless --merge)");
   sweep->add_flag("--force", sw.force, kForceHelpFile);
-  sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
+  auto* shard = sweep->add_option("--shard", sw.shard, "i/N: run the i-th of N blocks of cases (default 0/1)");
+  auto* resume = sweep->add_flag("--resume", sw.resume,
+                                 "Skip the run when --out already holds this shard complete (a partial or other "
+                                 "sweep's file is run again and replaced)");
   // Typed values are kept apart from the defaults, so a typed 0 is refused instead of meaning "default".
-  sweep->add_option_function<int>("--threads", [&sw](const int& v) { sw.threads = v; },
-                                  "Worker threads, 1..256 (default: hardware threads)");
-  sweep->add_option_function<double>("--cadence-hz", [&sw](const double& v) { sw.cadence_hz = v; },
+  auto* threads = sweep->add_option_function<int>("--threads", [&sw](const int& v) { sw.threads = v; },
+                                                  "Worker threads, 1..256 (default: hardware threads)");
+  auto* cadence = sweep->add_option_function<double>("--cadence-hz", [&sw](const double& v) { sw.cadence_hz = v; },
                                      "Calibration cadence [Hz] (default: the scene's validation.calibrate)");
-  sweep->add_option_function<double>(
+  auto* power = sweep->add_option_function<double>(
       "--power-w", [&sw](const double& v) { sw.power_w = v; },
       "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as given)");
-  sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")->check(names_a_load());
-  sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+  auto* load = sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")
+                   ->check(names_a_load());
+  auto* grid = sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+  sweep->add_option("--merge", sw.merge,
+                    "OUT.csv: merge the part CSVs given as positional arguments (one sweep, every case once) into "
+                    "one file in case order")
+      ->excludes(vary)
+      ->excludes(set)
+      ->excludes(out)
+      ->excludes(shard)
+      ->excludes(resume)
+      ->excludes(threads)
+      ->excludes(cadence)
+      ->excludes(power)
+      ->excludes(load)
+      ->excludes(grid);
 }
 
 void add_inspect_command(CLI::App& app, InspectArgs& ins) {

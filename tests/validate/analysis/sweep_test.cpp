@@ -23,21 +23,35 @@
 namespace rdyn::validate {
 namespace {
 
-TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
+// The shards, run apart (one thread each, in reverse order) and merged, are the whole sweep
+// run at once in two threads, byte for byte; each shard's file names the sweep and its cases.
+TEST(Sweep, MergedShardsAreTheWholeSweep) {
   SweepOptions o;
   o.scene = "bicycle";
   o.axes = {parse_sweep_axis("bicycle_leg.hip_torque_Nm=60:60:1"), parse_sweep_axis("bicycle_leg.crank_length_m=0.16:0.18:3")};
   o.threads = 2;
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   const std::string& whole = r.csv;
   EXPECT_EQ(r.cases, 3);
   EXPECT_EQ(r.failed, 0);
-  std::string parts;
+  std::vector<SweepPart> parts;
   o.shards = 2;
-  for (o.shard = 0; o.shard < 2; ++o.shard) parts += run_sweep(o, false).csv;
-  EXPECT_EQ(parts, whole);
-  // header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
-  EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 4);
+  o.threads = 1;
+  for (o.shard = 1; o.shard >= 0; --o.shard) {
+    const SweepResult s = run_sweep(o);
+    EXPECT_EQ(s.cases, o.shard == 0 ? 2 : 1);
+    parts.push_back(parse_sweep_part(s.csv, fmt::format("part{}.csv", o.shard)));
+    EXPECT_TRUE(parts.back().complete());
+  }
+  EXPECT_EQ(parts[1].id.sweep_hex, parts[0].id.sweep_hex);
+  EXPECT_NE(parts[1].id.sweep_hex, parts[1].id.scene_hex);
+  const MergedSweep m = merge_sweep_parts(parts);
+  EXPECT_EQ(m.csv, whole);
+  EXPECT_EQ(m.cases, 3);
+  // metadata + header + 3 cases, all calibrated at 1 Hz, longer cranks needing less torque.
+  EXPECT_EQ(whole.find("# rdyn-sweep v1 sweep="), 0u) << whole;
+  EXPECT_NE(whole.find(" shard=0/1 cases=0-3/3\ncase,"), std::string::npos) << whole;
+  EXPECT_EQ(std::count(whole.begin(), whole.end(), '\n'), 5);
   EXPECT_EQ(whole.find("error"), whole.find("error\n"));  // only the header's column name
   EXPECT_NE(whole.find(",status,drive_torque_Nm,"), std::string::npos) << whole;
   EXPECT_NE(whole.find(",peak_knee_force_N,"), std::string::npos) << whole;  // the scene's force name
@@ -45,6 +59,7 @@ TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   std::vector<double> torque;
   std::istringstream lines(whole);
   std::string line;
+  std::getline(lines, line);  // metadata
   std::getline(lines, line);  // header
   while (std::getline(lines, line)) {
     std::istringstream cells(line);
@@ -56,6 +71,7 @@ TEST(Sweep, ShardsConcatenateToTheWholeSweep) {
   EXPECT_GT(torque[0], torque[1]);
   EXPECT_GT(torque[1], torque[2]);
 }
+
 
 }  // namespace
 }  // namespace rdyn::validate
@@ -70,9 +86,9 @@ TEST(Sweep, UnknownKeysAndOutOfRangeEndsFailBeforeWork) {
   o.cadence_hz = 1.0;
   o.power_w = 1.0;
   o.axes = {parse_sweep_axis("no_such.key=1:2:3")};
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
   o.axes = {parse_sweep_axis("bodies.crank.mass_kg=1:-1:3")};  // the far end is not a mass
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
 }
 
 // A scene that cannot be calibrated at all (the four-bar has no drive torque) fails before
@@ -83,7 +99,7 @@ TEST(Sweep, UncalibratableSceneFailsBeforeWork) {
   o.cadence_hz = 1.0;
   o.power_w = 1.0;
   o.axes = {parse_sweep_axis("bodies.crank.mass_kg=0.4:0.6:3")};
-  EXPECT_THROW(run_sweep(o, false), models::SceneError);
+  EXPECT_THROW(run_sweep(o), models::SceneError);
 }
 
 // Removes a temporary scene file however the test ends (a throwing run_sweep included).
@@ -115,23 +131,28 @@ TEST(Sweep, FailingCasesAreCountedAndReported) {
   o.sets = {"gravity.enabled=false"};  // no stall: the torque–cadence map is monotonic
   o.axes = {parse_sweep_axis("ground_points.D.0=0.30:3.0:2")};
   o.threads = 2;
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   EXPECT_EQ(r.cases, 2);
   EXPECT_EQ(r.failed, 1) << r.csv;
-  const auto lines = r.csv.substr(r.csv.find('\n') + 1);
+  const auto header = r.csv.find('\n') + 1;  // after the metadata line
+  const auto lines = r.csv.substr(r.csv.find('\n', header) + 1);
   EXPECT_EQ(lines.find("0,0.3,ok,"), 0u) << r.csv;                 // the first case calibrates
   EXPECT_NE(lines.find("1,3,error,,,,,,"), std::string::npos) << r.csv;  // the second names its loop
 }
 
 // A named load through the sweep: a flywheel's motor against viscous drag c, calibrated to a
 // mean speed (no power): each row holds s = c·ω/(1 − ω/ω0) in a column named for the load's kind.
-// The sweep's CSV lines (the header first), with every case expected to succeed.
+// The sweep's CSV lines after the metadata line (the header first), with every case expected
+// to succeed.
 std::vector<std::string> successful_rows(const SweepOptions& o) {
-  const SweepResult r = run_sweep(o, false);
+  const SweepResult r = run_sweep(o);
   EXPECT_EQ(r.failed, 0) << r.csv;
   std::vector<std::string> rows;
   std::istringstream lines(r.csv);
-  for (std::string line; std::getline(lines, line);) rows.push_back(line);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line.find("# rdyn-sweep v1 "), 0u) << line;
+  while (std::getline(lines, line)) rows.push_back(line);
   return rows;
 }
 
@@ -191,11 +212,12 @@ TEST(Sweep, ABranchCheckIsNeverSkippedByAReusedTable) {
   o.threads = 1;
   for (const char* axis : {"loops.C.branch.sign=1:-1:2", "loops.C.branch.sign=-1:1:2"}) {
     o.axes = {parse_sweep_axis(axis)};
-    const SweepResult r = run_sweep(o, false);
+    const SweepResult r = run_sweep(o);
     EXPECT_EQ(r.failed, 1) << axis << "\n" << r.csv;
     std::istringstream lines(r.csv);
     std::string line;
-    std::getline(lines, line);
+    std::getline(lines, line);  // metadata
+    std::getline(lines, line);  // header
     while (std::getline(lines, line)) {
       const bool negative = line.find(",-1,") != std::string::npos;
       EXPECT_EQ(line.find(",error,") != std::string::npos, negative) << axis << ": " << line;
@@ -228,6 +250,60 @@ TEST(Sweep, ReusedTableGivesTheCaseItsOwnCalibration) {
       EXPECT_NE(line.find(fmt::format(",ok,{:.10g},", own.load_value)), std::string::npos)
           << line << " vs " << own.load_value;
     }
+}
+
+
+// The cases of one mechanism run one after the other whatever the order of --vary: with the
+// rider's height (a new table) as the last, fastest axis, one thread extracts two tables for
+// four cases, not four, and each row holds what the other axis order gives for its case.
+TEST(Sweep, CasesOfOneMechanismRunTogetherWhateverTheAxisOrder) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.threads = 1;
+  o.axes = {parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:2"),
+            parse_sweep_axis("bicycle_leg.subject.height_m=1.7:1.8:2")};
+  const SweepPlan plan = plan_sweep(o);
+  EXPECT_EQ(plan.changes_mechanism, (std::vector<bool>{false, true}));
+  const SweepResult height_last = run_sweep(plan, nullptr);
+  EXPECT_EQ(height_last.tables, 2);
+  EXPECT_EQ(height_last.failed, 0) << height_last.csv;
+  std::swap(o.axes[0], o.axes[1]);
+  const SweepResult height_first = run_sweep(o);
+  EXPECT_EQ(height_first.tables, 2);
+  // Row (p, h) of the first against row (h, p) of the second, from the status on.
+  auto rows_of = [](const std::string& csv) {
+    std::vector<std::string> rows;
+    std::istringstream lines(csv);
+    std::string line;
+    std::getline(lines, line);  // metadata
+    std::getline(lines, line);  // header
+    while (std::getline(lines, line)) rows.push_back(line.substr(line.find(",ok,")));
+    return rows;
+  };
+  const auto a = rows_of(height_last.csv), b = rows_of(height_first.csv);
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  for (int p = 0; p < 2; ++p)
+    for (int h = 0; h < 2; ++h) EXPECT_EQ(a[2 * p + h], b[2 * h + p]) << p << " " << h;
+}
+
+// Two threads take whole mechanisms while there are at least 4 per thread (3 powers × 8 heights:
+// chunks of up to 24/8 = 3 cases): each of the 8 tables is extracted once, and the file is the
+// one thread's, byte for byte.
+TEST(Sweep, ThreadsTakeWholeMechanismsAndWriteTheSameFile) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.resistance.power_W=100:150:3"),
+            parse_sweep_axis("bicycle_leg.subject.height_m=1.6:1.9:8")};
+  o.threads = 2;
+  const SweepResult two = run_sweep(o);
+  EXPECT_EQ(two.threads, 2);
+  EXPECT_EQ(two.tables, 8);
+  EXPECT_EQ(two.failed, 0) << two.csv;
+  o.threads = 1;
+  const SweepResult one = run_sweep(o);
+  EXPECT_EQ(one.tables, 8);
+  EXPECT_EQ(two.csv, one.csv);
 }
 
 }  // namespace
