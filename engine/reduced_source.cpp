@@ -127,6 +127,7 @@ reduced::GridSample FullKinetostaticSource::sample_fast(double q, bool with_cons
   }
   // Singular configuration: as sample_here.
   g.singular = ws_.impl().near_singular_projections > singular_before || k.conditioning < kSingularConditioning;
+  g.conditioning = k.conditioning;
   return g;
 }
 

@@ -224,6 +224,7 @@ struct SweepColumns {
   std::vector<std::vector<double>> poles;  // [force]: singular points where its columns have a pole
   // Singular grid points given their limit, with the pole residues their side samples show.
   std::vector<std::pair<long, std::vector<std::array<double, 3>>>> pole_residues;
+  double min_conditioning = 1.0;  // over the grid samples
   // Joints gating loads (their ratio's zeros are the switch angles, refined during the sweep)
   // and the zeros found; joints whose angle a profiled load reads.
   std::vector<int> gate_joints, profile_joints;
@@ -371,6 +372,49 @@ void store_sample(const GridSample& gs, long i, const GridPlan& g, SweepColumns&
 // One visit per grid point: (i) and (ii) when the method needs them, the static call for
 // position-only loads (only when the scene has some), and the velocity ratios; the gates'
 // switch angles and the point forces' meetings between consecutive points.
+// A configuration of rank loss between grid points (ExtractOptions::singular_hints): the pole
+// test of a singular grid point (sweep_refine.hpp) at q_s, its residue confirmed at q_s ± 4δ
+// (4δ ≤ the grid step) as find_force_poles confirms it at the grid neighbours; a pole is listed
+// like a grid point's. The samples run forward, q_s − 4δ to q_s + 4δ, crossing q_s once as the
+// sweep does. Returns nothing; the sweep goes on to the next grid point.
+void check_pole_between(KinetostaticSource& src, double q_s, const GridPlan& g, bool conservative_loads,
+                        SweepColumns& c) {
+  const double d = std::min(kSingularLimitStep_rad, g.h / 4);
+  const GridSample lo = src.sample(q_s - 4 * d, conservative_loads);
+  GridSample at;  // the limit's own values are not kept: only the residues
+  std::vector<std::array<double, 3>> res;
+  if (!calc_singular_limit(src, q_s, g.h, conservative_loads, at, &res)) return;
+  const GridSample hi = src.sample(q_s + 4 * d, conservative_loads);
+  for (int k = 0; k < g.nk && k < static_cast<int>(res.size()); ++k) {
+    const double far[3] = {
+        hi.acceleration.constraint_forces.at(k) - lo.acceleration.constraint_forces.at(k),
+        hi.velocity.constraint_forces.at(k) - lo.velocity.constraint_forces.at(k),
+        hi.conservative.forces.constraint_forces.size() > static_cast<size_t>(k) &&
+                lo.conservative.forces.constraint_forces.size() > static_cast<size_t>(k)
+            ? hi.conservative.forces.constraint_forces[k] - lo.conservative.forces.constraint_forces[k]
+            : 0.0};
+    bool pole = false;
+    for (int j = 0; j < 3; ++j) {
+      const double a = res[k][j];
+      if (a != 0.0) pole = pole || std::abs(0.5 * far[j] * 4 * d - a) < 0.3 * std::abs(a);
+    }
+    if (pole) c.poles[k].push_back(q_s);
+  }
+}
+
+// The hints inside (a, b), a turn's hints mapped into [q_first, q_first + 2π) when periodic.
+std::vector<double> hints_between(const ExtractOptions& opt, const GridPlan& g, double q_first, double a, double b) {
+  std::vector<double> out;
+  for (double q : opt.singular_hints) {
+    if (!std::isfinite(q)) continue;
+    if (g.periodic) q = q_first + std::fmod(std::fmod(q - q_first, 2 * kPi) + 2 * kPi, 2 * kPi);
+    const double eps = 1e-9 * std::max(1.0, std::abs(q));
+    if (q > a + eps && q < b - eps) out.push_back(q);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 void sweep_grid(KinetostaticSource& src, const models::Scene& scene, const ExtractOptions& opt, const GridPlan& g,
                 const Samples& s, SweepColumns& c) {
   const long n = g.n;
@@ -380,7 +424,11 @@ void sweep_grid(KinetostaticSource& src, const models::Scene& scene, const Extra
   for (long i = 0; i < n; ++i) {
     GridSample gs;
     if (inertial_here) {
+      if (i >= 1)
+        for (double q_s : hints_between(opt, g, s.q[0], s.q[i - 1], s.q[i]))
+          check_pole_between(src, q_s, g, conservative_loads, c);
       gs = src.sample(s.q[i], conservative_loads);
+      c.min_conditioning = std::min(c.min_conditioning, gs.conditioning);
       // A singular grid point gets the limit along the branch from both sides (a range's end
       // points have one side only: they keep the repair below, which refuses them).
       if (gs.singular && (g.periodic || (i > 0 && i < n - 1))) {
@@ -608,6 +656,8 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     for (long i = 1; i < g.n; ++i) c.m1[i] = c.m1[0] + integral[i];
   }
   find_force_poles(g, s, c);
+  for (auto& p : c.poles) std::sort(p.begin(), p.end());  // grid points' and between them
+  s.min_conditioning = c.min_conditioning;
   repair_singular_samples(g, s, c);
   const auto& forces = scene.outputs.constraint_forces;
   s.add("m1", c.m1);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "models/scene.hpp"
@@ -53,7 +54,15 @@ struct ExtractOptions {
   // Set: a non-periodic table over the range (range_intervals); empty: one period of a
   // revolute coordinate that turns fully.
   std::optional<ExtractRange> range;
+  // Configurations of rank loss between grid points (the full model's scan), where a constraint
+  // force may have a pole the grid samples do not show: each is checked as a singular grid point
+  // is (sweep_refine.hpp) when the sweep passes it, and a pole found is listed. [rad or m]
+  std::vector<double> singular_hints;
 };
+
+// Below this conditioning at a grid point, rank loss may lie between grid points: the caller
+// (validate's extract_from_full) scans for it and extracts again with singular_hints.
+inline constexpr double kScanBelowConditioning = 0.05;
 
 // Samples one period of a revolute independent coordinate, starting from the grid point
 // nearest the scene's initial q and continuing from point to point (so the full model stays

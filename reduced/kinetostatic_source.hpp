@@ -54,6 +54,10 @@ struct GridSample {
   // The configuration is singular (the loop Jacobian lost rank): velocities and forces there
   // are not determined by the constraints, so the sample is not trustworthy.
   bool singular = false;
+  // The loop Jacobian's conditioning there (smallest over largest singular value of its free
+  // columns; 1 without loops), when the source gives it; near rank loss it falls like the
+  // distance to it. The extraction looks for rank loss between grid points where it is small.
+  double conditioning = 1.0;
 };
 
 class KinetostaticSource {

@@ -57,6 +57,9 @@ struct Samples {
   // [rad or m]. No interpolation represents them there; the reduced model refuses the force's
   // rows near them (reduced_model.hpp, check_force_poles).
   std::vector<std::pair<std::string, std::vector<double>>> poles;
+  // The smallest loop conditioning over the grid samples (1 when the source gives none; not
+  // written to the table).
+  double min_conditioning = 1.0;
   const std::vector<double>* roots_of(const std::string& column) const;  // null when absent
 
   int column(const std::string& name) const;  // −1 when absent
