@@ -168,11 +168,20 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
     const auto *a = s.find_joint(g.driver), *b = s.find_joint(g.driven);
     if (a && b) seg("gear", g.name, joint_pt(*a), joint_pt(*b), "stroke=\"#7f8c8d\" stroke-dasharray=\"8 4\"");
   }
+  // A prismatic joint as the stroke from its parent point to its child point (a cylinder's length).
+  for (const auto& j : s.joints)
+    if (j.type == models::JointType::Prismatic)
+      seg("slide", j.name, point_of(pts, j.parent, j.parent_point), joint_pt(j), "stroke=\"#2c3e50\" stroke-width=\"6\"");
   o += "</g>\n<g class=\"bodies\" stroke=\"#2c3e50\" stroke-width=\"3\" stroke-linejoin=\"round\">\n";
   for (const auto& b : s.bodies) {
     const auto idx = body_outline(pts, b.name);
     std::string list, path;
     for (int i : idx) list += (list.empty() ? "" : " ") + std::to_string(i), path += num(X(i)) + "," + num(-Y(i)) + " ";
+    if (idx.size() == 1) {  // a body with one point (a cylinder's barrel): a disc there
+      o += fmt::format("<circle data-body=\"{}\" {} cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"#5dade2\"/>\n",
+                       html_escape(b.name), at(idx[0]), num(X(idx[0])), num(-Y(idx[0])), num(2 * r));
+      continue;
+    }
     const bool polygon = idx.size() >= 3;
     o += fmt::format("<{} data-body=\"{}\" data-is=\"{}\" points=\"{}\" fill=\"{}\" fill-opacity=\"0.35\"/>\n",
                      polygon ? "polygon" : "polyline", html_escape(b.name), list, path, polygon ? "#5dade2" : "none");
@@ -211,7 +220,10 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
 std::string q_text(const models::Scene& s, double q) {
   const auto* j = s.find_joint(s.independent);
   const bool rev = !j || j->type == models::JointType::Revolute;
-  return rev ? fmt::format("{} = {:.2f}°", s.independent, q * 180 / 3.14159265358979323846)
+  const double deg = q * 180 / 3.14159265358979323846;
+  if (rev && std::abs(deg) >= 360)  // an unwrapped angle: also within one turn, as a dial reads it
+    return fmt::format("{} = {:.2f}° ({:.2f}° in the turn)", s.independent, deg, deg - 360 * std::floor(deg / 360));
+  return rev ? fmt::format("{} = {:.2f}°", s.independent, deg)
              : fmt::format("{} = {:.4f} m", s.independent, q);
 }
 
