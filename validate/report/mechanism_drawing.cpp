@@ -168,9 +168,10 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
     const auto *a = s.find_joint(g.driver), *b = s.find_joint(g.driven);
     if (a && b) seg("gear", g.name, joint_pt(*a), joint_pt(*b), "stroke=\"#7f8c8d\" stroke-dasharray=\"8 4\"");
   }
-  // A prismatic joint as the stroke from its parent point to its child point (a cylinder's length).
+  // A prismatic joint between bodies as the stroke from its parent point to its child point (a
+  // cylinder's length); one on ground already has its rail.
   for (const auto& j : s.joints)
-    if (j.type == models::JointType::Prismatic)
+    if (j.type == models::JointType::Prismatic && j.parent != models::kGround)
       seg("slide", j.name, point_of(pts, j.parent, j.parent_point), joint_pt(j), "stroke=\"#2c3e50\" stroke-width=\"6\"");
   o += "</g>\n<g class=\"bodies\" stroke=\"#2c3e50\" stroke-width=\"3\" stroke-linejoin=\"round\">\n";
   for (const auto& b : s.bodies) {
