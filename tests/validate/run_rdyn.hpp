@@ -44,12 +44,10 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-inline RdynRun run_rdyn(const std::vector<std::string>& args, const std::filesystem::path& cwd,
-                        const RunLimits& limits = {}) {
+// Any program (argv[0] looked up in PATH, as posix_spawnp does), e.g. the browser tests' chromium.
+inline RdynRun run_argv(std::vector<std::string> argv, const std::filesystem::path& cwd, const RunLimits& limits = {}) {
   namespace fs = std::filesystem;
   const fs::path out_file = cwd / ".stdout", err_file = cwd / ".stderr";
-  std::vector<std::string> argv{RDYN_BINARY};
-  argv.insert(argv.end(), args.begin(), args.end());
   std::vector<char*> cargs;
   for (auto& a : argv) cargs.push_back(a.data());
   cargs.push_back(nullptr);
@@ -67,7 +65,7 @@ inline RdynRun run_rdyn(const std::vector<std::string>& args, const std::filesys
       rlimit rl{static_cast<rlim_t>(limits.file_size_limit), static_cast<rlim_t>(limits.file_size_limit)};
       setrlimit(RLIMIT_FSIZE, &rl);
     }
-    execv(cargs[0], cargs.data());
+    execvp(cargs[0], cargs.data());
     _exit(127);
   }
   const auto start = std::chrono::steady_clock::now();
@@ -98,6 +96,13 @@ inline RdynRun run_rdyn(const std::vector<std::string>& args, const std::filesys
   fs::remove(out_file);
   fs::remove(err_file);
   return r;
+}
+
+inline RdynRun run_rdyn(const std::vector<std::string>& args, const std::filesystem::path& cwd,
+                        const RunLimits& limits = {}) {
+  std::vector<std::string> argv{RDYN_BINARY};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return run_argv(std::move(argv), cwd, limits);
 }
 
 }  // namespace rdyn::test

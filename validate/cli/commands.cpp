@@ -23,6 +23,8 @@
 #include "validate/io/escape.hpp"
 #include "validate/harness/harness.hpp"
 #include "validate/cli/inspect.hpp"
+#include "validate/cli/animate_command.hpp"
+#include "engine/inspect.hpp"
 #include "validate/report/report.hpp"
 #include "validate/harness/summary.hpp"
 #include "validate/analysis/sweep.hpp"
@@ -95,6 +97,13 @@ bool is_rdyn_sweep(const std::string& head) {
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
+
+// The validation summary with the assembled mechanism drawn (`inspect --svg`'s drawing), which
+// the report embeds: kept in summary.json so that `rdyn report` re-draws it too.
+nlohmann::json with_drawing(nlohmann::json summary, const models::Scene& scene) {
+  summary["mechanism_svg"] = inspect_svg(scene, engine::calc_inspection(engine::FullModel(scene)));
+  return summary;
+}
 
 }  // namespace
 
@@ -318,7 +327,7 @@ namespace {
 nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
                             Progress& progress, bool& pass) {
   const ValidationResult v = run_validation(scene, opt, progress);
-  const nlohmann::json full = summary_json(v);
+  const nlohmann::json full = with_drawing(summary_json(v), scene);
   render_report(full, dir);
   pass = v.pass;
   nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
@@ -623,7 +632,7 @@ int run_validate(const ValidateArgs& a) {
   opt.quick = a.quick;
   opt.peers = a.peers;
   const ValidationResult v = run_validation(scene, opt, progress);
-  const nlohmann::json summary = summary_json(v);
+  const nlohmann::json summary = with_drawing(summary_json(v), scene);
   render_report(summary, out.file(""));
   out.commit();
   std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());

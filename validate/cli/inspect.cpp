@@ -2,7 +2,11 @@
 
 #include <cstdio>
 
+#include <memory>
+
 #include "models/scene_yaml.hpp"
+#include "validate/cli/animate_command.hpp"
+#include "validate/io/output_dir.hpp"
 
 namespace rdyn::validate {
 
@@ -84,9 +88,16 @@ int run_inspect(const InspectArgs& a) {
   std::vector<models::Override> overrides;
   for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
   const models::Scene scene = models::load_scene(a.scene, overrides);
+  // The drawing's destination is checked before any work.
+  std::unique_ptr<OutputFile> svg;
+  if (!a.svg.empty()) svg = std::make_unique<OutputFile>(a.svg, a.force, is_rdyn_svg);
   const engine::FullModel model(scene);
   const auto in = engine::calc_inspection(model);
   for (const auto& w : in.warnings) std::fprintf(stderr, "rdyn: warning: %s\n", w.c_str());
+  if (svg) {
+    svg->write(inspect_svg(scene, in));
+    svg->commit();
+  }
   const std::string text = inspection_json(scene, in).dump(2) + "\n";
   std::fputs(text.c_str(), stdout);
   return 0;

@@ -22,6 +22,8 @@ nlohmann::json assembly_json(const engine::Inspection& assembly);
 struct InspectArgs {
   std::string scene;
   std::vector<std::string> sets;
+  std::string svg;     // --svg FILE: also draw the assembled configuration (empty: no drawing)
+  bool force = false;  // replace an existing FILE rdyn did not write
 };
 // Prints the JSON on standard output and the warnings on standard error; returns 0. Throws like
 // the other commands (SceneError, EngineError: exit 2; NumericalError: exit 1).

@@ -9,6 +9,7 @@
 #include "models/scene.hpp"
 #include "reduced/samples.hpp"
 #include "validate/cli/cli_options.hpp"
+#include "validate/cli/animate_command.hpp"
 #include "validate/cli/commands.hpp"
 #include "validate/cli/expand.hpp"
 #include "validate/cli/inspect.hpp"
@@ -197,6 +198,31 @@ void add_inspect_command(CLI::App& app, InspectArgs& ins) {
       "dead points, found by continuation) and warnings (also on standard error).");
   inspect->add_option("scene", ins.scene, "Scene name or YAML file")->required();
   inspect->add_option("--set", ins.sets, "Override a scalar of the scene: key.path=value (repeatable)");
+  inspect->add_option("--svg", ins.svg,
+                      "Also draw the assembled configuration as SVG into FILE: every joint (data-joint, data-x, "
+                      "data-y in metres), body (data-body), ground pivot, loop, spring and point force; the range "
+                      "and dead points noted");
+  inspect->add_flag("--force", ins.force, kForceHelpFile);
+}
+
+void add_animate_command(CLI::App& app, AnimateArgs& an) {
+  auto* animate = app.add_subcommand(
+      "animate",
+      "Simulate a scene (every joint's coordinate output) and write DIR/animation.html: one self-contained page "
+      "(inline SVG, script and frames; no network) playing the mechanism with play/pause, a time slider, speed, "
+      "the independent coordinate's value, arrows for the requested constraint forces and reactions, and traced "
+      "points' paths. animation.html#t=T shows the pose at T (clamped to the run).");
+  animate->add_option("scene", an.scene, "Scene name or YAML file")->required();
+  animate->add_option("--model", an.model, "full (Simbody, default) or reduced (table at 10°, Eksergian's equation)")
+      ->check(CLI::IsMember({"full", "reduced"}));
+  animate->add_option_function<double>("--duration", [&an](const double& v) { an.duration = v; },
+                                       "Time simulated [s] (default: the scene's)");
+  animate->add_option_function<double>("--dt-out", [&an](const double& v) { an.dt_out = v; },
+                                       "Output interval [s] (default: the scene's); at most 2000 frames are kept");
+  animate->add_option("--trace", an.traces,
+                      "BODY.POINT whose path is drawn (repeatable; default: the named points where loops close)");
+  add_scene_overrides(*animate, an.sets);
+  add_output_folder(*animate, an.out, an.force);
 }
 
 void add_export_mjcf_command(CLI::App& app, ExportMjcfArgs& mj) {
@@ -299,6 +325,7 @@ struct CommandArgs {
   OptimizeArgs opz;
   DriveArgs drv;
   ExpandArgs exp;
+  AnimateArgs an;
 };
 
 // Runs the one subcommand given; the errors a command reports become the exit status (README,
@@ -316,6 +343,7 @@ int run_command(const CLI::App& app, const CommandArgs& a) {
     if (app.got_subcommand("optimize")) return run_optimize(a.opz);
     if (app.got_subcommand("drive")) return run_drive(a.drv);
     if (app.got_subcommand("expand")) return run_expand(a.exp);
+    if (app.got_subcommand("animate")) return run_animate(a.an);
   } catch (const rdyn::models::SceneError& e) {
     std::fprintf(stderr, "rdyn: error: %s\n", e.what());
     return kExitBadInput;
@@ -364,6 +392,7 @@ int main(int argc, char** argv) {
   add_optimize_command(app, a.opz);
   add_drive_command(app, a.drv);
   add_expand_command(app, a.exp);
+  add_animate_command(app, a.an);
   require_decimal_numbers(app);
   try {
     app.parse(argc, argv);

@@ -183,3 +183,43 @@ TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
 
 }  // namespace
 }  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// Standard base64 decoding, written here as the second route to the report's encoder.
+std::string from_base64(const std::string& in) {
+  const std::string k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  int bits = 0;
+  unsigned v = 0;
+  for (char c : in) {
+    if (c == '=') break;
+    v = (v << 6) | static_cast<unsigned>(k.find(c));
+    bits += 6;
+    if (bits >= 8) out += static_cast<char>((v >> (bits - 8)) & 255), bits -= 8;
+  }
+  return out;
+}
+
+TEST(Report, EmbedsTheMechanismDrawingAsAnImage) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_report_svg_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const std::string& svg : {std::string("<svg><script>alert(1)</script>x</svg>"), std::string("<svg>ab</svg>"),
+                                std::string("<svg>a</svg>")}) {  // the three padding cases
+    auto s = summary_json(test::synthetic_validation());
+    s["mechanism_svg"] = svg;
+    render_report(s, dir.string());
+    const std::string html = test::slurp(dir / "report.html");
+    const auto at = html.find("src=\"data:image/svg+xml;base64,");
+    ASSERT_NE(at, std::string::npos);
+    const auto start = at + std::string("src=\"data:image/svg+xml;base64,").size();
+    EXPECT_EQ(from_base64(html.substr(start, html.find('"', start) - start)), svg);
+    EXPECT_EQ(html.find("<script>alert"), std::string::npos);  // never inline: an image cannot run script
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rdyn::validate
