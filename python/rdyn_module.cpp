@@ -240,12 +240,12 @@ PYBIND11_MODULE(_rdyn, m) {
              }
              raise_status(s);
            },
-           py::arg("dt"), py::arg("torque").none(true), py::arg("scale").none(true))
+           py::arg("dt"), py::arg("torque").none(true) = py::none(), py::arg("scale").none(true) = py::none())
       .def("reset",
            [](Runtime& r, double q, double qdot, std::optional<double> torque, std::optional<double> scale) {
              raise_status(rr::reset(r.model, r.ws, q, qdot, drive_of(torque, scale)));
            },
-           py::arg("q"), py::arg("qdot"), py::arg("torque").none(true), py::arg("scale").none(true))
+           py::arg("q"), py::arg("qdot"), py::arg("torque").none(true) = py::none(), py::arg("scale").none(true) = py::none())
       .def_property_readonly("t", [](const Runtime& r) { return r.ws.get_t(); })
       .def_property_readonly("q", [](const Runtime& r) { return r.ws.get_q(); })
       .def_property_readonly("qdot", [](const Runtime& r) { return r.ws.get_qdot(); })
