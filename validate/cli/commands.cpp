@@ -107,8 +107,7 @@ nlohmann::json with_drawing(nlohmann::json summary, const models::Scene& scene) 
 
 }  // namespace
 
-int run_simulate(const SimulateArgs& a) {
-  const models::Scene scene = load(a.scene, a.sets);
+void check_simulate_args(const models::Scene& scene, const SimulateArgs& a) {
   const double duration = a.duration.value_or(scene.simulation.duration_s);
   const double dt_out = a.dt_out.value_or(scene.simulation.output_interval_s);
   const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
@@ -122,8 +121,13 @@ int run_simulate(const SimulateArgs& a) {
       duration / a.fixed_step > cli_limits::kMaxFixedSteps)
     throw ArgumentError(fmt::format("--fixed-step: {:g} s over {:g} s makes {:.3g} steps; at most {:g}", a.fixed_step,
                                     duration, duration / a.fixed_step, cli_limits::kMaxFixedSteps));
-  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+}
 
+SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, const reduced::Samples* table) {
+  check_simulate_args(scene, a);
+  const double duration = a.duration.value_or(scene.simulation.duration_s);
+  const double dt_out = a.dt_out.value_or(scene.simulation.output_interval_s);
+  const double tolerance = a.tolerance.value_or(scene.simulation.tolerance);
   nlohmann::json run = {{"scene", scene.name},     {"scene_file", scene.source_file}, {"model", a.model},
                         {"duration_s", duration},  {"output_interval_s", dt_out}};
   {  // The assembled configuration (every joint coordinate at t = 0), with its warnings.
@@ -171,7 +175,10 @@ int run_simulate(const SimulateArgs& a) {
     const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
     reduced::Samples samples;
     double extraction_ms = 0.0;
-    if (!a.table.empty()) {
+    if (table) {  // a table in memory (the Python module's Table)
+      samples = *table;
+      run["table"] = table->file.empty() ? std::string("(in memory)") : table->file;
+    } else if (!a.table.empty()) {
       // Checked before opening: a FIFO without a writer would block (models::non_regular_file_kind).
       if (const std::string kind = models::non_regular_file_kind(a.table); !kind.empty())
         throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
@@ -206,7 +213,6 @@ int run_simulate(const SimulateArgs& a) {
                 {"extraction_ms", extraction_ms},
                 {"events", ts.stats.events}});
   }
-  write_timeseries_csv(out.file("timeseries.csv"), ts);
   const auto eb = energy_balance(ts);
   run.update({{"steps_taken", ts.stats.steps_taken},
               {"steps_attempted", ts.stats.steps_attempted},
@@ -215,6 +221,17 @@ int run_simulate(const SimulateArgs& a) {
               {"wall_time_per_simulated_s", ts.stats.wall_time_s / duration},
               {"energy_balance_residual_J", eb.max_residual_J},
               {"energy_scale_J", eb.energy_scale_J}});
+  return {std::move(ts), std::move(run)};
+}
+
+int run_simulate(const SimulateArgs& a) {
+  const models::Scene scene = load(a.scene, a.sets);
+  check_simulate_args(scene, a);
+  OutputDir out(a.out, a.force);  // fails early on an unusable folder
+  const auto [ts, run] = simulate_scene(scene, a);
+  const double duration = run["duration_s"].get<double>();
+  const auto eb = energy_balance(ts);
+  write_timeseries_csv(out.file("timeseries.csv"), ts);
   write_json(out.file("run.json"), run);
   out.commit();
   std::fprintf(stderr, "%s\n",
@@ -226,14 +243,22 @@ int run_simulate(const SimulateArgs& a) {
   return 0;
 }
 
+Extraction extract_scene(const models::Scene& scene, double grid_deg, const std::string& method) {
+  require_grid("--grid-deg", grid_deg);
+  const auto m = reduced::parse_method(method);
+  const models::Scene oscene = reduced_reactions(scene).scene;
+  return extract_from_full(reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene,
+                           grid_deg, m);
+}
+
+bool is_rdyn_table_file(const std::string& head) { return is_rdyn_table(head); }
+
 int run_extract(const ExtractArgs& a) {
   require_grid("--grid-deg", a.grid_deg);
   const models::Scene scene = load(a.scene, a.sets);
-  const auto method = reduced::parse_method(a.method);
+  reduced::parse_method(a.method);  // a bad method is refused before the destination is touched
   OutputFile out(a.out, a.force, is_rdyn_table);  // fails early on an unusable destination
-  const models::Scene oscene = reduced_reactions(scene).scene;
-  const auto e = extract_from_full(reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene,
-                                   a.grid_deg, method);
+  const auto e = extract_scene(scene, a.grid_deg, a.method);
   out.write(reduced::format_samples_csv(e.samples));
   out.commit();
   std::string range;  // range tables: the span and, when found, the dead points
@@ -262,11 +287,7 @@ int run_calibrate(const CalibrateArgs& a) {
   require_grid("--grid-deg", a.grid_deg);
   const std::string text = models::read_scene_text(a.scene);  // once: the scene may be a stream
   const models::Scene scene = models::parse_scene(text, models::resolve_scene_path(a.scene), base);
-  CalibrationOptions opt = calibration_options_of(scene, a.cadence_given ? a.cadence_hz : 0.0,
-                                                  a.power_given ? a.power_w : 0.0, a.load);
-  if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
-  opt.grid_deg = a.grid_deg;
-  opt.interpolation = a.interpolation;
+  CalibrationOptions opt = check_calibrate_args(scene, a);
   // --write-scene with --force: a full-model miss still writes the scene (marked), then exit 1.
   opt.keep_unconfirmed = a.force && !a.write_scene.empty();
   if (!a.write_scene.empty()) check_writable(text, scene, opt);
@@ -274,6 +295,33 @@ int run_calibrate(const CalibrateArgs& a) {
   if (!a.write_scene.empty()) out = std::make_unique<OutputFile>(a.write_scene, a.force, is_rdyn_calibrated_scene);
   Progress progress;
   const auto r = calibrate(scene, opt, progress);
+  nlohmann::json j = calibration_json(scene, opt, r);
+  if (out) {
+    out->write(calibrated_scene_yaml(a.scene, text, base, scene, opt, r));
+    out->commit();
+    j["written_scene"] = a.write_scene;
+  }
+  if (!r.unconfirmed.empty())
+    throw models::NumericalError(r.unconfirmed + "; the scene was written to " + a.write_scene +
+                                 " all the same (--force), marked as not confirmed");
+  std::printf("%s\n", j.dump(2).c_str());
+  return 0;
+}
+
+CalibrationOptions check_calibrate_args(const models::Scene& scene, const CalibrateArgs& a) {
+  if (a.cadence_given) require_positive_up_to("--cadence-hz", a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
+  if (a.power_given) require_positive_up_to("--power-w", a.power_w, cli_limits::kMaxPower_W, " W");
+  require_grid("--grid-deg", a.grid_deg);
+  CalibrationOptions opt = calibration_options_of(scene, a.cadence_given ? a.cadence_hz : 0.0,
+                                                  a.power_given ? a.power_w : 0.0, a.load);
+  if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
+  opt.grid_deg = a.grid_deg;
+  opt.interpolation = a.interpolation;
+  return opt;
+}
+
+nlohmann::json calibration_json(const models::Scene& scene, const CalibrationOptions& opt,
+                                const CalibrationResult& r) {
   auto number_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   const bool joint_torque = std::isfinite(r.torque_Nm);
   nlohmann::json j = {
@@ -309,16 +357,7 @@ int run_calibrate(const CalibrateArgs& a) {
     j["initial_guess_Nm"] = r.initial_guess;
     j["drive_work_per_rev_per_Nm"] = r.work_per_rev_per_unit;
   }
-  if (out) {
-    out->write(calibrated_scene_yaml(a.scene, text, base, scene, opt, r));
-    out->commit();
-    j["written_scene"] = a.write_scene;
-  }
-  if (!r.unconfirmed.empty())
-    throw models::NumericalError(r.unconfirmed + "; the scene was written to " + a.write_scene +
-                                 " all the same (--force), marked as not confirmed");
-  std::printf("%s\n", j.dump(2).c_str());
-  return 0;
+  return j;
 }
 
 namespace {

@@ -7,6 +7,12 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "models/scene.hpp"
+#include "models/timeseries.hpp"
+#include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/calibrate.hpp"
 #include "validate/io/argument_error.hpp"
 
 namespace rdyn::validate {
@@ -33,6 +39,17 @@ struct SimulateArgs {
   double fixed_step = 1e-3;
 };
 int run_simulate(const SimulateArgs& args);
+// What `rdyn simulate` computes, without writing it (the Python module's simulate): the
+// arguments checked as the CLI checks them (ArgumentError names the option), the run, and
+// run.json's content. args.scene, sets, out and force are not read.
+struct SimulateRun {
+  models::TimeSeries ts;  // timeseries.csv's columns
+  nlohmann::json run;     // run.json
+};
+void check_simulate_args(const models::Scene& scene, const SimulateArgs& args);
+// `table`, when given, stands for args.table (a table already read or extracted).
+SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& args,
+                           const reduced::Samples* table = nullptr);
 
 struct ExtractArgs {
   std::string scene;
@@ -43,6 +60,11 @@ struct ExtractArgs {
   bool force = false;  // replace a file rdyn did not write
 };
 int run_extract(const ExtractArgs& args);
+// What `rdyn extract` computes for a loaded scene (the grid and method checked as the CLI
+// checks them; `reactions: all` resolved as simulate resolves it).
+Extraction extract_scene(const models::Scene& scene, double grid_deg, const std::string& method);
+// Recognises a table rdyn wrote, so saving over it needs no --force.
+bool is_rdyn_table_file(const std::string& first_bytes);
 
 struct CalibrateArgs {
   std::string scene;
@@ -59,6 +81,11 @@ struct CalibrateArgs {
   std::string interpolation = "fourier";
 };
 int run_calibrate(const CalibrateArgs& args);
+// The options `rdyn calibrate` runs with for these arguments (checked; ArgumentError), and the
+// JSON it prints for a result (without "written_scene").
+CalibrationOptions check_calibrate_args(const models::Scene& scene, const CalibrateArgs& args);
+nlohmann::json calibration_json(const models::Scene& scene, const CalibrationOptions& opt,
+                                const CalibrationResult& result);
 
 struct ValidateArgs {
   std::string scene;  // or suite

@@ -1,0 +1,196 @@
+"""rdyn from Python: the reduced-parameter model of 1-DOF mechanisms and its full Simbody model.
+
+A thin layer over rdyn's C++ library: the same functions the ``rdyn`` command runs, with the
+same names, units (SI, radians) and errors. See docs/python.md.
+
+    import rdyn
+    scene = rdyn.load_scene("fourbar", overrides={"gravity.enabled": False})
+    run = rdyn.simulate(scene, model="reduced", duration=1.0)
+    run["qdot"]            # numpy array, timeseries.csv's column
+    run.info               # run.json's content
+
+Errors: ``rdyn.SceneError`` (attributes file, line, field), ``rdyn.NumericalError``,
+``rdyn.ArgumentError`` (also a ValueError), ``rdyn.TableError``, ``rdyn.OutputError``; all
+derive from ``rdyn.Error``.
+"""
+import json as _json
+import os as _os
+from collections.abc import Mapping as _Mapping
+
+# An installed package finds the shipped scenes of its own prefix
+# (P/lib/python3/dist-packages/rdyn → P/share/rdyn/scenes) unless RDYN_SCENES_DIR says otherwise.
+_installed_scenes = _os.path.normpath(
+    _os.path.join(_os.path.dirname(__file__), "..", "..", "..", "..", "share", "rdyn", "scenes"))
+if "RDYN_SCENES_DIR" not in _os.environ and _os.path.isdir(_installed_scenes):
+    _os.environ["RDYN_SCENES_DIR"] = _installed_scenes
+
+from . import _rdyn
+from ._rdyn import (Error, SceneError, NumericalError, ArgumentError, TableError,  # noqa: F401
+                    OutputError)
+
+__all__ = ["load_scene", "extract", "load_table", "simulate", "calibrate", "validate", "Runtime",
+           "Scene", "Table", "Run", "Error", "SceneError", "NumericalError", "ArgumentError",
+           "TableError", "OutputError"]
+
+
+def _override_text(path, value):
+    # --set's syntax: PATH=VALUE, VALUE as YAML; Python's booleans are YAML's true/false.
+    if isinstance(value, bool):
+        value = "true" if value else "false"
+    return f"{path}={value}"
+
+
+class _Columns(_Mapping):
+    """A read-only mapping column name → numpy array, in the file's column order."""
+
+    def __init__(self, columns):
+        self._columns = dict(columns)
+
+    def __getitem__(self, name):
+        return self._columns[name]
+
+    def __iter__(self):
+        return iter(self._columns)
+
+    def __len__(self):
+        return len(self._columns)
+
+    def to_pandas(self):
+        """The columns as a pandas DataFrame (needs pandas)."""
+        import pandas
+        return pandas.DataFrame(self._columns)
+
+
+class Scene:
+    """A loaded scene (``rdyn.load_scene``); immutable."""
+
+    def __init__(self, name_or_path, sets, scene):
+        self.name_or_path = name_or_path
+        self.sets = list(sets)  # the overrides as --set texts, for the CLI-backed functions
+        self._scene = scene
+
+    @property
+    def name(self):
+        return self._scene.name
+
+    @property
+    def source_file(self):
+        return self._scene.source_file
+
+    def to_yaml(self):
+        """The scene as rdyn reads it (``rdyn expand``'s YAML)."""
+        return _rdyn.scene_to_yaml(self._scene)
+
+    def inspect(self):
+        """``rdyn inspect``'s JSON as a dict: assembly, DOF, loop gaps, range (degrees, metres)."""
+        return _json.loads(_rdyn.inspect_json(self._scene))
+
+    def __repr__(self):
+        return f"rdyn.Scene({self.name!r}, file={self.source_file!r})"
+
+
+def load_scene(name_or_path, overrides=None):
+    """Loads a shipped scene by name or a YAML file; ``overrides`` maps a scene path to a value
+    (``rdyn --set PATH=VALUE``). Raises SceneError (file, line, field)."""
+    sets = [_override_text(k, v) for k, v in (overrides or {}).items()]
+    return Scene(name_or_path, sets, _rdyn.load_scene(str(name_or_path), sets))
+
+
+class Table(_Columns):
+    """A reduced table (``rdyn extract``): mapping column → numpy array, q_deg (or q_m) first."""
+
+    def __init__(self, samples, scene, calls=None, extraction_ms=None):
+        super().__init__(_rdyn.table_columns(samples))
+        self._samples = samples
+        self.scene = scene
+        self.kinetostatic_calls = calls
+        self.extraction_ms = extraction_ms
+
+    def save(self, path, force=False):
+        """Writes the table as ``rdyn extract --out`` does (atomically; replacing a file rdyn did
+        not write needs force=True)."""
+        _rdyn.save_table(self._samples, _os.fspath(path), force)
+
+
+def extract(scene, grid_deg=10, method="kinetostatic"):
+    """``rdyn extract``: the reduced table of a scene on a grid of ``grid_deg`` degrees."""
+    samples, calls, ms = _rdyn.extract(scene._scene, float(grid_deg), method)
+    return Table(samples, scene, calls, ms)
+
+
+def load_table(path, scene):
+    """Reads a table written by ``rdyn extract`` (or Table.save) for ``scene``. Raises
+    TableError (file, line and field in the message). The table is checked against the scene
+    when it is used (simulate, Runtime)."""
+    return Table(_rdyn.read_table(_os.fspath(path)), scene)
+
+
+class Run(_Columns):
+    """A simulated motion: mapping column → numpy array (timeseries.csv's columns);
+    ``info`` is run.json's content."""
+
+    def __init__(self, columns, info):
+        super().__init__(columns)
+        self.info = info
+
+
+def simulate(scene, model="reduced", duration=None, table=None, **options):
+    """``rdyn simulate``: ``model`` "reduced" or "full"; ``duration`` [s] (None: the scene's);
+    ``table`` a Table (None: extract now); options as the CLI's long options with
+    underscores: dt_out, tolerance, integrator, route, grid_deg, method, interpolation,
+    energy_consistent, reduced_integrator, reduced_tolerance, fixed_step."""
+    if model not in ("reduced", "full"):
+        raise ArgumentError(f"model: must be reduced or full (got {model!r})")
+    args = _rdyn.SimulateArgs()
+    args.model = model
+    if duration is not None:
+        args.duration = float(duration)
+    for key, value in options.items():
+        if key in ("model", "duration", "table") or not hasattr(args, key):
+            raise TypeError(f"simulate() got an unknown option {key!r}")
+        setattr(args, key, value)
+    columns, info = _rdyn.simulate(scene._scene, args, None if table is None else table._samples)
+    return Run(columns, _json.loads(info))
+
+
+def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=10, interpolation="fourier"):
+    """``rdyn calibrate``: the drive (or ``load``) for a mean cadence [Hz] and, optionally, a
+    mean power [W]; returns the CLI's JSON as a dict (e.g. "drive_torque_Nm")."""
+    return _json.loads(_rdyn.calibrate(scene._scene, cadence_hz, power_w, load or "", float(grid_deg),
+                                       interpolation))
+
+
+class Runtime:
+    """The embedding runtime (docs/embedding.md): a fixed-step RK4 reduced model, allocation-free
+    and releasing the GIL while it steps.
+
+        rt = rdyn.Runtime(table, scene)
+        rt.step(1e-3, drive=69.7)     # hip torque magnitude [N·m] (scene signs); None: scene's
+        rt.q, rt.qdot, rt.forces
+    """
+
+    def __init__(self, table, scene=None, interpolation=None, energy_consistent=False):
+        scene = table.scene if scene is None else scene
+        self._rt = _rdyn.Runtime(table._samples, scene._scene, interpolation, energy_consistent)
+        self.step_raw = self._rt.step  # (dt, torque=None, scale=None): the call without this wrapper
+
+    def step(self, dt, drive=None, scale=None):
+        """One step of ``dt`` [s]; ``drive`` sets every scene joint torque to that magnitude
+        (scene signs), ``scale`` scales them; neither: the scene's torques. Raises
+        ArgumentError (bad dt or drive) or NumericalError; the state is then unchanged."""
+        self._rt.step(dt, drive, scale)
+
+    def reset(self, q, qdot, drive=None, scale=None):
+        """Sets t = 0 and the state (q [rad or m], qdot)."""
+        self._rt.reset(q, qdot, drive, scale)
+
+    t = property(lambda self: self._rt.t, doc="time since the last reset [s]")
+    q = property(lambda self: self._rt.q, doc="independent coordinate [rad or m]")
+    qdot = property(lambda self: self._rt.qdot, doc="its rate [rad/s or m/s]")
+    qddot = property(lambda self: self._rt.qddot, doc="its acceleration [rad/s² or m/s²]")
+    energy = property(lambda self: self._rt.energy, doc="kinetic + potential energy [J]")
+    work = property(lambda self: self._rt.work, doc="work of the non-conservative loads [J]")
+    forces = property(lambda self: self._rt.forces, doc="constraint forces [N] (force_names order)")
+    force_names = property(lambda self: self._rt.force_names)
+    drive_names = property(lambda self: self._rt.drive_names)
+    drive_torques = property(lambda self: self._rt.drive_torques)

@@ -1,0 +1,186 @@
+"""The Python module against the CLI on the same scenes (the same C++ code path, so the values
+agree bit for bit where both write them at full precision), and its errors with their fields."""
+import json
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import rdyn
+from conftest import read_csv, read_json
+
+
+def test_simulate_reduced_matches_cli(rdyn_cli, tmp_path):
+    scene = rdyn.load_scene("fourbar")
+    run = rdyn.simulate(scene, model="reduced", duration=1.0)
+    rdyn_cli("simulate", "fourbar", "--model", "reduced", "--duration", "1", "--out", str(tmp_path / "cli"))
+    cli = read_csv(tmp_path / "cli" / "timeseries.csv")
+    assert list(run.keys()) == list(cli.keys())
+    assert len(run["qdot"]) == len(cli["qdot"]) > 10
+    # The CSV holds %.17g: the round trip is exact, so the same code path agrees bit for bit.
+    np.testing.assert_allclose(run["qdot"], cli["qdot"], rtol=0, atol=1e-12)
+    assert np.array_equal(run["q"], np.array(cli["q"]))
+    info = read_json(tmp_path / "cli" / "run.json")
+    for key in ("scene", "model", "duration_s", "kinetostatic_calls", "steps_taken", "energy_balance_residual_J"):
+        assert run.info[key] == info[key], key
+
+
+def test_simulate_full_matches_cli(rdyn_cli, tmp_path):
+    scene = rdyn.load_scene("fourbar", overrides={"gravity.enabled": False})
+    run = rdyn.simulate(scene, model="full", duration=0.2)
+    rdyn_cli("simulate", "fourbar", "--set", "gravity.enabled=false", "--model", "full", "--duration", "0.2",
+             "--out", str(tmp_path / "cli"))
+    cli = read_csv(tmp_path / "cli" / "timeseries.csv")
+    assert np.array_equal(run["qdot"], np.array(cli["qdot"]))
+    assert run.info["steps_taken"] == read_json(tmp_path / "cli" / "run.json")["steps_taken"]
+
+
+def test_extract_table_and_round_trip(rdyn_cli, tmp_path):
+    scene = rdyn.load_scene("fourbar")
+    table = rdyn.extract(scene, grid_deg=10)
+    rdyn_cli("extract", "fourbar", "--grid-deg", "10", "--out", str(tmp_path / "cli.csv"))
+    cli = read_csv(tmp_path / "cli.csv")
+    assert list(table.keys()) == list(cli.keys())
+    assert len(table["m1"]) == len(cli["m1"]) == 36
+    for name in cli:
+        assert np.array_equal(table[name], np.array(cli[name])), name
+    # Saved from Python: the same bytes as the CLI's file; read back: the same columns.
+    table.save(tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    back = rdyn.load_table(tmp_path / "cli.csv", scene)
+    assert np.array_equal(back["m2"], table["m2"])
+    # A table given to simulate: the same run as extracting there.
+    a = rdyn.simulate(scene, model="reduced", duration=0.5, table=back)
+    b = rdyn.simulate(scene, model="reduced", duration=0.5)
+    assert np.array_equal(a["q"], b["q"])
+    assert a.info["table"] == str(tmp_path / "cli.csv")
+
+
+def test_save_refuses_a_foreign_file(tmp_path):
+    table = rdyn.extract(rdyn.load_scene("fourbar"), grid_deg=30)
+    (tmp_path / "mine.csv").write_text("not rdyn's\n")
+    with pytest.raises(rdyn.OutputError):
+        table.save(tmp_path / "mine.csv")
+    assert (tmp_path / "mine.csv").read_text() == "not rdyn's\n"
+    table.save(tmp_path / "mine.csv", force=True)
+    assert (tmp_path / "mine.csv").read_text().startswith("# rdyn-table")
+
+
+def test_calibrate_matches_cli(rdyn_cli):
+    r = rdyn.calibrate(rdyn.load_scene("bicycle"), cadence_hz=1, power_w=125)
+    cli = json.loads(rdyn_cli("calibrate", "bicycle", "--cadence-hz", "1", "--power-w", "125").stdout)
+    assert abs(r["drive_torque_Nm"] - cli["drive_torque_Nm"]) <= 1e-9
+    assert set(r) == set(cli)
+    assert abs(r["mean_power_w"] - 125) < 0.01 * 125  # and it does what it says
+
+
+def test_scene_yaml_and_inspect_match_cli(rdyn_cli):
+    scene = rdyn.load_scene("fourbar")
+    assert scene.to_yaml() == rdyn_cli("expand", "fourbar").stdout
+    assert scene.inspect() == json.loads(rdyn_cli("inspect", "fourbar").stdout)
+
+
+def test_scene_error_fields(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    text = open(os.path.join(os.environ["RDYN_SCENES_SRC"], "fourbar.yaml")).read()
+    bad.write_text(text.replace("initial: {q_deg: 30,", "initial: {bogus_field: 3, q_deg: 30,", 1))
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.load_scene(bad)
+    assert e.value.file == str(bad)
+    assert e.value.line > 0
+    assert "bogus_field" in e.value.field or "bogus_field" in str(e.value)
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.load_scene("no-such-scene")
+    assert e.value.line == 0
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.load_scene("fourbar", overrides={"gravity.enabled": "maybe"})
+    assert "gravity.enabled" in e.value.field
+
+
+def test_argument_errors_name_the_option():
+    scene = rdyn.load_scene("fourbar")
+    with pytest.raises(rdyn.ArgumentError, match="--grid-deg"):
+        rdyn.extract(scene, grid_deg=7)
+    with pytest.raises(rdyn.ArgumentError, match="--duration"):
+        rdyn.simulate(scene, duration=-1)
+    with pytest.raises(ValueError):  # ArgumentError is a ValueError
+        rdyn.calibrate(scene, cadence_hz=-1)
+    with pytest.raises(TypeError):
+        rdyn.simulate(scene, duration=1, no_such_option=3)
+
+
+def test_table_error():
+    with pytest.raises(rdyn.TableError):
+        rdyn.load_table(os.path.join(os.environ["RDYN_SCENES_SRC"], "fourbar.yaml"), rdyn.load_scene("fourbar"))
+
+
+def runtime_for(scene_name, grid_deg=10):
+    scene = rdyn.load_scene(scene_name)
+    return rdyn.Runtime(rdyn.extract(scene, grid_deg=grid_deg), scene)
+
+
+def test_runtime_matches_fixed_step_simulate():
+    # The runtime's step is simulate's rk4-fixed: the same states at the output times.
+    scene = rdyn.load_scene("fourbar")
+    table = rdyn.extract(scene, grid_deg=10)
+    run = rdyn.simulate(scene, model="reduced", duration=0.1, table=table, reduced_integrator="rk4-fixed",
+                        fixed_step=1e-3, dt_out=0.01, interpolation="fourier")
+    rt = rdyn.Runtime(table, scene)
+    qs = []
+    for i in range(100):
+        rt.step(1e-3)
+        if (i + 1) % 10 == 0:
+            qs.append(rt.q)
+    np.testing.assert_allclose(qs, run["q"][1:], rtol=0, atol=1e-12)
+
+
+def test_runtime_errors_leave_the_state():
+    rt = runtime_for("fourbar", 30)
+    q0, qdot0 = rt.q, rt.qdot
+    with pytest.raises(rdyn.ArgumentError):
+        rt.step(10.0)  # dt beyond 1 s
+    with pytest.raises(rdyn.ArgumentError):
+        rt.step(1e-3, drive=float("nan"))
+    assert (rt.q, rt.qdot) == (q0, qdot0)
+
+
+def test_control_loop_1khz_bicycle():
+    # A PD controller holds the reduced bicycle at 1 Hz, 1 kHz from Python (docs/embedding.md).
+    rt = runtime_for("bicycle")
+    target = 2 * np.pi
+    for _ in range(20000):
+        hip = 69.7 + 400 * (target - rt.qdot) - 20 * rt.qddot
+        rt.step(1e-3, drive=min(max(hip, 0.0), 500.0))
+    qdots = []
+    for _ in range(5000):
+        hip = 69.7 + 400 * (target - rt.qdot) - 20 * rt.qddot
+        rt.step(1e-3, drive=min(max(hip, 0.0), 500.0))
+        qdots.append(rt.qdot)
+    assert abs(np.mean(qdots) - target) < 0.01 * target
+    assert len(rt.forces) == len(rt.force_names)
+
+
+def test_step_releases_the_gil():
+    # Another Python thread makes progress while one thread steps: with the GIL held through
+    # the C++ call it could only run between steps. Counted, not timed.
+    rt = runtime_for("fourbar", 30)
+    counter = {"n": 0, "stop": False}
+
+    def count():
+        while not counter["stop"]:
+            counter["n"] += 1
+    th = threading.Thread(target=count)
+    th.start()
+    rt._rt.time_cpp_steps(1e-4, 200000, 0.0)  # one long C++ call without the GIL
+    counter["stop"] = True
+    th.join()
+    assert counter["n"] > 0
+
+
+def test_run_to_pandas():
+    pandas = pytest.importorskip("pandas")
+    run = rdyn.simulate(rdyn.load_scene("fourbar"), duration=0.2)
+    df = run.to_pandas()
+    assert isinstance(df, pandas.DataFrame) and list(df.columns) == list(run.keys())
