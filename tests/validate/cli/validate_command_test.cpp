@@ -135,7 +135,9 @@ TEST(ValidateCommand, JointReactionsAndShakingAreComparedJudgedAndPlotted) {
   std::string scene = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml");
   scene += "    - {quantity: R_crank_x, grid_deg: 10, max_error: 1.0e-3}\n";
   std::ofstream(dir / "legpress.yaml") << scene;
-  const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir, {600.0});
+  rdyn::test::RunLimits limits;
+  limits.time_limit_s = 600.0;
+  const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir, limits);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto s = nlohmann::json::parse(slurp(dir / "v/summary.json"));
   const auto& q = s.at("quantities");
