@@ -39,12 +39,6 @@ namespace rdyn::validate {
 
 namespace {
 
-// The reactions a reduced run gives: with `reactions: all`, those the reduced model can (the
-// others named); a listed one it cannot give is refused (with_reaction_requests).
-reduced::ReducedReactions reduced_reactions(const models::Scene& scene) {
-  if (scene.outputs.reactions_all) return reduced::split_reduced_reactions(scene);
-  return {scene, {}};
-}
 
 
 std::vector<models::Override> overrides_of(const std::vector<std::string>& sets) {
@@ -161,17 +155,7 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
   } else {
     // Joint outputs: the table and the model carry one constraint line per reaction component.
     // `reactions: all` gives those the reduced model can and names the others.
-    const auto split = reduced_reactions(scene);
-    const models::Scene& oscene = split.scene;
-    if (!split.not_given.empty()) {
-      auto ng = nlohmann::json::array();
-      for (const auto& [name, why] : split.not_given) {
-        std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
-                     name.c_str(), why.c_str());
-        ng.push_back({{"reaction", name}, {"why", why}});
-      }
-      run["reactions_not_given"] = ng;
-    }
+    const models::Scene oscene = reduced_output_scene(scene, run);
     const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
     reduced::Samples samples;
     double extraction_ms = 0.0;
@@ -246,7 +230,8 @@ int run_simulate(const SimulateArgs& a) {
 Extraction extract_scene(const models::Scene& scene, double grid_deg, const std::string& method) {
   require_grid("--grid-deg", grid_deg);
   const auto m = reduced::parse_method(method);
-  const models::Scene oscene = reduced_reactions(scene).scene;
+  const models::Scene oscene =
+      scene.outputs.reactions_all ? reduced::split_reduced_reactions(scene).scene : scene;  // as simulate
   return extract_from_full(reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene,
                            grid_deg, m);
 }
@@ -691,6 +676,21 @@ int run_export_mjcf(const ExportMjcfArgs& a) {
   out.write(models::export_mjcf(scene, opt));
   out.commit();
   return 0;
+}
+
+models::Scene reduced_output_scene(const models::Scene& scene, nlohmann::json& run) {
+  if (!scene.outputs.reactions_all) return scene;
+  auto split = reduced::split_reduced_reactions(scene);
+  if (!split.not_given.empty()) {
+    auto ng = nlohmann::json::array();
+    for (const auto& [name, why] : split.not_given) {
+      std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
+                   name.c_str(), why.c_str());
+      ng.push_back({{"reaction", name}, {"why", why}});
+    }
+    run["reactions_not_given"] = ng;
+  }
+  return std::move(split.scene);
 }
 
 }  // namespace rdyn::validate

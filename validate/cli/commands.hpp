@@ -136,4 +136,10 @@ struct ExportMjcfArgs {
 };
 int run_export_mjcf(const ExportMjcfArgs& args);
 
+// The scene whose joint outputs a reduced run gives: with `reactions: all`, the reactions the
+// reduced model can give, each other one named in a warning and in run["reactions_not_given"]
+// (reduced::split_reduced_reactions); otherwise the scene (a listed reaction it cannot give is
+// refused when the model is built). simulate and drive.
+models::Scene reduced_output_scene(const models::Scene& scene, nlohmann::json& run);
+
 }  // namespace rdyn::validate

@@ -12,6 +12,7 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/samples.hpp"
 #include "validate/analysis/build_reduced.hpp"
+#include "validate/cli/commands.hpp"
 #include "validate/cli/cli_limits.hpp"
 #include "validate/analysis/drive.hpp"
 #include "validate/cli/decimal_number.hpp"
@@ -161,18 +162,7 @@ DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, co
   if (a.model == "full") return calc_drive_full(scene, motion);
   // Joint outputs as `simulate --model reduced` gives them: `reactions: all` those it can (the
   // others named), listed ones or refused.
-  const auto split = scene.outputs.reactions_all ? reduced::split_reduced_reactions(scene)
-                                                 : reduced::ReducedReactions{scene, {}};
-  if (!split.not_given.empty()) {
-    auto ng = nlohmann::json::array();
-    for (const auto& [name, why] : split.not_given) {
-      std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
-                   name.c_str(), why.c_str());
-      ng.push_back({{"reaction", name}, {"why", why}});
-    }
-    run["reactions_not_given"] = ng;
-  }
-  const models::Scene& oscene = split.scene;
+  const models::Scene oscene = reduced_output_scene(scene, run);
   const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
   auto e = extract_from_full(rscene, a.grid_deg, reduced::Method::Kinetostatic);
   const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
