@@ -222,7 +222,7 @@ bool read_annotations(TableReader& r, Samples& s) {
     for (std::string v; in >> v;) {
       if (static_cast<long>(vals.size()) >= kMaxTableRows)
         r.fail(r.ln, fmt::format("more than {} values on one line", kMaxTableRows));
-      vals.push_back(r.number(v, singular ? "singular angle" : "root"));
+      vals.push_back(r.number(v, singular ? "singular angle" : pole ? "pole" : "root"));
     }
     for (size_t i = 1; i < vals.size(); ++i)
       if (!(vals[i] > vals[i - 1])) r.fail(r.ln, "values must be strictly increasing");

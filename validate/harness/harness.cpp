@@ -175,6 +175,26 @@ ValidationResult describe(const models::Scene& scene) {
     auto split = reduced::split_reduced_reactions(scene);
     v.joint_output_quantities = models::joint_output_names(split.scene);
     for (const auto& n : v.joint_output_quantities) v.quantities.push_back(n);
+    // A threshold judges the reduced model against the full one: on a column only the full model
+    // gives it could only fail, after the whole ladder. Refused before any work.
+    const auto all_columns = models::joint_output_names(scene);
+    for (size_t i = 0; i < scene.validation.thresholds.size(); ++i) {
+      const std::string& q = scene.validation.thresholds[i].quantity;
+      const bool full_only =
+          std::find(all_columns.begin(), all_columns.end(), q) != all_columns.end() &&
+          std::find(v.joint_output_quantities.begin(), v.joint_output_quantities.end(), q) ==
+              v.joint_output_quantities.end();
+      if (!full_only) continue;
+      const std::string field = fmt::format("validation.thresholds[{}].quantity", i);
+      int line = scene.line_of(field);
+      for (const std::string& key : {fmt::format("validation.thresholds[{}]", i), std::string("validation.thresholds")})
+        if (line == 0) line = scene.line_of(key);
+      throw models::SceneError(scene.source_file, line, field,
+                               fmt::format("'{}' is a column the reduced model does not give ({}); a threshold "
+                                           "compares the two models",
+                                           q, split.not_given.empty() ? std::string("see outputs.reactions")
+                                                                      : split.not_given.front().second));
+    }
     v.reactions_not_given = std::move(split.not_given);
   }
   v.quantities.push_back("mean_qdot");

@@ -165,6 +165,23 @@ TEST(ValidateCommand, JointReactionsAndShakingAreComparedJudgedAndPlotted) {
   fs::remove_all(dir);
 }
 
+// A threshold on a reaction only the full model gives could only fail after the whole ladder:
+// refused before any work (exit 2, the threshold's field), nothing written.
+TEST(ValidateCommand, AThresholdOnAFullModelOnlyReactionIsRefusedUpFront) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_full_only_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string scene = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml");
+  scene += "    - {quantity: R_rail_x, grid_deg: 10, max_error: 1.0e-3}\n";
+  std::ofstream(dir / "legpress.yaml") << scene;
+  const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("validation.thresholds[2].quantity"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("reduced model does not give"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "v"));
+  fs::remove_all(dir);
+}
+
 // `reactions: all` on the reduced model gives every reaction it can and names the others (the
 // leg press's rail); a listed reaction it cannot give is still refused (exit 2, with the line).
 TEST(ValidateCommand, ReactionsAllOnTheReducedModelNamesTheOnesItCannotGive) {
