@@ -124,17 +124,24 @@ TEST(ValidateCommand, SuiteWritesReportsAndFailsOnAThreshold) {
 
 namespace {
 
+// A fresh folder for one test, holding the user's leg press (tests/validate/scenes/legpress-cal.yaml)
+// as legpress.yaml with `extra` appended (lines of its validation.thresholds list).
+fs::path folder_with_legpress(const std::string& name, const std::string& extra) {
+  const fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "legpress.yaml")
+      << slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml") + extra;
+  return dir;
+}
+
 // A user's leg press asks for every reaction and the shaking load (issue #23): validate compares
 // each one the reduced model gives with the full model, judges a threshold on one of them, plots
 // them, and names the reaction only the full model gives (the rail: a spring acts on its
 // carriage). The reduced model agrees with the full one to about 1e-5 of each peak.
 TEST(ValidateCommand, JointReactionsAndShakingAreComparedJudgedAndPlotted) {
-  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_joints_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::string scene = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml");
-  scene += "    - {quantity: R_crank_x, grid_deg: 10, max_error: 1.0e-3}\n";
-  std::ofstream(dir / "legpress.yaml") << scene;
+  const fs::path dir =
+      folder_with_legpress("rdyn_validate_joints", "    - {quantity: R_crank_x, grid_deg: 10, max_error: 1.0e-3}\n");
   rdyn::test::RunLimits limits;
   limits.time_limit_s = 600.0;
   const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir, limits);
@@ -168,12 +175,8 @@ TEST(ValidateCommand, JointReactionsAndShakingAreComparedJudgedAndPlotted) {
 // A threshold on a reaction only the full model gives could only fail after the whole ladder:
 // refused before any work (exit 2, the threshold's field), nothing written.
 TEST(ValidateCommand, AThresholdOnAFullModelOnlyReactionIsRefusedUpFront) {
-  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_full_only_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  std::string scene = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml");
-  scene += "    - {quantity: R_rail_x, grid_deg: 10, max_error: 1.0e-3}\n";
-  std::ofstream(dir / "legpress.yaml") << scene;
+  const fs::path dir =
+      folder_with_legpress("rdyn_validate_full_only", "    - {quantity: R_rail_x, grid_deg: 10, max_error: 1.0e-3}\n");
   const auto r = rdyn::test::run_rdyn({"validate", "legpress.yaml", "--quick", "--out", "v"}, dir);
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("validation.thresholds[2].quantity"), std::string::npos) << r.err;
