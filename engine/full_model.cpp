@@ -74,185 +74,6 @@ MassProperties planar_mass(double m, models::Vec2 com, double Izz_c, double extr
   return MassProperties(m, v3(com), about_origin);
 }
 
-// Singular values below this fraction of the largest count as zero when ranking the
-// constraint Jacobian. Exactly redundant rows (a repeated loop) come out at ~1e-16 relative
-// and rows made redundant by an assembled geometry (a parallelogram's third link) at the
-// assembly accuracy 1e-12; a loop near an aligned position has σ_min/σ_max ≈ 0.3·(distance
-// in rad) (measured on the parallelogram, see reduced_source.cpp), so 1e-9 flags only
-// configurations within ~3e-9 rad of a singular one, and those are re-checked nearby.
-constexpr double kRankTolerance = 1e-9;
-// Above this many constraint rows the row-by-row search for redundant ones (one SVD per row)
-// is skipped and only the counts are reported.
-constexpr int kMaxRowsToName = 400;
-
-int numerical_rank(const Matrix& A, double tolerance = kRankTolerance) {
-  if (A.nrow() == 0 || A.ncol() == 0) return 0;
-  FactorSVD svd(A);
-  Vector sv;
-  svd.getSingularValues(sv);
-  if (sv.size() == 0 || !std::isfinite(sv[0])) return 0;
-  int r = 0;
-  for (int i = 0; i < sv.size(); ++i) r += sv[i] > tolerance * sv[0] ? 1 : 0;
-  return r;
-}
-
-// Constraint Jacobian ∂(loop and gear conditions)/∂u at a state realized to Position, one
-// block per constraint, restricted to the mobilities of the mechanism: the constraint
-// actuators' sliders are prescribed to x = 0 and are not degrees of freedom of the scene.
-struct Mobility {
-  int mobilities = 0;  // columns: joint coordinates of the mechanism
-  int rows = 0;        // loop and gear conditions
-  int rank = 0;        // of the whole Jacobian
-  bool independent_free = true;  // rank unchanged without the independent coordinate's column
-  std::vector<std::string> redundant;  // constraints owning a redundant row, "loop 'C' (1 row)"
-};
-
-// rank_tolerance: relative, as numerical_rank.
-Mobility calc_mobility(const FullModel::Impl& m, const State& s, double rank_tolerance = kRankTolerance) {
-  m.system.realize(s, Stage::Position);
-  std::vector<bool> keep(s.getNU(), true);
-  for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
-  std::vector<int> cols;
-  for (int c = 0; c < s.getNU(); ++c)
-    if (keep[c]) cols.push_back(c);
-  std::vector<Matrix> rows;          // one 1×ncols row per constraint equation
-  std::vector<int> owner;            // its constraint
-  for (size_t k = 0; k < m.constraints.size(); ++k) {
-    const Matrix P = m.constraints[k].second.calcPositionConstraintMatrixP(s);  // mp × nu
-    for (int r = 0; r < P.nrow(); ++r) {
-      Matrix row(1, static_cast<int>(cols.size()));
-      for (size_t c = 0; c < cols.size(); ++c) row(0, static_cast<int>(c)) = P(r, cols[c]);
-      rows.push_back(row);
-      owner.push_back(static_cast<int>(k));
-    }
-  }
-  auto rank_of = [&](const std::vector<bool>& use, int drop_col) {
-    int n = 0;
-    for (bool u : use) n += u ? 1 : 0;
-    Matrix A(n, static_cast<int>(cols.size()) - (drop_col >= 0 ? 1 : 0));
-    for (size_t r = 0, i = 0; r < rows.size(); ++r) {
-      if (!use[r]) continue;
-      for (int c = 0, o = 0; c < static_cast<int>(cols.size()); ++c)
-        if (c != drop_col) A(static_cast<int>(i), o++) = rows[r](0, c);
-      ++i;
-    }
-    return numerical_rank(A, rank_tolerance);
-  };
-  Mobility out;
-  out.mobilities = static_cast<int>(cols.size());
-  out.rows = static_cast<int>(rows.size());
-  std::vector<bool> use(rows.size(), true);
-  out.rank = rank_of(use, -1);
-  int indep_col = -1;
-  const int indep_u = m.joint_mobod[m.independent].getFirstUIndex(s);
-  for (size_t c = 0; c < cols.size(); ++c)
-    if (cols[c] == indep_u) indep_col = static_cast<int>(c);
-  out.independent_free = rank_of(use, indep_col) == out.rank;
-  if (out.rank < out.rows && out.rows <= kMaxRowsToName) {
-    // Drop rows from the last declared constraint backwards; a row whose removal keeps the
-    // rank repeats what the rows kept impose (for two identical loops, the second one).
-    std::vector<int> count(m.constraints.size(), 0);
-    for (int r = out.rows - 1; r >= 0; --r) {
-      use[r] = false;
-      if (rank_of(use, -1) == out.rank) {
-        ++count[owner[r]];
-      } else {
-        use[r] = true;
-      }
-    }
-    for (size_t k = 0; k < m.constraints.size(); ++k)
-      if (count[k] > 0)
-        out.redundant.push_back(
-            fmt::format("{} ({} row{})", m.constraints[k].first, count[k], count[k] > 1 ? "s" : ""));
-  }
-  return out;
-}
-
-// A configuration next to `s` on the same branch: the independent coordinate moved by dq
-// and the rest projected onto the constraints. Empty when the projection fails.
-std::optional<State> nearby_configuration(const FullModel::Impl& m, const State& s, double dq) {
-  State near = s;
-  try {
-    m.set_law(near, 0, poly_law(m.scene.initial.q + dq, 0.0, 0.0));
-    m.system.realize(near, Stage::Time);
-    m.system.prescribeQ(near);
-    m.system.projectQ(near, 1e-12);
-    m.system.realize(near, Stage::Position);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  return near;
-}
-
-bool one_dof(const Mobility& mob) {
-  return mob.mobilities - mob.rank == 1 && mob.rank == mob.rows && mob.independent_free;
-}
-
-// Degrees of freedom by rank (the counting check in models/ cannot see geometry): the
-// mechanism must have mobilities − rank(G) = 1, independent constraint rows (redundant
-// ones leave the constraint forces undetermined, Simbody would return one of infinitely
-// many splits) and an independent coordinate the constraints do not fix. At an isolated
-// singular configuration (aligned links) the rank drops only there, so a deficient
-// initial configuration is re-checked 0.01 rad (or 1 mm) to either side before refusing.
-void check_one_dof(const FullModel::Impl& m, const State& s) {
-  Mobility mob = calc_mobility(m, s);
-  if (one_dof(mob)) return;
-  const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
-  const double step = rev ? 0.01 : 1e-3;
-  for (double dq : {step, -step}) {
-    if (const auto near = nearby_configuration(m, s, dq)) {
-      const Mobility other = calc_mobility(m, *near);
-      // One degree of freedom beside the start but not at it: the start itself is singular.
-      if (one_dof(other)) throw_singular_start(m, s);
-      if (other.rank > mob.rank) mob = other;
-    }
-  }
-  const int dof = mob.mobilities - mob.rank;
-  std::string names;
-  for (const auto& r : mob.redundant) names += (names.empty() ? "" : ", ") + r;
-  const std::string where = fmt::format("{}: at {} = {:.6g} {}", m.scene.source_file, m.scene.independent,
-                                        m.scene.initial.q, rev ? "rad" : "m");
-  if (dof != 1) {
-    throw EngineError(fmt::format(
-        "{} the mechanism has {} degrees of freedom: {} joint coordinates, {} of them fixed by the {} loop and gear "
-        "conditions (rank of the constraint Jacobian); rdyn needs exactly 1{}",
-        where, dof, mob.mobilities, mob.rank, mob.rows,
-        names.empty() ? "" : "; redundant (their conditions repeat the others'): " + names));
-  }
-  if (mob.rank < mob.rows) {
-    throw EngineError(fmt::format(
-        "{} redundant constraints: {} repeat conditions the other loops and gears already impose (constraint "
-        "Jacobian rank {} of {} rows); the constraint forces would not be determined — remove the redundant "
-        "loop or link",
-        where, names.empty() ? "some rows" : names, mob.rank, mob.rows));
-  }
-  throw EngineError(fmt::format("{} the independent coordinate '{}' cannot move: the loops and gears fix it (the "
-                                "mechanism's one degree of freedom moves other joints only); choose another "
-                                "independent joint",
-                                where, m.scene.independent));
-}
-
-}  // namespace
-
-void throw_singular_start(const FullModel::Impl& m, const State& s) {
-  // The local count at the singular threshold the extraction uses (kSingularConditioning): an
-  // assembly lands ~1e-6 rad from an aligned position (its closure error is quadratic there),
-  // where the rank at kRankTolerance is still full.
-  const Mobility here = calc_mobility(m, s, kSingularConditioning);
-  const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
-  throw models::SceneError(
-      m.scene.source_file, m.scene.line_of("initial"), "initial",
-      fmt::format("the mechanism starts at a singular configuration of '{}' ({}): the loop Jacobian loses rank there "
-                  "(rank {} of {} loop and gear rows over {} joint coordinates, singular values below {:g} of the "
-                  "largest dropped: locally {} degrees of freedom, 1 beside it) and assembly branches cross there, "
-                  "so neither the branch to follow nor the velocities and constraint forces are determined; start "
-                  "it a little away from there",
-                  m.scene.independent, format_coordinate(m.joint_q(s, m.independent), rev), here.rank, here.rows,
-                  here.mobilities, kSingularConditioning, here.mobilities - here.rank));
-}
-
-namespace {
-
 // Each loop that names its branch must have closed on it: the named joint's coordinate (a
 // revolute angle wrapped to (−180°, 180°]) has the sign asked for. Zero (the boundary between
 // the branches, a singular position) is neither.
@@ -304,97 +125,104 @@ void check_point_forces(const FullModel::Impl& m, const State& s) {
 
 }  // namespace
 
-void calc_mobility_count(const FullModel::Impl& m, const State& s, int& mobilities, int& rows, int& rank) {
-  const Mobility mob = calc_mobility(m, s);
-  mobilities = mob.mobilities;
-  rows = mob.rows;
-  rank = mob.rank;
-}
+namespace {
 
-FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
-    : scene(s), options(o), matter(system), forces(system) {
-  const size_t nj = scene.joints.size(), nb = scene.bodies.size();
-  joint_mobod.resize(nj);
-  body_mobod.resize(nb);
-  joint_fold.resize(nj);
-  body_fold.resize(nb);
-  independent = scene.joint_index(scene.independent);
-  if (independent < 0) throw EngineError(scene.source_file + ": unknown independent joint '" + scene.independent + "'");
-  // Requests the builder below can honour (check_scene refuses the others with a line number;
-  // this keeps a scene built in code from reaching Simbody with a dangling handle).
+// Requests the builder can honour (check_scene refuses the others with a line number; this keeps
+// a scene built in code from reaching Simbody with a dangling handle). The independent joint is
+// accepted (its pin is prescribed, the sliders after it carry the child): the reduced model's
+// reaction lines (reduced/joint_outputs.hpp) use it.
+void check_constraint_force_requests(const models::Scene& scene) {
   for (const auto& c : scene.outputs.constraint_forces) {
     const int j = scene.joint_index(c.joint);
-    // The independent joint is accepted here (its pin is prescribed, the sliders after it carry
-    // the child): the reduced model's reaction lines (reduced/joint_outputs.hpp) use it.
     if (j < 0 || scene.joints[j].type != JointType::Revolute || !(std::hypot(c.direction.x, c.direction.y) > 0))
       throw EngineError(fmt::format("{}: constraint force '{}' needs a revolute joint and a non-zero direction",
                                     scene.source_file, c.name));
   }
-  actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
-                                                                          : 0);
+}
 
-  // 1. Which geared bodies can be folded onto their driver (models/gear_fold.hpp): a leaf
-  //    turning about a fixed axis through its centre of mass, touched by nothing else, whose
-  //    motion is not requested. Its kinetic energy ½ I (r u)² becomes ½ (r² I) u² on the driver.
-  std::vector<double> extra_inertia(nb, 0.0);
-  std::vector<bool> gear_folded(scene.gears.size(), false);
-  if (options.fold_geared_bodies)
-    for (const auto& f : models::calc_gear_folds(scene)) {
-      joint_fold[f.driven_joint] = f;
-      body_fold[f.body] = f;
-      gear_folded[f.gear] = true;
-      extra_inertia[f.driver_body] += f.moved_inertia_kgm2;
-    }
+// Stage 1: which geared bodies can be folded onto their driver (models/gear_fold.hpp): a leaf
+// turning about a fixed axis through its centre of mass, touched by nothing else, whose motion
+// is not requested. Its kinetic energy ½ I (r u)² becomes ½ (r² I) u² on the driver.
+struct GearFolding {
+  std::vector<double> extra_inertia;  // [body] kg·m² moved onto it
+  std::vector<bool> folded;           // [gear]
+};
+GearFolding fold_geared_bodies(FullModel::Impl& m) {
+  GearFolding out{std::vector<double>(m.scene.bodies.size(), 0.0), std::vector<bool>(m.scene.gears.size(), false)};
+  if (!m.options.fold_geared_bodies) return out;
+  for (const auto& f : models::calc_gear_folds(m.scene)) {
+    m.joint_fold[f.driven_joint] = f;
+    m.body_fold[f.body] = f;
+    out.folded[f.gear] = true;
+    out.extra_inertia[f.driver_body] += f.moved_inertia_kgm2;
+  }
+  return out;
+}
 
-  // 2. Mobilizers in tree order (parents first).
+// A revolute joint with requested constraint forces (the Actuator route): a pin to a massless
+// frame C turned like the child (rotation offset + q), then one slider per requested direction
+// d_k (child frame), in series, the last carrying the child. Each slider's F and M frames are
+// Rz(a_k) so it slides along d_k and leaves the orientation alone: R_PB = Rz(offset) Rz(q). In
+// series every slider carries the whole joint force, so its multiplier is that force projected
+// on its own d_k (virtual power: ẋ_k moves the child along d_k), whatever the other directions
+// are — the Reaction route's quantity.
+void add_actuated_pin(FullModel::Impl& m, int j, MobilizedBody& parent, const Body::Rigid& info,
+                      const std::vector<int>& requests) {
+  const auto& jt = m.scene.joints[j];
+  MobilizedBody::Pin pin(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)), Body::Massless(),
+                         Transform());
+  MobilizedBody carrier = pin;
+  for (size_t i = 0; i < requests.size(); ++i) {
+    const auto& d = m.scene.outputs.constraint_forces[requests[i]].direction;
+    const Rotation R_d(std::atan2(d.y, d.x), ZAxis);
+    const bool last = i + 1 == requests.size();
+    MobilizedBody::Slider slider(carrier, Transform(R_d), last ? Body(info) : Body(Body::Massless()),
+                                 Transform(R_d, last ? v3(jt.child_point) : Vec3(0)));
+    m.actuator_slider[requests[i]] = slider;
+    carrier = slider;
+  }
+  m.joint_mobod[j] = pin;
+  m.body_mobod[m.scene.body_index(jt.child)] = carrier;
+}
+
+// The mobilizer of joint j (its parent already built): a slider, a pin, or a pin with constraint
+// actuators.
+void add_joint_mobilizer(FullModel::Impl& m, int j, const std::vector<double>& extra_inertia) {
+  const auto& scene = m.scene;
+  const auto& jt = scene.joints[j];
+  MobilizedBody parent = jt.parent == models::kGround ? MobilizedBody(m.matter.updGround())
+                                                      : m.body_mobod[scene.body_index(jt.parent)];
+  const int b = scene.body_index(jt.child);
+  const auto& bd = scene.bodies[b];
+  const Body::Rigid info(planar_mass(bd.mass_kg, bd.com_m, bd.inertia_kgm2, extra_inertia[b]));
+  std::vector<int> requests;  // constraint forces asked of this joint
+  for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k)
+    if (scene.outputs.constraint_forces[k].joint == jt.name) requests.push_back(static_cast<int>(k));
+  if (jt.type == JointType::Prismatic) {
+    const Rotation R(std::atan2(jt.axis.y, jt.axis.x), ZAxis);
+    MobilizedBody::Slider mb(parent, Transform(R, v3(jt.parent_point)), info, Transform(R, v3(jt.child_point)));
+    m.joint_mobod[j] = m.body_mobod[b] = mb;
+  } else if (!requests.empty() && m.options.route == ConstraintForceRoute::Actuator) {
+    add_actuated_pin(m, j, parent, info, requests);
+  } else {
+    MobilizedBody::Pin mb(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)), info,
+                          Transform(v3(jt.child_point)));
+    m.joint_mobod[j] = m.body_mobod[b] = mb;
+  }
+}
+
+// Stage 2: mobilizers in tree order (parents first); a folded joint gets none.
+void add_mobilizers(FullModel::Impl& m, const std::vector<double>& extra_inertia) {
+  const auto& scene = m.scene;
+  const size_t nj = scene.joints.size();
   std::vector<bool> built(nj, false);
   for (size_t pass = 0, done = 0; done < nj && pass <= nj; ++pass) {
     for (size_t j = 0; j < nj; ++j) {
       const auto& jt = scene.joints[j];
       if (built[j]) continue;
-      if (joint_fold[j]) { built[j] = true; ++done; continue; }
-      if (jt.parent != models::kGround && !body_mobod[scene.body_index(jt.parent)].isInSubsystem())
-        continue;
-      MobilizedBody parent = jt.parent == models::kGround ? MobilizedBody(matter.updGround())
-                                                          : body_mobod[scene.body_index(jt.parent)];
-      const int b = scene.body_index(jt.child);
-      const auto& bd = scene.bodies[b];
-      const Body::Rigid info(planar_mass(bd.mass_kg, bd.com_m, bd.inertia_kgm2, extra_inertia[b]));
-      std::vector<int> requests;  // constraint forces asked of this joint
-      for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k)
-        if (scene.outputs.constraint_forces[k].joint == jt.name) requests.push_back(static_cast<int>(k));
-
-      if (jt.type == JointType::Prismatic) {
-        const Rotation R(std::atan2(jt.axis.y, jt.axis.x), ZAxis);
-        MobilizedBody::Slider mb(parent, Transform(R, v3(jt.parent_point)), info,
-                                 Transform(R, v3(jt.child_point)));
-        joint_mobod[j] = body_mobod[b] = mb;
-      } else if (!requests.empty() && options.route == ConstraintForceRoute::Actuator) {
-        // Constraint actuators: a pin to a massless frame C turned like the child (rotation
-        // offset + q), then one slider per requested direction d_k (child frame), in series,
-        // the last carrying the child. Each slider's F and M frames are Rz(a_k) so it slides
-        // along d_k and leaves the orientation alone: R_PB = Rz(offset) Rz(q). In series every
-        // slider carries the whole joint force, so its multiplier is that force projected on
-        // its own d_k (virtual power: ẋ_k moves the child along d_k), whatever the other
-        // directions are — the Reaction route's quantity.
-        MobilizedBody::Pin pin(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)),
-                               Body::Massless(), Transform());
-        MobilizedBody carrier = pin;
-        for (size_t i = 0; i < requests.size(); ++i) {
-          const auto& d = scene.outputs.constraint_forces[requests[i]].direction;
-          const Rotation R_d(std::atan2(d.y, d.x), ZAxis);
-          const bool last = i + 1 == requests.size();
-          MobilizedBody::Slider slider(carrier, Transform(R_d), last ? Body(info) : Body(Body::Massless()),
-                                       Transform(R_d, last ? v3(jt.child_point) : Vec3(0)));
-          actuator_slider[requests[i]] = slider;
-          carrier = slider;
-        }
-        joint_mobod[j] = pin;
-        body_mobod[b] = carrier;
-      } else {
-        MobilizedBody::Pin mb(parent, Transform(Rotation(jt.offset_rad, ZAxis), v3(jt.parent_point)), info,
-                              Transform(v3(jt.child_point)));
-        joint_mobod[j] = body_mobod[b] = mb;
+      if (!m.joint_fold[j]) {
+        if (jt.parent != models::kGround && !m.body_mobod[scene.body_index(jt.parent)].isInSubsystem()) continue;
+        add_joint_mobilizer(m, static_cast<int>(j), extra_inertia);
       }
       built[j] = true;
       ++done;
@@ -405,41 +233,63 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
       throw EngineError(fmt::format("{}: joint '{}' hangs from no body reachable from ground (the joints must "
                                     "form a tree)",
                                     scene.source_file, scene.joints[j].name));
+}
 
-  // 3. Loop closures: a point of body_b stays on the z line through a point of body_a:
-  //    the two in-plane rows of a planar revolute, without Ball's redundant third row.
-  for (const auto& l : scene.loops) {
-    MobilizedBody a = l.body_a == models::kGround ? MobilizedBody(matter.updGround())
-                                                   : body_mobod[scene.body_index(l.body_a)];
-    MobilizedBody b = l.body_b == models::kGround ? MobilizedBody(matter.updGround())
-                                                   : body_mobod[scene.body_index(l.body_b)];
-    constraints.emplace_back("loop '" + l.name + "'",
-                             Constraint::PointOnLine(a, UnitVec3(ZAxis), v3(l.point_a), b, v3(l.point_b)));
+// Stage 3: loop closures: a point of body_b stays on the z line through a point of body_a: the
+// two in-plane rows of a planar revolute, without Ball's redundant third row.
+void add_loop_closures(FullModel::Impl& m) {
+  for (const auto& l : m.scene.loops) {
+    MobilizedBody a = l.body_a == models::kGround ? MobilizedBody(m.matter.updGround())
+                                                   : m.body_mobod[m.scene.body_index(l.body_a)];
+    MobilizedBody b = l.body_b == models::kGround ? MobilizedBody(m.matter.updGround())
+                                                   : m.body_mobod[m.scene.body_index(l.body_b)];
+    m.constraints.emplace_back("loop '" + l.name + "'",
+                               Constraint::PointOnLine(a, UnitVec3(ZAxis), v3(l.point_a), b, v3(l.point_b)));
   }
-  // 4. Gears that were not folded: q_driven − r·q_driver − c = 0.
-  for (size_t g = 0; g < scene.gears.size(); ++g) {
-    if (gear_folded[g]) continue;
-    const auto& gear = scene.gears[g];
-    const int jr = scene.joint_index(gear.driver), jd = scene.joint_index(gear.driven);
+}
+
+// Stage 4: gears that were not folded: q_driven − r·q_driver − c = 0.
+void add_gear_couplers(FullModel::Impl& m, const std::vector<bool>& folded) {
+  for (size_t g = 0; g < m.scene.gears.size(); ++g) {
+    if (folded[g]) continue;
+    const auto& gear = m.scene.gears[g];
+    const int jr = m.scene.joint_index(gear.driver), jd = m.scene.joint_index(gear.driven);
     Vector coeff(3);
     coeff[0] = -gear.ratio;
     coeff[1] = 1.0;
-    coeff[2] = -models::calc_gear_offset(scene, gear);
-    std::vector<MobilizedBodyIndex> mbs{joint_mobod[jr].getMobilizedBodyIndex(),
-                                        joint_mobod[jd].getMobilizedBodyIndex()};
+    coeff[2] = -models::calc_gear_offset(m.scene, gear);
+    std::vector<MobilizedBodyIndex> mbs{m.joint_mobod[jr].getMobilizedBodyIndex(),
+                                        m.joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
-    constraints.emplace_back("gear '" + gear.name + "'",
-                             Constraint::CoordinateCoupler(matter, new Function::Linear(coeff), mbs, qs));
+    m.constraints.emplace_back("gear '" + gear.name + "'",
+                               Constraint::CoordinateCoupler(m.matter, new Function::Linear(coeff), mbs, qs));
   }
+}
 
-  // 5. Prescribed laws: the independent coordinate (enabled for kinetostatic calls,
-  //    disabled for forward dynamics) and each constraint actuator (always x = 0).
+}  // namespace
+
+FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
+    : scene(s), options(o), matter(system), forces(system) {
+  const size_t nj = scene.joints.size(), nb = scene.bodies.size();
+  joint_mobod.resize(nj);
+  body_mobod.resize(nb);
+  joint_fold.resize(nj);
+  body_fold.resize(nb);
+  independent = scene.joint_index(scene.independent);
+  if (independent < 0) throw EngineError(scene.source_file + ": unknown independent joint '" + scene.independent + "'");
+  check_constraint_force_requests(scene);
+  actuator_slider.resize(options.route == ConstraintForceRoute::Actuator ? scene.outputs.constraint_forces.size()
+                                                                          : 0);
+  const GearFolding folding = fold_geared_bodies(*this);
+  add_mobilizers(*this, folding.extra_inertia);
+  add_loop_closures(*this);
+  add_gear_couplers(*this, folding.folded);
+  // Stage 5: prescribed laws: the independent coordinate (enabled for kinetostatic calls,
+  // disabled for forward dynamics) and each constraint actuator (always x = 0).
   independent_motion = Motion::Custom(joint_mobod[independent], new LawMotion(*this, 0));
   for (size_t k = 0; k < actuator_slider.size(); ++k)
     actuator_motion.push_back(Motion::Custom(actuator_slider[k], new LawMotion(*this, 1 + static_cast<int>(k))));
-
   add_scene_loads(*this);
-
   try {
     default_state = system.realizeTopology();
     system.realizeModel(default_state);

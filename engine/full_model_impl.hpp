@@ -115,8 +115,14 @@ struct FullWorkspace::Impl {
 
 // Joint coordinates of the mechanism (constraint actuators' sliders excluded), loop and gear
 // condition rows and the rank of their Jacobian, at a state realized to Position
-// (full_model.cpp; the same count check_one_dof uses).
+// (engine/mobility.cpp; the same count check_one_dof uses).
 void calc_mobility_count(const FullModel::Impl& m, const SimTK::State& s, int& mobilities, int& rows, int& rank);
+
+// Refuses an assembled configuration that is not one degree of freedom by rank (mobilities −
+// rank(G) = 1, independent rows, an independent coordinate the constraints do not fix):
+// EngineError naming the count or the redundant constraints; throw_singular_start when the rank
+// drops only at the start (engine/mobility.cpp).
+void check_one_dof(const FullModel::Impl& m, const SimTK::State& s);
 
 // calc_loop_conditioning (kinetostatic.hpp) at a state.
 double calc_loop_conditioning(const FullModel::Impl& m, const SimTK::State& s);

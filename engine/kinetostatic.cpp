@@ -300,6 +300,171 @@ double calc_loop_conditioning(const FullModel::Impl& m, const State& s) {
   return conditioning_of(svd, J.G_free);
 }
 
+namespace {
+
+// Stage 1 of a sample: call (i)'s laws (q̇ = 1, q̈ = 0, loads off, every actuator at
+// x = ẋ = ẍ = 0) and the starting configuration of the projection. From the anchor (the last
+// grid point of this workspace) a second-order predictor along the branch, so Newton starts
+// O(Δ³) from the solution; without one (or beyond max_extrapolation) the configuration the
+// sample starts from — the assembly or the last continuation move.
+void start_sample(const FullModel::Impl& m, FullWorkspace::Impl& w, double q, double max_extrapolation) {
+  State& s = w.state;
+  ensure_kinetostatic_mode(m, s);
+  s.setTime(0.0);
+  m.set_law(s, 0, poly_law(q, 1.0, 0.0));
+  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
+  m.set_load_mode(s, kLoadsOff);
+  if (w.anchor_set && w.anchor_q.size() == s.getNQ()) {
+    const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+    const double d = revolute ? std::remainder(q - w.anchor_x, 2 * M_PI) : q - w.anchor_x;
+    if (std::abs(d) <= max_extrapolation) s.updQ() = w.anchor_q + w.anchor_dq * d + w.anchor_ddq * (0.5 * d * d);
+  }
+}
+
+// Stage 2: the Newton projection of the loops, the only iterative step (velocities and
+// accelerations follow from linear solves with the Jacobian at the converged configuration).
+void project_sample(const FullModel::Impl& m, FullWorkspace::Impl& w, double q) {
+  try {
+    project_prescribed(w);
+  } catch (const std::exception& e) {
+    throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
+                                  "(dead point or a loop that cannot close): {}",
+                                  m.scene.source_file, m.scene.independent, q, describe_simbody_exception(e)));
+  }
+  m.system.realize(w.state, Stage::Position);
+}
+
+double conditioning_of_rates(BranchRates& r) {
+  return r.J.G.nrow() == 0 ? 1.0 : r.svd ? conditioning_of(*r.svd, r.J.G_free) : 0.0;
+}
+
+// Stage 3: r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its
+// accelerations) from the Jacobian of this configuration (calc_branch_rates); the state is left
+// at u = r. Near a singular configuration, not on it (there the rates are repaired, not
+// computed), the projection is polished to rounding and the rates computed again
+// (polish_projection). Returns the rates used; `conditioning` is theirs.
+BranchRates& calc_sample_rates(const FullModel::Impl& m, State& s, BranchRates& first, BranchRates& polished,
+                               double& conditioning) {
+  calc_branch_rates(m, s, first);
+  conditioning = conditioning_of_rates(first);
+  if (conditioning < kSingularConditioning || conditioning >= kPolishConditioning) return first;
+  polish_projection(m, s);
+  calc_branch_rates(m, s, polished);
+  conditioning = conditioning_of_rates(polished);
+  return polished;
+}
+
+// Stage 4: every joint's coordinate, rate per unit q̇ and the rate's slope. Returns false when
+// one is not finite.
+bool fill_joint_rates(const FullModel::Impl& m, const State& s, const Vector& u, const Vector& b,
+                      KinetostaticSample& out) {
+  const int nj = static_cast<int>(m.scene.joints.size());
+  out.joint_q.resize(nj);
+  out.ratio_q.resize(nj);
+  out.ratio_slope.resize(nj);
+  bool finite = true;
+  for (int j = 0; j < nj; ++j) {
+    out.joint_q[j] = m.joint_q(s, j);
+    out.ratio_q[j] = joint_part(m, s, u, j);
+    out.ratio_slope[j] = joint_part(m, s, b, j);
+    finite &= std::isfinite(out.joint_q[j]) && std::isfinite(out.ratio_q[j]) && std::isfinite(out.ratio_slope[j]);
+  }
+  return finite;
+}
+
+// Stage 5 (a grid point): the reduced parameters by virtual power with r and r_x,k (both satisfy
+// G v = 0, zero on the other prescribed mobilities), loads off, M u̇ + c + Gᵀλ + τ = 0 and the
+// actuators supplying −τ: call (i): m2 = rᵀ(M b + c), me2_k = r_x,kᵀ(M b + c); call (ii), where
+// q̇ = 0 and u̇ = r: m1 = rᵀ M r, me1_k = r_x,kᵀ M r. Also L̇ of every point force at ẋ_k = 1 (the
+// state's velocities are not used again). Returns false when a value is not finite.
+bool fill_inertial_parameters(const FullModel::Impl& m, State& s, BranchRates& rates, KinetostaticSample& out) {
+  const Vector &u = rates.r, &b = rates.b;
+  const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
+  Vector Mr, inertial;
+  m.matter.multiplyByM(s, u, Mr);
+  m.matter.calcResidualForceIgnoringConstraints(s, Vector(), Vector_<SpatialVec>(), b, inertial);  // M b + c
+  out.m1 = ~u * Mr;
+  out.m2 = ~u * inertial;
+  bool finite = std::isfinite(out.m1) && std::isfinite(out.m2);
+  for (int k = 0; k < nx; ++k) {
+    // r_x,k: ẋ_k = 1, q̇ = 0, the other x fixed.
+    const int col = m.actuator_slider[k].getFirstUIndex(s);
+    Vector rx(s.getNU(), 0.0);
+    rx[col] = 1.0;
+    rates.complete(rx, rates.column(col));
+    std::vector<double> ratio(nj);
+    for (int j = 0; j < nj; ++j) finite &= std::isfinite(ratio[j] = joint_part(m, s, rx, j));
+    out.ratio_x.push_back(std::move(ratio));
+    out.me1.push_back(~rx * Mr);
+    out.me2.push_back(~rx * inertial);
+    if (!m.scene.point_forces.empty()) {
+      s.updU() = rx;
+      m.system.realize(s, Stage::Velocity);
+      out.length_wrt_x.push_back(point_force_rates(m, s));
+    } else {
+      out.length_wrt_x.emplace_back();
+    }
+    finite &= std::isfinite(out.me1.back()) && std::isfinite(out.me2.back());
+  }
+  return finite;
+}
+
+// Stage 6 (a grid point): this point anchors the next prediction: q' = N r, q'' = N b (Ṅ = 0 for
+// the pins and sliders rdyn builds). At a singular configuration r and b are least-squares
+// values of no particular branch (a parallelogram's aligned position, where the
+// antiparallelogram branch crosses): extrapolating along them led the next projection onto the
+// other branch (the hard parallelogram's table turned antiparallelogram after 180°, and its
+// reduced run diverged). There the prediction follows the chord from the previous grid point
+// instead, the branch the sweep came along (positions are determined at the singular point;
+// only the rates are not). (q_start, x_start): the configuration the sample started from.
+void update_anchor(const FullModel::Impl& m, FullWorkspace::Impl& w, double q, const BranchRates& rates,
+                   bool singular, const Vector& q_start, double x_start, double max_extrapolation) {
+  State& s = w.state;
+  const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  Vector q_before;
+  double x_before = 0.0;
+  const bool had_anchor = w.anchor_set && w.anchor_q.size() == s.getNQ();
+  if (had_anchor) q_before = w.anchor_q, x_before = w.anchor_x;
+  w.anchor_set = true;
+  w.anchor_x = q;
+  w.anchor_q = s.getQ();
+  m.matter.multiplyByN(s, false, rates.r, w.anchor_dq);
+  m.matter.multiplyByN(s, false, rates.b, w.anchor_ddq);
+  double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
+  // How far a chord may reach: two extrapolation lengths from the previous grid point; from the
+  // start, wherever it was (the first grid point is the one nearest the start, and the first
+  // call has no extrapolation length yet).
+  double chord_limit = 2 * max_extrapolation;
+  if (singular && !had_anchor && q_start.size() == s.getNQ()) {
+    // The first grid point: the chord from the configuration the sample started from.
+    q_before = q_start;
+    dx = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
+    chord_limit = INFINITY;
+    // Started on the singular configuration itself: branches cross there and nothing says which
+    // one the sweep should follow (a parallelogram started aligned). Bad input, not a failed
+    // move to retry.
+    if (!(std::abs(dx) > 1e-9)) {
+      w.anchor_set = false;
+      throw_singular_start(m, s);
+    }
+  }
+  if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {
+    w.anchor_dq = (w.anchor_q - q_before) / dx;
+    w.anchor_ddq = 0.0 * w.anchor_dq;
+  } else if (singular && had_anchor && q_start.size() == s.getNQ()) {
+    // Reached by continuation moves (the anchor lies beyond the chord's reach): the chord from
+    // the last move. Without it a prediction from here (the limit samples beside a singular grid
+    // point, reduced/extract.cpp) followed least-squares rates onto the other branch on 30° grids.
+    const double dm = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
+    if (std::abs(dm) > 1e-9) {
+      w.anchor_dq = (w.anchor_q - q_start) / dm;
+      w.anchor_ddq = 0.0 * w.anchor_dq;
+    }
+  }
+}
+
+}  // namespace
+
 KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspace& ws, double q,
                                             double max_extrapolation, SampleParts parts) {
   const auto& m = model.impl();
@@ -309,153 +474,25 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   auto& w = ws.impl();
   State& s = w.state;
   ensure_kinetostatic_mode(m, s);
-  s.setTime(0.0);
-  // Call (i): q̇ = 1, q̈ = 0, loads off, every actuator at x = ẋ = ẍ = 0.
-  m.set_law(s, 0, poly_law(q, 1.0, 0.0));
-  for (size_t k = 0; k < m.actuator_slider.size(); ++k) m.set_law(s, 1 + static_cast<int>(k), poly_law(0, 0, 0));
-  m.set_load_mode(s, kLoadsOff);
-  // Without an anchor (the first grid point) the configuration this sample starts from — the
-  // assembly or the last continuation move — gives the direction the sweep comes from, which
-  // a singular first grid point needs (below).
-  // With an anchor too far for the predictor (a grid coarser than a continuation move), it is
-  // the last move, on the branch a move away: the chord a singular point needs then.
+  // The configuration before the move gives the direction the sweep comes from, which a
+  // singular grid point needs (update_anchor).
   const Vector q_start = s.getQ();
   const double x_start = m.joint_q(s, m.independent);
-  if (w.anchor_set && w.anchor_q.size() == s.getNQ()) {
-    // Second-order predictor along the branch: Newton starts O(Δ³) from the solution.
-    const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
-    const double d = revolute ? std::remainder(q - w.anchor_x, 2 * M_PI) : q - w.anchor_x;
-    if (std::abs(d) <= max_extrapolation) s.updQ() = w.anchor_q + w.anchor_dq * d + w.anchor_ddq * (0.5 * d * d);
-  }
+  start_sample(m, w, q, max_extrapolation);
   const long singular_before = w.near_singular_projections;
-  // Position: the Newton projection of the loops, the only iterative step. Velocities and
-  // accelerations follow from linear solves with the Jacobian at the converged configuration.
-  try {
-    project_prescribed(w);
-  } catch (const std::exception& e) {
-    throw EngineError(fmt::format("{}: cannot reach {} = {:.6g} from the previous configuration "
-                                  "(dead point or a loop that cannot close): {}",
-                                  m.scene.source_file, m.scene.independent, q, describe_simbody_exception(e)));
-  }
-  m.system.realize(s, Stage::Position);
-  const int nj = static_cast<int>(m.scene.joints.size()), nx = static_cast<int>(m.actuator_slider.size());
-  const int nu = s.getNU();
+  project_sample(m, w, q);
   KinetostaticSample out;
   out.near_singular = w.near_singular_projections > singular_before;
-  // r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its accelerations),
-  // from the Jacobian of this configuration (calc_branch_rates); the state is left at u = r.
   BranchRates first, polished;
-  calc_branch_rates(m, s, first);
-  auto conditioning_of_rates = [](BranchRates& r) {
-    return r.J.G.nrow() == 0 ? 1.0 : r.svd ? conditioning_of(*r.svd, r.J.G_free) : 0.0;
-  };
-  double conditioning = conditioning_of_rates(first);
-  BranchRates* rates = &first;
-  // Near a singular configuration, not on it (there the rates are repaired, not computed): the
-  // projection polished to rounding, then the rates again (polish_projection).
-  if (conditioning >= kSingularConditioning && conditioning < kPolishConditioning) {
-    polish_projection(m, s);
-    calc_branch_rates(m, s, polished);
-    rates = &polished;
-    conditioning = conditioning_of_rates(polished);
-  }
-  const Vector &u = rates->r, &b = rates->b;
-  if (parts == SampleParts::All) out.conditioning = conditioning;
-  if (parts == SampleParts::All) out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1
-  out.joint_q.resize(nj);
-  out.ratio_q.resize(nj);
-  out.ratio_slope.resize(nj);
-  for (int j = 0; j < nj; ++j) {
-    out.joint_q[j] = m.joint_q(s, j);
-    out.ratio_q[j] = joint_part(m, s, u, j);
-    out.ratio_slope[j] = joint_part(m, s, b, j);
-  }
-  bool finite = true;
-  for (int j = 0; j < nj; ++j)
-    finite &= std::isfinite(out.joint_q[j]) && std::isfinite(out.ratio_q[j]) && std::isfinite(out.ratio_slope[j]);
+  double conditioning = 1.0;
+  BranchRates& rates = calc_sample_rates(m, s, first, polished, conditioning);
+  bool finite = fill_joint_rates(m, s, rates.r, rates.b, out);
   if (parts == SampleParts::All) {
-    // Virtual power with r and r_x,k (both satisfy G v = 0, zero on the other prescribed
-    // mobilities), loads off, M u̇ + c + Gᵀλ + τ = 0 and the actuators supplying −τ:
-    // call (i): m2 = rᵀ(M b + c), me2_k = r_x,kᵀ(M b + c); call (ii), where q̇ = 0 and u̇ = r:
-    // m1 = rᵀ M r, me1_k = r_x,kᵀ M r.
-    Vector Mr, inertial;
-    m.matter.multiplyByM(s, u, Mr);
-    m.matter.calcResidualForceIgnoringConstraints(s, Vector(), Vector_<SpatialVec>(), b, inertial);  // M b + c
-    out.m1 = ~u * Mr;
-    out.m2 = ~u * inertial;
-    finite &= std::isfinite(out.m1) && std::isfinite(out.m2);
-    for (int k = 0; k < nx; ++k) {
-      // r_x,k: ẋ_k = 1, q̇ = 0, the other x fixed.
-      const int col = m.actuator_slider[k].getFirstUIndex(s);
-      Vector rx(nu, 0.0);
-      rx[col] = 1.0;
-      rates->complete(rx, rates->column(col));
-      std::vector<double> rates(nj);
-      for (int j = 0; j < nj; ++j) finite &= std::isfinite(rates[j] = joint_part(m, s, rx, j));
-      out.ratio_x.push_back(std::move(rates));
-      out.me1.push_back(~rx * Mr);
-      out.me2.push_back(~rx * inertial);
-      if (!m.scene.point_forces.empty()) {  // L̇ at ẋ_k = 1 (the state's velocities are not used again)
-        s.updU() = rx;
-        m.system.realize(s, Stage::Velocity);
-        out.length_wrt_x.push_back(point_force_rates(m, s));
-      } else {
-        out.length_wrt_x.emplace_back();
-      }
-      finite &= std::isfinite(out.me1.back()) && std::isfinite(out.me2.back());
-    }
-    // This point anchors the next prediction: q' = N r, q'' = N b (Ṅ = 0 for the pins and
-    // sliders rdyn builds). At a singular configuration r and b are least-squares values of no
-    // particular branch (a parallelogram's aligned position, where the antiparallelogram branch
-    // crosses): extrapolating along them led the next projection onto the other branch (the
-    // hard parallelogram's table turned antiparallelogram after 180°, and its reduced run
-    // diverged). There the prediction follows the chord from the previous grid point instead,
-    // the branch the sweep came along (positions are determined at the singular point; only
-    // the rates are not).
+    out.conditioning = conditioning;
+    out.length_wrt_q = point_force_rates(m, s);  // L̇ at q̇ = 1
+    finite &= fill_inertial_parameters(m, s, rates, out);
     const bool singular = out.near_singular || out.conditioning < kSingularConditioning;
-    Vector q_before;
-    double x_before = 0.0;
-    const bool had_anchor = w.anchor_set && w.anchor_q.size() == s.getNQ();
-    if (had_anchor) q_before = w.anchor_q, x_before = w.anchor_x;
-    w.anchor_set = true;
-    w.anchor_x = q;
-    w.anchor_q = s.getQ();
-    m.matter.multiplyByN(s, false, u, w.anchor_dq);
-    m.matter.multiplyByN(s, false, b, w.anchor_ddq);
-    double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
-    // How far a chord may reach: two extrapolation lengths from the previous grid point; from
-    // the start, wherever it was (the first grid point is the one nearest the start, and the
-    // first call has no extrapolation length yet).
-    double chord_limit = 2 * max_extrapolation;
-    if (singular && !had_anchor && q_start.size() == s.getNQ()) {
-      // The first grid point: the chord from the configuration the sample started from.
-      const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
-      q_before = q_start;
-      dx = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
-      chord_limit = INFINITY;
-      // Started on the singular configuration itself: branches cross there and nothing says
-      // which one the sweep should follow (a parallelogram started aligned). Bad input, not a
-      // failed move to retry.
-      if (!(std::abs(dx) > 1e-9)) {
-        w.anchor_set = false;
-        throw_singular_start(m, s);
-      }
-    }
-    if (singular && q_before.size() == s.getNQ() && std::abs(dx) > 1e-9 && std::abs(dx) <= chord_limit) {
-      w.anchor_dq = (w.anchor_q - q_before) / dx;
-      w.anchor_ddq = 0.0 * w.anchor_dq;
-    } else if (singular && had_anchor && q_start.size() == s.getNQ()) {
-      // Reached by continuation moves (the anchor lies beyond the chord's reach): the chord from
-      // the last move. Without it a prediction from here (the limit samples beside a singular
-      // grid point, reduced/extract.cpp) followed least-squares rates onto the other branch on
-      // 30° grids.
-      const bool revolute = m.scene.joints[m.independent].type == models::JointType::Revolute;
-      const double dm = revolute ? std::remainder(q - x_start, 2 * M_PI) : q - x_start;
-      if (std::abs(dm) > 1e-9) {
-        w.anchor_dq = (w.anchor_q - q_start) / dm;
-        w.anchor_ddq = 0.0 * w.anchor_dq;
-      }
-    }
+    update_anchor(m, w, q, rates, singular, q_start, x_start, max_extrapolation);
   }
   if (!finite)
     throw models::NumericalError(fmt::format("{}: the full model returned a non-finite reduced parameter or velocity "

@@ -496,142 +496,202 @@ void check_reduced_options(const ReducedOptions& opt) {
   }
 }
 
-models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdot0, const ReducedOptions& opt) {
-  const auto start = std::chrono::steady_clock::now();
-  check_reduced_options(opt);  // before any allocation
+namespace {
+
+void check_simulation_start(const ReducedModel& m, double q0, double qdot0) {
   if (!std::isfinite(q0) || !std::isfinite(qdot0))
     throw TableError(fmt::format("reduced simulation start (q, q̇) = ({}, {}) is not finite", q0, qdot0));
   if (!m.table.in_range(q0))
     throw TableError(fmt::format("reduced simulation start q = {:.9g} lies outside the range [{:.9g}, {:.9g}] of its "
                                  "table (rad or m)",
                                  q0, m.table.q0, m.table.q0 + m.table.intervals * m.table.step));
-  models::TimeSeries ts;
+}
+
+// The output rows of a run: n + 1 of them, the last at t = duration.
+struct OutputGrid {
+  long n;
+  const ReducedOptions& opt;
+  double t(long i) const { return models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s); }
+};
+
+void reserve_series(const ReducedModel& m, long n, models::TimeSeries& ts) {
   ts.force_names = m.force_names;
   ts.forces.resize(m.force_names.size());
-  std::vector<double> f(m.force_names.size());
-  const long n = models::calc_output_rows(opt.duration_s, opt.output_interval_s);  // the last at t = duration
-  auto t_out = [&](long i) { return models::calc_output_time(i, n, opt.duration_s, opt.output_interval_s); };
   for (auto* v : {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work}) v->reserve(n + 1);
   for (auto& v : ts.forces) v.reserve(n + 1);
   ts.gates.reserve(n + 1);
+}
 
-  if (opt.integrator == "rk4-fixed") {
-    // Fixed steps regardless of the outputs; outputs by quintic Hermite inside each step.
-    ReducedWorkspace ws(m);
-    ws.q = q0, ws.qdot = qdot0;
-    init_gates(m, ws);
-    double E_point = 0.0;  // energy at the last point (one lookup with its q̈)
-    auto point = [&](const ReducedWorkspace& w) {
-      AdaptiveIntegrator::Point p{w.t, w.q, w.qdot, 0, w.work, 0};
-      E_point = calc_acceleration_energy(m, ws, p.q, p.qdot, p.qddot, p.power);
-      return p;
-    };
-    record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
-    DivergenceGuard guard = start_divergence_guard(ts.energy.front(), calc_potential_min(m), 0.0);
+// The divergence guard's message (both integrators): the reduced equation's own energy balance
+// E − E0 = W must hold to interpolation accuracy; a gross failure means the table is too coarse.
+[[noreturn]] void throw_divergence(const DivergenceGuard& guard, double t, double E, double work, const char* advice) {
+  throw models::NumericalError(fmt::format(
+      "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
+      "initially {:.3g} J, work of the loads {:.3g} J) — {}",
+      t, E - guard.energy0 - work, E, guard.energy0, work, advice));
+}
+
+// Fixed RK4 steps regardless of the outputs; outputs by quintic Hermite inside each step (linear
+// across a gate switch), or, with step_outputs, one RK4 step of the row's length from the step's
+// start.
+class FixedStepRun {
+ public:
+  FixedStepRun(const ReducedModel& m, const ReducedOptions& opt, OutputGrid grid, models::TimeSeries& ts,
+               std::chrono::steady_clock::time_point start)
+      : m_(m), opt_(opt), grid_(grid), ts_(ts), start_(start), ws_(m), before_(0), f_(m.force_names.size()) {
+    // step_outputs: the step's start, and a row's sub-step (made only then: a workspace is a
+    // dozen allocations, ~10 % of a 5 s run at 50 ms steps).
+    if (opt.step_outputs) at_start_.emplace(m), sub_.emplace(m);
+  }
+
+  void run(double q0, double qdot0) {
+    ws_.q = q0, ws_.qdot = qdot0;
+    init_gates(m_, ws_);
+    before_.resize(ws_.gate_on.size());
+    record(m_, ws_, 0.0, q0, qdot0, 0.0, ts_, f_);
+    DivergenceGuard guard = start_divergence_guard(ts_.energy.front(), calc_potential_min(m_), 0.0);
     long i = 1;
-    AdaptiveIntegrator::Point a = point(ws);
-    std::vector<char> before(ws.gate_on.size());
-    // step_outputs: the step's start, and a row's sub-step (made only then: a workspace is a dozen
-    // allocations, ~10 % of a 5 s run at 50 ms steps).
-    std::optional<ReducedWorkspace> at_start, sub;
-    if (opt.step_outputs) at_start.emplace(m), sub.emplace(m);
-    while (i <= n) {
-      std::copy(ws.gate_on.begin(), ws.gate_on.end(), before.begin());
-      if (opt.step_outputs) *at_start = ws;
-      // Budgets (the step count was checked against the duration; this also catches a time
-      // that stops advancing in floating point). The clock is read every 64 steps.
-      if (ts.stats.steps_taken >= opt.max_steps)
-        throw models::NumericalError(fmt::format(
-            "reduced integration stopped at t = {:.6g} s: it used its budget of {} fixed steps", ws.t, opt.max_steps));
-      if (ts.stats.steps_taken % 64 == 0 &&
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > opt.max_wall_s)
-        throw models::NumericalError(fmt::format(
-            "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps", ws.t,
-            opt.max_wall_s, ts.stats.steps_taken));
+    AdaptiveIntegrator::Point a = point();
+    while (i <= grid_.n) {
+      std::copy(ws_.gate_on.begin(), ws_.gate_on.end(), before_.begin());
+      if (opt_.step_outputs) *at_start_ = ws_;
+      check_budgets();
       // a: the step's start point, with the gates ws holds now: its q̈ and power are RK4's k1.
       const double k1[2] = {a.qddot, a.power};
-      const double t_switch = step_fixed_rk4(m, ws, std::min(opt.fixed_step_s, opt.duration_s - ws.t), k1);
-      ++ts.stats.steps_taken;
-      if (!std::isnan(t_switch)) ++ts.stats.events;
-      if (!std::isfinite(ws.q) || !std::isfinite(ws.qdot) || !std::isfinite(ws.work))
-        throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws.t));
-      if (!m.table.in_range(ws.q)) {  // edge of a range table, crossed within this step (linear estimate)
-        const double edge = domain_edge(m, ws.q);
-        throw_left_domain(m, edge, a.t + (ws.t - a.t) * (edge - a.q) / (ws.q - a.q));
-      }
-      const AdaptiveIntegrator::Point b = point(ws);
-      const double E = E_point;  // divergence guard, as for the adaptive path
-      if (divergence_guard_fires(guard, E, b.work))
-        throw models::NumericalError(fmt::format(
-            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
-            "initially {:.3g} J, work of the loads {:.3g} J) — the table or the fixed step is too coarse for this run",
-            b.t, E - guard.energy0 - b.work, E, guard.energy0, b.work));
-      // A switch inside the step breaks the smoothness Hermite assumes: sample by linear
-      // interpolation there, with the gates that held at each sample's time (the fixed-step
-      // path is the real-time one; accuracy is secondary).
-      for (; i <= n && t_out(i) <= b.t + 1e-12; ++i) {
-        const double s = (t_out(i) - a.t) / (b.t - a.t);
-        double q, v, w;
-        if (opt.step_outputs && t_out(i) < b.t) {
-          // One RK4 step of the row's length from the step's start (switches located as in
-          // the step itself), with the gates that hold at the row's time.
-          *sub = *at_start;
-          step_fixed_rk4(m, *sub, t_out(i) - a.t, k1);
-          ws.gate_on.swap(sub->gate_on);
-          record(m, ws, t_out(i), sub->q, sub->qdot, sub->work, ts, f);
-          ws.gate_on.swap(sub->gate_on);
-          continue;
-        }
-        if (!std::isnan(t_switch)) q = a.q + s * (b.q - a.q), v = a.qdot + s * (b.qdot - a.qdot), w = a.work + s * (b.work - a.work);
-        else hermite(a, b, s, q, v, w);
-        if (t_out(i) < t_switch) ws.gate_on.swap(before);
-        record(m, ws, t_out(i), q, v, w, ts, f);
-        if (t_out(i) < t_switch) ws.gate_on.swap(before);
-      }
+      const double t_switch = step_fixed_rk4(m_, ws_, std::min(opt_.fixed_step_s, opt_.duration_s - ws_.t), k1);
+      ++ts_.stats.steps_taken;
+      if (!std::isnan(t_switch)) ++ts_.stats.events;
+      check_step_end(a);
+      const AdaptiveIntegrator::Point b = point();
+      if (divergence_guard_fires(guard, e_point_, b.work))
+        throw_divergence(guard, b.t, e_point_, b.work, "the table or the fixed step is too coarse for this run");
+      i = record_rows(i, a, b, t_switch, k1);
       a = b;
-      if (ws.t >= opt.duration_s - 1e-12) break;
+      if (ws_.t >= opt_.duration_s - 1e-12) break;
     }
-    ts.stats.steps_attempted = ts.stats.steps_taken;
-    ts.stats.smallest_step_s = opt.fixed_step_s;
-  } else {
-    AdaptiveIntegrator integ(m, opt.tolerance, opt.integrator, IntegratorLimits{opt.max_steps, opt.max_wall_s});
-    integ.reset(0.0, q0, qdot0);
-    ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
-    record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
-    DivergenceGuard guard = start_divergence_guard(ts.energy.front(), calc_potential_min(m), 0.0);
-    long i = 1;
-    while (i <= n) {
-      integ.step(opt.duration_s);
-      const auto& a = integ.step_start();
-      const auto& b = integ.step_end();
-      // Divergence guard: the reduced equation's own energy balance E − E0 = W must hold to
-      // interpolation accuracy; a gross failure means the table is too coarse to be stable.
-      const double E = calc_energy(m, b.q, b.qdot);
-      if (divergence_guard_fires(guard, E, b.work))
-        throw models::NumericalError(fmt::format(
-            "reduced model diverges at t = {:.6g} s: its energy balance is off by {:.3g} J (energy {:.3g} J, "
-            "initially {:.3g} J, work of the loads {:.3g} J) — the table is too coarse for this run (refine the "
-            "grid, or use --energy-consistent)",
-            b.t, E - guard.energy0 - b.work, E, guard.energy0, b.work));
-      for (; i <= n && t_out(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
-        double q, v, w;
-        if (b.t - a.t <= 0 || t_out(i) >= b.t) {
-          q = b.q, v = b.qdot, w = b.work;
-        } else if (opt.step_outputs) {
-          double y[3];
-          integ.calc_within_step(t_out(i), y);
-          q = y[0], v = y[1], w = y[2];
-        } else {
-          hermite(a, b, (t_out(i) - a.t) / (b.t - a.t), q, v, w);
-        }
-        record(m, ws, t_out(i), q, v, w, ts, f);
-      }
-    }
-    ts.stats.steps_taken = integ.steps();
-    ts.stats.steps_attempted = integ.steps() + integ.rejected();
-    ts.stats.events = integ.events();
-    ts.stats.smallest_step_s = integ.smallest_step();
+    ts_.stats.steps_attempted = ts_.stats.steps_taken;
+    ts_.stats.smallest_step_s = opt_.fixed_step_s;
   }
+
+ private:
+  // The workspace's state as a point, with its q̈ and power; its energy in e_point_ (one lookup).
+  AdaptiveIntegrator::Point point() {
+    AdaptiveIntegrator::Point p{ws_.t, ws_.q, ws_.qdot, 0, ws_.work, 0};
+    e_point_ = calc_acceleration_energy(m_, ws_, p.q, p.qdot, p.qddot, p.power);
+    return p;
+  }
+
+  // Budgets (the step count was checked against the duration; this also catches a time that
+  // stops advancing in floating point). The clock is read every 64 steps.
+  void check_budgets() const {
+    if (ts_.stats.steps_taken >= opt_.max_steps)
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s: it used its budget of {} fixed steps", ws_.t, opt_.max_steps));
+    if (ts_.stats.steps_taken % 64 == 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() > opt_.max_wall_s)
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps", ws_.t,
+          opt_.max_wall_s, ts_.stats.steps_taken));
+  }
+
+  void check_step_end(const AdaptiveIntegrator::Point& a) const {
+    if (!std::isfinite(ws_.q) || !std::isfinite(ws_.qdot) || !std::isfinite(ws_.work))
+      throw models::NumericalError(fmt::format("reduced model produced a non-finite state at t = {:.6g} s", ws_.t));
+    if (!m_.table.in_range(ws_.q)) {  // edge of a range table, crossed within this step (linear estimate)
+      const double edge = domain_edge(m_, ws_.q);
+      throw_left_domain(m_, edge, a.t + (ws_.t - a.t) * (edge - a.q) / (ws_.q - a.q));
+    }
+  }
+
+  // The rows from i that fall in the step [a, b]; returns the next row. A switch inside the step
+  // breaks the smoothness Hermite assumes: linear interpolation there, with the gates that held
+  // at each row's time (the fixed-step path is the real-time one; accuracy is secondary).
+  long record_rows(long i, const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point& b, double t_switch,
+                   const double k1[2]) {
+    for (; i <= grid_.n && grid_.t(i) <= b.t + 1e-12; ++i) {
+      const double t = grid_.t(i), s = (t - a.t) / (b.t - a.t);
+      if (opt_.step_outputs && t < b.t) {
+        // One RK4 step of the row's length from the step's start (switches located as in the
+        // step itself), with the gates that hold at the row's time.
+        *sub_ = *at_start_;
+        step_fixed_rk4(m_, *sub_, t - a.t, k1);
+        ws_.gate_on.swap(sub_->gate_on);
+        record(m_, ws_, t, sub_->q, sub_->qdot, sub_->work, ts_, f_);
+        ws_.gate_on.swap(sub_->gate_on);
+        continue;
+      }
+      double q, v, w;
+      if (!std::isnan(t_switch)) q = a.q + s * (b.q - a.q), v = a.qdot + s * (b.qdot - a.qdot), w = a.work + s * (b.work - a.work);
+      else hermite(a, b, s, q, v, w);
+      if (t < t_switch) ws_.gate_on.swap(before_);
+      record(m_, ws_, t, q, v, w, ts_, f_);
+      if (t < t_switch) ws_.gate_on.swap(before_);
+    }
+    return i;
+  }
+
+  const ReducedModel& m_;
+  const ReducedOptions& opt_;
+  OutputGrid grid_;
+  models::TimeSeries& ts_;
+  std::chrono::steady_clock::time_point start_;
+  ReducedWorkspace ws_;
+  std::vector<char> before_;
+  std::optional<ReducedWorkspace> at_start_, sub_;
+  std::vector<double> f_;
+  double e_point_ = 0.0;  // energy at the last point()
+};
+
+// GSL's adaptive steps; outputs by quintic Hermite inside each step, or, with step_outputs, the
+// stepper's own dense output.
+void run_adaptive(const ReducedModel& m, double q0, double qdot0, const ReducedOptions& opt, OutputGrid grid,
+                  models::TimeSeries& ts) {
+  std::vector<double> f(m.force_names.size());
+  AdaptiveIntegrator integ(m, opt.tolerance, opt.integrator, IntegratorLimits{opt.max_steps, opt.max_wall_s});
+  integ.reset(0.0, q0, qdot0);
+  ReducedWorkspace& ws = const_cast<ReducedWorkspace&>(integ.state());
+  record(m, ws, 0.0, q0, qdot0, 0.0, ts, f);
+  DivergenceGuard guard = start_divergence_guard(ts.energy.front(), calc_potential_min(m), 0.0);
+  long i = 1;
+  while (i <= grid.n) {
+    integ.step(opt.duration_s);
+    const auto& a = integ.step_start();
+    const auto& b = integ.step_end();
+    const double E = calc_energy(m, b.q, b.qdot);
+    if (divergence_guard_fires(guard, E, b.work))
+      throw_divergence(guard, b.t, E, b.work,
+                       "the table is too coarse for this run (refine the grid, or use --energy-consistent)");
+    for (; i <= grid.n && grid.t(i) <= b.t + 1e-12 * std::max(1.0, b.t); ++i) {
+      double q, v, w;
+      if (b.t - a.t <= 0 || grid.t(i) >= b.t) {
+        q = b.q, v = b.qdot, w = b.work;
+      } else if (opt.step_outputs) {
+        double y[3];
+        integ.calc_within_step(grid.t(i), y);
+        q = y[0], v = y[1], w = y[2];
+      } else {
+        hermite(a, b, (grid.t(i) - a.t) / (b.t - a.t), q, v, w);
+      }
+      record(m, ws, grid.t(i), q, v, w, ts, f);
+    }
+  }
+  ts.stats.steps_taken = integ.steps();
+  ts.stats.steps_attempted = integ.steps() + integ.rejected();
+  ts.stats.events = integ.events();
+  ts.stats.smallest_step_s = integ.smallest_step();
+}
+
+}  // namespace
+
+models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdot0, const ReducedOptions& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  check_reduced_options(opt);  // before any allocation
+  check_simulation_start(m, q0, qdot0);
+  const OutputGrid grid{models::calc_output_rows(opt.duration_s, opt.output_interval_s), opt};
+  models::TimeSeries ts;
+  reserve_series(m, grid.n, ts);
+  if (opt.integrator == "rk4-fixed") FixedStepRun(m, opt, grid, ts, start).run(q0, qdot0);
+  else run_adaptive(m, q0, qdot0, opt, grid, ts);
   ts.stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return ts;
 }
