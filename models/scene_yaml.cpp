@@ -10,460 +10,19 @@
 #include <limits>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include "models/bicycle_leg.hpp"
+#include "models/scene_yaml_study.hpp"
+#include "models/yaml_fields.hpp"
 
 namespace rdyn::models {
 
+using namespace yaml;
+
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diag = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
-std::vector<std::string> split_key_path(const std::string& path);
-
-// v / len, or v itself when it is already a unit vector to rounding (|len − 1| ≤ 4 ulp):
-// dividing a normalised vector by its rounded length can move it by an ulp, and a scene
-// written by scene_to_yaml must read back bit for bit.
-Vec2 unit_vector(const Vec2& v, double len) {
-  if (std::abs(len - 1.0) <= 4 * std::numeric_limits<double>::epsilon()) return v;
-  return {v.x / len, v.y / len};
-}
-bool parse_index(const std::string& text, size_t size, size_t& index);
-
-int line_of(const YAML::Node& n) {
-  const auto m = n.Mark();
-  return m.is_null() ? 0 : m.line + 1;
-}
-
-// Limits on the text and its tree, checked before anything reads a value. Scenes are a few
-// kilobytes and a few hundred nodes; these bounds are orders of magnitude above that and
-// keep any input's memory and time small.
-constexpr size_t kMaxSceneBytes = 1 << 20;
-// yaml-cpp recurses once per nesting level while parsing (it stops itself at 2000 levels,
-// DeepRecursion) and so do the tree walks here: 64 is far more than a scene needs.
-constexpr int kMaxDepth = 64;
-// Aliases share nodes, so `&a [*b, *b, ...]` chains ("billion laughs") make a small text
-// whose tree is exponentially large when walked; an alias to its own ancestor makes a cycle.
-// Every walk over the tree is bounded by this many node visits and by kMaxDepth.
-constexpr size_t kMaxTreeNodes = 200000;
-constexpr size_t kMaxOverrideKeyLength = 1024;
-
-// Walks the tree once: keys are unique scalars, every mapping and list has at most
-// limits::kMaxItems entries, every scalar at most limits::kMaxTextLength characters, the
-// nesting at most kMaxDepth and the walk (aliases expanded) at most kMaxTreeNodes visits.
-void check_yaml_tree(const YAML::Node& node, const std::string& file, const std::string& path,
-                     int depth, size_t& visits) {
-  auto fail = [&](const YAML::Node& at, const std::string& field, const std::string& msg) {
-    // A path through a cycle is as long as the depth limit allows: keep the message readable.
-    throw SceneError(file, line_of(at), field.size() > 100 ? field.substr(0, 100) + "…" : field,
-                     msg);
-  };
-  if (++visits > kMaxTreeNodes)
-    fail(node, path,
-         fmt::format(
-             "the YAML tree has more than {} nodes (aliases expanded); a scene needs far fewer",
-             kMaxTreeNodes));
-  if (depth > kMaxDepth)
-    fail(node, path,
-         fmt::format("nested more than {} levels deep (or an alias refers to its own ancestor)",
-                     kMaxDepth));
-  auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
-  if (node.IsScalar()) {
-    if (node.Scalar().size() > limits::kMaxTextLength)
-      fail(node, path,
-           fmt::format("a value of {} characters; at most {}", node.Scalar().size(),
-                       limits::kMaxTextLength));
-  } else if (node.IsSequence()) {
-    if (node.size() > limits::kMaxItems)
-      fail(node, path,
-           fmt::format("a list of {} items; at most {}", node.size(), limits::kMaxItems));
-    for (size_t i = 0; i < node.size(); ++i)
-      check_yaml_tree(node[i], file, path + fmt::format("[{}]", i), depth + 1, visits);
-  } else if (node.IsMap()) {
-    if (node.size() > limits::kMaxItems)
-      fail(node, path,
-           fmt::format("a mapping of {} keys; at most {}", node.size(), limits::kMaxItems));
-    std::map<std::string, int> first_line;  // key → line of its first occurrence
-    for (const auto& kv : node) {
-      if (!kv.first.IsScalar())
-        fail(kv.first, path, "a key must be plain text, not a list or mapping");
-      const std::string& key = kv.first.Scalar();
-      const std::string shown = key.size() > 64 ? key.substr(0, 64) + "…" : key;
-      // yaml-cpp keeps both entries of a repeated key and reads the first: refuse instead.
-      const auto [it, inserted] = first_line.emplace(key, line_of(kv.first));
-      if (!inserted)
-        fail(kv.first, child(shown),
-             fmt::format("duplicate key '{}' (first given at line {})", shown, it->second));
-      check_yaml_tree(kv.second, file, child(shown), depth + 1, visits);
-    }
-  }
-}
-
-void check_yaml_tree(const YAML::Node& root, const std::string& file) {
-  size_t visits = 0;
-  check_yaml_tree(root, file, "", 0, visits);
-}
-
-// Line of the `---` (or `...`) that ends the first document, the last such line before the
-// second document's first node (its mark: the node, not the marker); that line itself when
-// none is found.
-int calc_document_marker_line(const std::string& text, int second_line) {
-  int line = 1, marker = 0;
-  for (size_t at = 0; at < text.size() && (second_line <= 0 || line < second_line); ++line) {
-    if (text.compare(at, 3, "---") == 0 || text.compare(at, 3, "...") == 0) marker = line;
-    const auto nl = text.find('\n', at);
-    if (nl == std::string::npos) break;
-    at = nl + 1;
-  }
-  return marker > 0 ? marker : second_line;
-}
-
-// Parses scene text with the limits above (size, flow nesting, NUL bytes before parsing; the
-// tree after). Throws SceneError.
-YAML::Node load_checked_yaml(const std::string& text, const std::string& file) {
-  // Refuse anything huge before the YAML parser sees it.
-  if (text.size() > kMaxSceneBytes)
-    throw SceneError(
-        file, 0, "",
-        fmt::format("too large for a scene ({} bytes, at most {})", text.size(), kMaxSceneBytes));
-  {  // flow nesting, counted conservatively (brackets inside quotes count too)
-    int depth = 0, max_depth = 0;
-    for (char c : text) {
-      if (c == '[' || c == '{')
-        max_depth = std::max(max_depth, ++depth);
-      else if ((c == ']' || c == '}') && depth > 0)
-        --depth;
-    }
-    if (max_depth > kMaxDepth)
-      throw SceneError(
-          file, 0, "",
-          fmt::format("nested too deeply for a scene (more than {} levels of [ or {{)", kMaxDepth));
-  }
-  if (text.find('\0') != std::string::npos)
-    throw SceneError(file, 0, "", "not a text file (contains NUL bytes)");
-  YAML::Node root;
-  try {
-    // All documents: YAML::Load reads the first and silently drops the rest, so a scene
-    // pasted after `---` would be ignored (issue #23).
-    const std::vector<YAML::Node> docs = YAML::LoadAll(text);
-    if (docs.size() > 1) throw SceneError(file, calc_document_marker_line(text, line_of(docs[1])), "",
-                                          "a second YAML document (after '---'); a scene file holds one "
-                                          "scene: remove the marker and what follows, or merge the two");
-    if (!docs.empty()) root = docs.front();
-  } catch (const YAML::Exception& e) {  // ParserException, DeepRecursion (block nesting)
-    throw SceneError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "", "malformed YAML: " + e.msg);
-  }
-  if (!root || root.IsNull()) throw SceneError(file, 0, "", "the scene file is empty");
-  if (!root.IsMap())
-    throw SceneError(file, line_of(root), "", "a scene must be a YAML mapping of keys");
-  check_yaml_tree(root, file);
-  return root;
-}
-
-// The node a field path names ("bodies[2].mass_kg", "loads.brake.coefficient",
-// "gravity.g_m_s2[1]": map keys, list items by index or by name), or the deepest ancestor
-// found when the field is not in the tree (a value derived from it, or generated).
-YAML::Node locate_field(const YAML::Node& root, const std::string& field) {
-  std::vector<std::string> parts;  // "a[2].b" → a, 2, b
-  for (const std::string& dotted : split_key_path(field)) {
-    const auto open = dotted.find('[');
-    parts.push_back(dotted.substr(0, open));
-    for (auto i = open; i != std::string::npos; i = dotted.find('[', i + 1))
-      parts.push_back(dotted.substr(i + 1, dotted.find(']', i) - i - 1));
-  }
-  YAML::Node cur;
-  cur.reset(root);
-  YAML::Node found;  // null: nothing matched
-  for (const auto& key : parts) {
-    YAML::Node next;
-    bool ok = false;
-    if (cur.IsMap() && cur[key]) {
-      next.reset(cur[key]);
-      ok = true;
-    } else if (cur.IsSequence()) {
-      size_t idx = 0;
-      if (parse_index(key, cur.size(), idx)) {
-        next.reset(cur[idx]);
-        ok = true;
-      }
-      for (size_t k = 0; k < cur.size() && !ok; ++k)
-        if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
-            cur[k]["name"].Scalar() == key) {
-          next.reset(cur[k]);
-          ok = true;
-        }
-    }
-    if (!ok) break;
-    cur.reset(next);
-    found.reset(cur);
-  }
-  return found;
-}
-
-// What a reading needs besides the YAML: the file for messages, and the nodes that `--set`
-// overrides created or replaced, so that an error in one of them names the override.
-struct Context {
-  std::string file;
-  std::vector<std::pair<YAML::Node, std::string>> set_by_override;  // node, override key path
-
-  const std::string* override_of(const YAML::Node& n) const {
-    for (const auto& [node, path] : set_by_override)
-      if (n.IsDefined() && node.is(n)) return &path;
-    return nullptr;
-  }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& field,
-                         const std::string& msg) const {
-    if (const std::string* o = override_of(n))
-      throw SceneError(file, 0, "--set " + *o, field + ": " + msg);
-    throw SceneError(file, line_of(n), field, msg);
-  }
-};
-
-// Records where `key` of the scene was given: the node's line, or the --set override that
-// set it (Scene::key_overrides), so that refusals found after loading name the right one.
-void note_key(Scene& s, const Context& ctx, const std::string& key, const YAML::Node& n) {
-  if (const std::string* o = ctx.override_of(n)) {
-    s.key_lines.erase(key);
-    s.key_overrides[key] = *o;
-  } else {
-    s.key_lines[key] = line_of(n);
-  }
-}
-
-// A YAML mapping whose keys are checked against the allowed set; typed getters throw
-// SceneError with file, line and dotted field path.
-class Fields {
- public:
-  Fields(const YAML::Node& node, std::string path, const Context& ctx,
-         std::vector<std::string> allowed)
-      : node_(node), path_(std::move(path)), ctx_(ctx), allowed_(std::move(allowed)) {
-    if (!node_.IsMap()) fail_at(node_, path_, "expected a mapping of keys to values");
-    for (const auto& kv : node_) {
-      if (!kv.first.IsScalar()) fail_at(kv.first, path_, "a key must be a plain name, not a list or mapping");
-      const std::string key = kv.first.as<std::string>();
-      if (std::find(allowed_.begin(), allowed_.end(), key) != allowed_.end()) continue;
-      std::string best;
-      size_t best_d = 4;  // suggest only close matches
-      for (const auto& a : allowed_) {
-        const size_t d = edit_distance(key, a);
-        if (d < best_d) best_d = d, best = a;
-      }
-      fail_at(ctx_.override_of(kv.second) ? kv.second : kv.first, join(key),
-              best.empty() ? "unknown key" : fmt::format("unknown key (did you mean '{}'?)", best));
-    }
-  }
-
-  bool has(const std::string& k) const { return static_cast<bool>(node_[k]); }
-  YAML::Node raw(const std::string& k) const { return node_[k]; }
-  std::string join(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
-  int line() const { return line_of(node_); }
-
-  [[noreturn]] void fail_at(const YAML::Node& n, const std::string& field,
-                            const std::string& msg) const {
-    ctx_.fail(n, field, msg);
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& msg) const {
-    fail_at(has(key) ? node_[key] : node_, join(key), msg);
-  }
-
-  YAML::Node required(const std::string& k) const {
-    if (!has(k)) fail_at(node_, join(k), "missing required field");
-    return node_[k];
-  }
-
-  double num(const std::string& k) const { return to_num(required(k), join(k)); }
-  double num_or(const std::string& k, double def) const { return has(k) ? num(k) : def; }
-  // A number given in a unit other than the scene's (degrees, hertz): checked in that unit,
-  // so the message quotes what the user typed.
-  double num_abs_max(const std::string& k, double def, double max, const char* unit) const {
-    const double v = num_or(k, def);
-    if (std::abs(v) > max)
-      fail(k, fmt::format("must be finite with |value| ≤ {:g} {} (got {:g})", max, unit, v));
-    return v;
-  }
-  double num_in(const std::string& k, double lo, double hi, const char* unit) const {
-    const double v = num(k);
-    if (v < lo || v > hi)
-      fail(k, fmt::format("must be in [{:g}, {:g}] {} (got {:g})", lo, hi, unit, v));
-    return v;
-  }
-  std::string str(const std::string& k) const {
-    const YAML::Node n = required(k);
-    if (!n.IsScalar()) fail_at(n, join(k), "expected a text value");
-    return n.as<std::string>();
-  }
-  std::string str_or(const std::string& k, const std::string& def) const {
-    return has(k) ? str(k) : def;
-  }
-  // A name (see is_valid_name): checked here, where the line is known.
-  std::string name(const std::string& k) const {
-    const std::string v = str(k);
-    if (!is_valid_name(v)) fail(k, invalid_name_message(v));
-    return v;
-  }
-  bool flag_or(const std::string& k, bool def) const {
-    if (!has(k)) return def;
-    const YAML::Node n = node_[k];
-    bool v = false;
-    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
-      fail_at(n, join(k), "expected true or false");
-    return v;
-  }
-  Vec2 vec2(const std::string& k) const { return to_vec2(required(k), join(k)); }
-
-  double to_num(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail_at(n, field, "expected a number");
-    double v = 0.0;
-    const std::string text = n.Scalar();
-    if (!YAML::convert<double>::decode(n, v) || text.empty())
-      fail_at(n, field, fmt::format("expected a number, got '{}'", text.substr(0, 40)));
-    if (!std::isfinite(v))
-      fail_at(n, field, fmt::format("must be finite, got '{}'", text.substr(0, 40)));
-    // A nonzero literal below the smallest normal double (2.2e-308) would be read as 0 or a
-    // denormal that has lost its digits: refuse it instead of silently changing the value.
-    if (std::abs(v) < std::numeric_limits<double>::min()) {
-      const std::string mantissa = text.substr(0, text.find_first_of("eE"));
-      if (mantissa.find_first_of("123456789") != std::string::npos)
-        fail_at(n, field,
-                fmt::format("'{}' is too small to represent (below 2.2e-308 in magnitude); write 0 if zero is meant",
-                            text.substr(0, 40)));
-    }
-    return v;
-  }
-  Vec2 to_vec2(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsSequence() || n.size() != 2) fail_at(n, field, "expected a pair [x, y]");
-    return {to_num(n[0], field + "[0]"), to_num(n[1], field + "[1]")};
-  }
-
-  const Context& ctx() const { return ctx_; }
-  const std::string& file() const { return ctx_.file; }
-
- private:
-  YAML::Node node_;
-  std::string path_;
-  const Context& ctx_;
-  std::vector<std::string> allowed_;
-};
-
-// Reads a list of mappings; each item must have a unique `name` unless `named` is false.
-template <typename F>
-void for_each_item(const Fields& parent, const std::string& key, F&& f) {
-  if (!parent.has(key)) return;
-  const YAML::Node seq = parent.raw(key);
-  if (!seq.IsSequence()) parent.fail(key, "expected a list");
-  for (size_t i = 0; i < seq.size(); ++i) f(seq[i], parent.join(key) + fmt::format("[{}]", i));
-}
-
-// Point on a body: [x, y] or the name of one of the body's (or ground's) points.
-Vec2 read_point(const Fields& f, const std::string& key, const std::string& body, const Scene& s) {
-  const YAML::Node n = f.required(key);
-  if (n.IsSequence()) return f.to_vec2(n, f.join(key));
-  if (!n.IsScalar()) f.fail(key, "expected [x, y] or the name of a point");
-  const std::string name = n.as<std::string>();
-  if (body == kGround) {
-    auto it = s.ground_points.find(name);
-    if (it != s.ground_points.end()) return it->second;
-  } else if (const Body* b = s.find_body(body)) {
-    auto it = b->points.find(name);
-    if (it != b->points.end()) return it->second;
-  }
-  f.fail(key, fmt::format("body '{}' has no point named '{}'", body, name));
-}
-
-// Splits a dotted key path; every part non-empty ("a..b", ".a" and "a." are malformed).
-std::vector<std::string> split_key_path(const std::string& path) {
-  std::vector<std::string> parts(1);
-  for (char c : path) {
-    if (c == '.')
-      parts.emplace_back();
-    else
-      parts.back() += c;
-  }
-  return parts;
-}
-
-// A list index: digits only, below `size`.
-bool parse_index(const std::string& text, size_t size, size_t& index) {
-  if (text.empty() || text.size() > 9 ||
-      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    return false;
-  index = std::stoul(text);
-  return index < size;
-}
-
-// Applies one override to the YAML tree; records the nodes it created or set in `touched`
-// (so that a later error in them names the override).
-void apply_override(YAML::Node root, const Override& o, const std::string& file,
-                    std::vector<std::pair<YAML::Node, std::string>>* touched = nullptr) {
-  const std::vector<std::string> parts = split_key_path(o.path);
-  auto fail = [&](const std::string& msg) { throw SceneError(file, 0, "--set " + o.path, msg); };
-  if (std::any_of(parts.begin(), parts.end(), [](auto& p) { return p.empty(); }))
-    fail("malformed key path (empty part)");
-  YAML::Node cur;
-  cur.reset(root);
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    const std::string& key = parts[i];
-    YAML::Node next;
-    if (cur.IsSequence()) {
-      size_t idx = 0;
-      bool found = false;
-      if (parse_index(key, cur.size(), idx)) {
-        next.reset(cur[idx]);
-        found = true;
-      } else {
-        for (size_t k = 0; k < cur.size() && !found; ++k)
-          if (cur[k].IsMap() && cur[k]["name"] && cur[k]["name"].IsScalar() &&
-              cur[k]["name"].Scalar() == key) {
-            next.reset(cur[k]);
-            found = true;
-          }
-      }
-      if (!found)
-        fail(fmt::format("no list item '{}' (an index below {} or an item's name)", key,
-                         cur.size()));
-    } else if (cur.IsMap()) {
-      if (!cur[key]) {
-        cur[key] = YAML::Node(YAML::NodeType::Map);  // allows setting a generator default
-        if (touched) touched->push_back({cur[key], o.path});
-      }
-      next.reset(cur[key]);
-    } else {
-      fail(fmt::format("'{}' is not a mapping or list", key));
-    }
-    cur.reset(next);
-  }
-  const std::string& last = parts.back();
-  if (cur.IsSequence()) {  // e.g. one coordinate of a point: bodies.rocker.points.C.0=0.2
-    size_t idx = 0;
-    if (!parse_index(last, cur.size(), idx) || !cur[idx].IsScalar())
-      fail(fmt::format("no scalar list item '{}' (an index below {})", last, cur.size()));
-    cur[idx] = o.value;
-    if (touched) touched->push_back({cur[idx], o.path});
-    return;
-  }
-  if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
-  if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
-  cur[last] = o.value;
-  if (touched) touched->push_back({cur[last], o.path});
-}
-
 ResistanceLaw read_law(const Fields& f, const std::string& key) {
   const std::string v = f.str(key);
   if (v == "constant") return ResistanceLaw::Constant;
@@ -511,127 +70,139 @@ void read_bicycle_leg(const Fields& f, Scene& s) {
   make_bicycle_leg(p, s);
 }
 
-void read_mechanism(const Fields& top, Scene& s) {
-  if (top.has("ground_points")) {
-    const YAML::Node gp = top.raw("ground_points");
-    if (!gp.IsMap()) top.fail("ground_points", "expected a mapping name: [x, y]");
-    for (const auto& kv : gp) {
-      if (!kv.first.IsScalar()) top.fail("ground_points", "a point's name must be plain text");
-      s.ground_points[kv.first.as<std::string>()] =
-          top.to_vec2(kv.second, "ground_points." + kv.first.as<std::string>());
-    }
+// A mapping name: [x, y] of points (ground_points, a body's points).
+void read_named_points(const Fields& f, const std::string& key, std::map<std::string, Vec2>& out) {
+  const YAML::Node pts = f.raw(key);
+  if (!pts.IsMap()) f.fail(key, "expected a mapping name: [x, y]");
+  for (const auto& kv : pts) {
+    if (!kv.first.IsScalar()) f.fail(key, "a point's name must be plain text");
+    out[kv.first.as<std::string>()] = f.to_vec2(kv.second, f.join(key + "." + kv.first.as<std::string>()));
   }
-  for_each_item(top, "bodies", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.ctx(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"});
-    Body b;
-    b.name = f.name("name");
-    b.mass_kg = f.num("mass_kg");  // ranges: check_scene
-    b.com_m = f.has("com_m") ? f.vec2("com_m") : Vec2{};
-    b.inertia_kgm2 = f.num("inertia_kgm2");
-    if (s.find_body(b.name) || b.name == kGround)
-      f.fail("name", "duplicate body name '" + b.name + "'");
-    if (f.has("points")) {
-      const YAML::Node pts = f.raw("points");
-      if (!pts.IsMap()) f.fail("points", "expected a mapping name: [x, y]");
-      for (const auto& kv : pts) {
-        if (!kv.first.IsScalar()) f.fail("points", "a point's name must be plain text");
-        b.points[kv.first.as<std::string>()] =
-            f.to_vec2(kv.second, f.join("points." + kv.first.as<std::string>()));
-      }
+}
+
+Body read_body(const Fields& f, const Scene& s) {
+  Body b;
+  b.name = f.name("name");
+  b.mass_kg = f.num("mass_kg");  // ranges: check_scene
+  b.com_m = f.has("com_m") ? f.vec2("com_m") : Vec2{};
+  b.inertia_kgm2 = f.num("inertia_kgm2");
+  if (s.find_body(b.name) || b.name == kGround) f.fail("name", "duplicate body name '" + b.name + "'");
+  if (f.has("points")) read_named_points(f, "points", b.points);
+  return b;
+}
+
+Joint read_joint(const Fields& f, const Scene& s) {
+  Joint j;
+  j.name = f.name("name");
+  const std::string type = f.str("type");
+  if (type == "revolute")
+    j.type = JointType::Revolute;
+  else if (type == "prismatic")
+    j.type = JointType::Prismatic;
+  else
+    f.fail("type", "expected revolute or prismatic");
+  j.parent = f.str("parent");
+  j.child = f.str("child");
+  if (j.parent != kGround && !s.find_body(j.parent)) f.fail("parent", "unknown body '" + j.parent + "'");
+  if (!s.find_body(j.child)) f.fail("child", "unknown body '" + j.child + "'");
+  j.parent_point = f.has("parent_point") ? read_point(f, "parent_point", j.parent, s) : Vec2{};
+  j.child_point = f.has("child_point") ? read_point(f, "child_point", j.child, s) : Vec2{};
+  if (j.type == JointType::Prismatic) {
+    j.axis = f.has("axis") ? f.vec2("axis") : Vec2{1, 0};
+    const double len = std::hypot(j.axis.x, j.axis.y);
+    if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
+    j.axis = unit_vector(j.axis, len);
+    if (f.has("offset_deg") || f.has("guess_deg") || f.has("offset_rad") || f.has("guess_rad"))
+      f.fail("type", "prismatic joints take guess_m, not angles");
+    j.guess = f.num_or("guess_m", 0.0);
+    return j;
+  }
+  if (f.has("axis") || f.has("guess_m")) f.fail("type", "revolute joints take guess_deg and no axis");
+  // Degrees, or radians (what scene_to_yaml writes: x·π/180 need not round back to the same double).
+  const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
+  auto angle = [&](const std::string& name) {
+    if (f.has(name + "_deg") && f.has(name + "_rad"))
+      f.fail(name + "_rad", fmt::format("give {0}_deg or {0}_rad, not both", name));
+    if (f.has(name + "_rad")) return f.num_abs_max(name + "_rad", 0.0, limits::kMaxAngle_rad, "rad");
+    return f.num_abs_max(name + "_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
+  };
+  j.offset_rad = angle("offset");
+  j.guess = angle("guess");
+  return j;
+}
+
+// The joints a loop closes over: those on exactly one of the two tree paths from body_a and
+// body_b down to ground (only they can tell its branches apart).
+std::vector<std::string> joints_of_loop(const Scene& s, const Loop& l) {
+  auto path_to_ground = [&](std::string body) {
+    std::vector<std::string> joints;
+    for (size_t guard = 0; guard <= s.joints.size() && body != "ground"; ++guard) {
+      const auto it = std::find_if(s.joints.begin(), s.joints.end(), [&](const Joint& jt) { return jt.child == body; });
+      if (it == s.joints.end()) break;
+      joints.push_back(it->name);
+      body = it->parent;
     }
-    s.bodies.push_back(b);
+    return joints;
+  };
+  const auto pa = path_to_ground(l.body_a), pb = path_to_ground(l.body_b);
+  std::vector<std::string> on_loop;
+  for (const auto& j : pa)
+    if (std::find(pb.begin(), pb.end(), j) == pb.end()) on_loop.push_back(j);
+  for (const auto& j : pb)
+    if (std::find(pa.begin(), pa.end(), j) == pa.end()) on_loop.push_back(j);
+  return on_loop;
+}
+
+// A loop's `branch`: {joint, sign: positive|negative} (or +1 / -1).
+BranchSign read_branch(const Fields& b, const Fields& top, const Scene& s, const Loop& l) {
+  BranchSign br{b.str("joint"), +1};
+  if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
+  if (br.joint == top.str_or("independent", ""))
+    b.fail("joint", "the independent coordinate is set by `initial`, not by assembly: name another joint");
+  const auto on_loop = joints_of_loop(s, l);
+  if (std::find(on_loop.begin(), on_loop.end(), br.joint) == on_loop.end()) {
+    std::string list;
+    for (const auto& j : on_loop) list += (list.empty() ? "" : ", ") + j;
+    b.fail("joint", fmt::format("'{}' is not a joint of loop '{}' (its joints: {}): only a joint the loop closes "
+                                "over can pick its branch",
+                                br.joint, l.name, list));
+  }
+  const std::string sign = b.str("sign");
+  if (sign == "positive" || sign == "+1" || sign == "1") br.sign = +1;
+  else if (sign == "negative" || sign == "-1") br.sign = -1;
+  else b.fail("sign", "expected positive or negative (or +1, -1)");
+  return br;
+}
+
+Loop read_loop(const Fields& f, const Fields& top, Scene& s) {
+  Loop l;
+  l.name = f.name("name");
+  l.body_a = f.str("body_a");
+  l.body_b = f.str("body_b");
+  l.point_a = read_point(f, "point_a", l.body_a, s);
+  l.point_b = read_point(f, "point_b", l.body_b, s);
+  if (f.has("branch")) {
+    note_key(s, top.ctx(), "loops." + l.name + ".branch", f.raw("branch"));
+    l.branch = read_branch(Fields(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"}), top, s, l);
+  }
+  return l;
+}
+
+// The mechanism: ground points, bodies, joints (tree), loops, gears, the independent joint.
+void read_mechanism(const Fields& top, Scene& s) {
+  if (top.has("ground_points")) read_named_points(top, "ground_points", s.ground_points);
+  for_each_item(top, "bodies", [&](const YAML::Node& n, const std::string& path) {
+    s.bodies.push_back(read_body(Fields(n, path, top.ctx(), {"name", "mass_kg", "com_m", "inertia_kgm2", "points"}), s));
   });
   for_each_item(top, "joints", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.ctx(),
-             {"name", "type", "parent", "child", "parent_point", "child_point", "axis",
-              "offset_deg", "guess_deg", "guess_m", "offset_rad", "guess_rad"});
-    Joint j;
-    j.name = f.name("name");
-    const std::string type = f.str("type");
-    if (type == "revolute")
-      j.type = JointType::Revolute;
-    else if (type == "prismatic")
-      j.type = JointType::Prismatic;
-    else
-      f.fail("type", "expected revolute or prismatic");
-    j.parent = f.str("parent");
-    j.child = f.str("child");
-    if (j.parent != kGround && !s.find_body(j.parent))
-      f.fail("parent", "unknown body '" + j.parent + "'");
-    if (!s.find_body(j.child)) f.fail("child", "unknown body '" + j.child + "'");
-    j.parent_point = f.has("parent_point") ? read_point(f, "parent_point", j.parent, s) : Vec2{};
-    j.child_point = f.has("child_point") ? read_point(f, "child_point", j.child, s) : Vec2{};
-    if (j.type == JointType::Prismatic) {
-      j.axis = f.has("axis") ? f.vec2("axis") : Vec2{1, 0};
-      const double len = std::hypot(j.axis.x, j.axis.y);
-      if (len < 1e-12) f.fail("axis", "must be a non-zero vector");
-      j.axis = unit_vector(j.axis, len);
-      if (f.has("offset_deg") || f.has("guess_deg") || f.has("offset_rad") || f.has("guess_rad"))
-        f.fail("type", "prismatic joints take guess_m, not angles");
-      j.guess = f.num_or("guess_m", 0.0);
-    } else {
-      if (f.has("axis") || f.has("guess_m"))
-        f.fail("type", "revolute joints take guess_deg and no axis");
-      // Degrees, or radians (what scene_to_yaml writes: x·π/180 need not round back to the same double).
-      const double max_deg = limits::kMaxAngle_rad * 180.0 / kPi;
-      auto angle = [&](const std::string& name) {
-        if (f.has(name + "_deg") && f.has(name + "_rad"))
-          f.fail(name + "_rad", fmt::format("give {0}_deg or {0}_rad, not both", name));
-        if (f.has(name + "_rad")) return f.num_abs_max(name + "_rad", 0.0, limits::kMaxAngle_rad, "rad");
-        return f.num_abs_max(name + "_deg", 0.0, max_deg, "degrees") * kPi / 180.0;
-      };
-      j.offset_rad = angle("offset");
-      j.guess = angle("guess");
-    }
-    s.joints.push_back(j);
+    s.joints.push_back(read_joint(Fields(n, path, top.ctx(),
+                                         {"name", "type", "parent", "child", "parent_point", "child_point", "axis",
+                                          "offset_deg", "guess_deg", "guess_m", "offset_rad", "guess_rad"}),
+                                  s));
   });
   for_each_item(top, "loops", [&](const YAML::Node& n, const std::string& path) {
-    Fields f(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b", "branch"});
-    Loop l;
-    l.name = f.name("name");
-    l.body_a = f.str("body_a");
-    l.body_b = f.str("body_b");
-    l.point_a = read_point(f, "point_a", l.body_a, s);
-    l.point_b = read_point(f, "point_b", l.body_b, s);
-    if (f.has("branch")) {  // {joint, sign: positive|negative} (or +1 / -1)
-      Fields b(f.raw("branch"), f.join("branch"), top.ctx(), {"joint", "sign"});
-      note_key(s, top.ctx(), "loops." + l.name + ".branch", f.raw("branch"));
-      BranchSign br{b.str("joint"), +1};
-      if (!s.find_joint(br.joint)) b.fail("joint", "unknown joint '" + br.joint + "'");
-      if (br.joint == top.str_or("independent", ""))
-        b.fail("joint", "the independent coordinate is set by `initial`, not by assembly: name another joint");
-      // Only a joint the loop closes over can tell its branches apart: the joints on exactly one
-      // of the two tree paths from body_a and body_b down to ground.
-      auto path_to_ground = [&](std::string body) {
-        std::vector<std::string> joints;
-        for (size_t guard = 0; guard <= s.joints.size() && body != "ground"; ++guard) {
-          const auto it = std::find_if(s.joints.begin(), s.joints.end(), [&](const Joint& jt) { return jt.child == body; });
-          if (it == s.joints.end()) break;
-          joints.push_back(it->name);
-          body = it->parent;
-        }
-        return joints;
-      };
-      const auto pa = path_to_ground(l.body_a), pb = path_to_ground(l.body_b);
-      std::vector<std::string> on_loop;
-      for (const auto& j : pa)
-        if (std::find(pb.begin(), pb.end(), j) == pb.end()) on_loop.push_back(j);
-      for (const auto& j : pb)
-        if (std::find(pa.begin(), pa.end(), j) == pa.end()) on_loop.push_back(j);
-      if (std::find(on_loop.begin(), on_loop.end(), br.joint) == on_loop.end()) {
-        std::string list;
-        for (const auto& j : on_loop) list += (list.empty() ? "" : ", ") + j;
-        b.fail("joint", fmt::format("'{}' is not a joint of loop '{}' (its joints: {}): only a joint the loop closes "
-                                    "over can pick its branch",
-                                    br.joint, l.name, list));
-      }
-      const std::string sign = b.str("sign");
-      if (sign == "positive" || sign == "+1" || sign == "1") br.sign = +1;
-      else if (sign == "negative" || sign == "-1") br.sign = -1;
-      else b.fail("sign", "expected positive or negative (or +1, -1)");
-      l.branch = br;
-    }
-    s.loops.push_back(l);
+    s.loops.push_back(read_loop(Fields(n, path, top.ctx(), {"name", "body_a", "point_a", "body_b", "point_b", "branch"}),
+                                top, s));
   });
   for_each_item(top, "gears", [&](const YAML::Node& n, const std::string& path) {
     Fields f(n, path, top.ctx(), {"name", "driver", "driven", "ratio"});
@@ -855,83 +426,6 @@ void read_loads(const Fields& top, Scene& s, std::vector<PendingDissipation>& pe
   });
 }
 
-// The `optimize` block (rdyn optimize): every name known, every number in range, here where
-// the line is known.
-void read_optimize(const Fields& f, Scene& s) {
-  OptimizeSpec o;
-  std::vector<YAML::Node> same_nodes;
-  for_each_item(f, "loads", [&](const YAML::Node& n, const std::string& path) {
-    Fields l(n, path, f.ctx(), {"load", "same_as", "shift_deg", "shift_rad"});
-    OptimizeLoad d;
-    d.load = l.name("load");
-    // That the load exists is checked when optimizing (validate/analysis/optimize.cpp, resolve_design),
-    // at this line: a scene whose drive is switched off (a generator's hip_torque_Nm: 0, "no
-    // drive") makes no such torque, and simulate, extract or inspect of it must not be refused
-    // for a block only `rdyn optimize` reads (issue #23).
-    note_key(s, f.ctx(), fmt::format("optimize.loads[{}].load", o.loads.size()), n["load"]);
-    for (const auto& e : o.loads)
-      if (e.load == d.load) l.fail("load", "'" + d.load + "' is listed twice");
-    if (l.has("same_as")) {
-      d.same_as = l.name("same_as");
-      if (d.same_as == d.load) l.fail("same_as", "a load cannot take its own shape");
-    }
-    for (const char* k : {"shift_deg", "shift_rad"})
-      if (l.has(k) && !l.has("same_as")) l.fail(k, "a shift needs same_as");
-    if (l.has("shift_deg") && l.has("shift_rad")) l.fail("shift_rad", "give shift_deg or shift_rad, not both");
-    // shift_rad: how rdyn writes it back (degrees do not reach every radian value exactly).
-    d.shift_rad = l.has("shift_rad") ? l.num_abs_max("shift_rad", 0.0, 2 * kPi, "rad")
-                                     : l.num_abs_max("shift_deg", 0.0, 360.0, "degrees") * kPi / 180.0;
-    o.loads.push_back(d);
-    same_nodes.push_back(n);
-  });
-  if (f.has("loads") && o.loads.empty()) f.fail("loads", "list at least one design load, or leave the key out");
-  // Where the design is written: the refusals that need the whole design (calibration scales
-  // every joint torque together) come after loading.
-  s.key_lines["optimize"] = f.line();
-  if (f.has("loads")) note_key(s, f.ctx(), "optimize.loads", f.raw("loads"));
-  for (size_t i = 0; i < o.loads.size(); ++i) {
-    const auto& d = o.loads[i];
-    if (d.same_as.empty()) continue;
-    const auto it = std::find_if(o.loads.begin(), o.loads.end(), [&](const OptimizeLoad& e) { return e.load == d.same_as; });
-    const std::string path = f.join("loads") + fmt::format("[{}].same_as", i);
-    if (it == o.loads.end())
-      f.fail_at(same_nodes[i]["same_as"], path, "'" + d.same_as + "' is not a design load listed in optimize.loads");
-    if (!it->same_as.empty())
-      f.fail_at(same_nodes[i]["same_as"], path,
-                "'" + d.same_as + "' takes its shape from '" + it->same_as + "': name that load instead");
-  }
-  if (f.has("of")) {
-    o.of = f.name("of");
-    const Joint* j = s.find_joint(o.of);
-    if (!j) f.fail("of", "unknown joint '" + o.of + "'");
-    if (j->type != JointType::Revolute) f.fail("of", "a profile reads a revolute joint's angle");
-  }
-  if (f.has("force")) {
-    o.force = f.name("force");
-    const auto& cf = s.outputs.constraint_forces;
-    if (std::none_of(cf.begin(), cf.end(), [&](const ConstraintForceRequest& c) { return c.name == o.force; }))
-      f.fail("force", "no requested constraint force named '" + o.force + "' (outputs.constraint_forces)");
-  }
-  if (f.has("harmonics")) {
-    const double h = f.num_in("harmonics", 1, kMaxOptimizeHarmonics, "");
-    if (h != std::floor(h)) f.fail("harmonics", fmt::format("must be a whole number (got {:g})", h));
-    o.harmonics = static_cast<int>(h);
-  }
-  if (f.has("max_load")) {
-    o.max_load = f.num("max_load");
-    if (!(o.max_load > 0 && o.max_load <= limits::kMaxForce))
-      f.fail("max_load", fmt::format("must be in (0, {:g}] N·m or N (got {:g})", limits::kMaxForce, o.max_load));
-  }
-  o.nonnegative = f.flag_or("nonnegative", true);
-  o.objective = f.str_or("objective", "peak");
-  if (o.objective != "peak" && o.objective != "pnorm") f.fail("objective", "expected peak or pnorm");
-  if (f.has("p")) {
-    o.p = f.num_in("p", 2, 64, "");
-    if (o.objective != "pnorm") f.fail("p", "an exponent needs objective: pnorm");
-  }
-  s.optimize = o;
-}
-
 // initial: read before the mechanism, because the generator places the mechanism at q0.
 void read_initial(const Fields& top, const Context& ctx, Scene& s) {
   if (!top.has("initial")) return;
@@ -991,153 +485,6 @@ void read_gravity(const Fields& top, const Context& ctx, Scene& s) {
   Fields f(top.raw("gravity"), "gravity", ctx, {"enabled", "g_m_s2"});
   s.gravity.enabled = f.flag_or("enabled", true);
   if (f.has("g_m_s2")) s.gravity.g_m_s2 = f.vec2("g_m_s2");
-}
-
-// outputs.constraint_forces: name, joint and a direction (a vector, or a named point of the
-// joint's child), stored as a unit vector.
-void read_constraint_force_requests(const Fields& f, const Context& ctx, Scene& s) {
-  for_each_item(f, "constraint_forces", [&](const YAML::Node& n, const std::string& path) {
-    Fields c(n, path, ctx, {"name", "joint", "direction"});
-    ConstraintForceRequest r{c.name("name"), c.str("joint"), {}};
-    const Joint* j = s.find_joint(r.joint);
-    if (!j) c.fail("joint", "unknown joint '" + r.joint + "'");
-    const YAML::Node d = c.required("direction");
-    if (d.IsScalar()) {  // toward a named point of the child, from the joint
-      const Vec2 to = read_point(c, "direction", j->child, s);
-      r.direction = {to.x - j->child_point.x, to.y - j->child_point.y};
-    } else {
-      r.direction = c.vec2("direction");
-    }
-    const double len = std::hypot(r.direction.x, r.direction.y);
-    if (len < 1e-12) c.fail("direction", "must be a non-zero vector");
-    r.direction = unit_vector(r.direction, len);
-    for (const auto& other : s.outputs.constraint_forces)
-      if (other.name == r.name) c.fail("name", "duplicate constraint force name");
-    s.outputs.constraint_forces.push_back(r);
-  });
-}
-
-void read_output_bodies(const Fields& f, Scene& s) {
-  if (!f.has("bodies")) return;
-  const YAML::Node b = f.raw("bodies");
-  if (!b.IsSequence()) f.fail("bodies", "expected a list of body names");
-  for (size_t i = 0; i < b.size(); ++i) {
-    // A body name, not a mapping or a list (yaml-cpp would only say "bad conversion").
-    if (!b[i].IsScalar()) f.fail_at(b[i], fmt::format("outputs.bodies[{}]", i), "expected a body name");
-    s.outputs.bodies.push_back(b[i].as<std::string>());
-  }
-}
-
-// `all` or a list of names; each name known (joints; for reactions, joints or loops).
-std::vector<std::string> read_names_or_all(const Fields& f, const Scene& s, const std::string& key,
-                                           bool loops_too) {
-  std::vector<std::string> out;
-  const YAML::Node n = f.raw(key);
-  const std::string what = loops_too ? "joint or loop" : "joint";
-  if (n.IsScalar() && n.Scalar() == "all") {
-    for (const auto& j : s.joints) out.push_back(j.name);
-    if (loops_too)
-      for (const auto& l : s.loops) out.push_back(l.name);
-  } else if (n.IsSequence()) {
-    for (const auto& item : n) {
-      const std::string name = item.IsScalar() ? item.Scalar() : "";
-      const bool loop = loops_too && std::any_of(s.loops.begin(), s.loops.end(),
-                                                 [&](const Loop& l) { return l.name == name; });
-      if (!s.find_joint(name) && !loop)
-        f.fail_at(item, f.join(key), "unknown " + what + " '" + name.substr(0, 64) + "'");
-      if (std::find(out.begin(), out.end(), name) != out.end())
-        f.fail_at(item, f.join(key), "'" + name + "' is listed twice");
-      out.push_back(name);
-    }
-  } else {
-    f.fail(key, "expected all or a list of " + what + " names");
-  }
-  for (const auto& name : out)  // R_<name> must say which one it is
-    if (loops_too && s.find_joint(name) &&
-        std::any_of(s.loops.begin(), s.loops.end(), [&](const Loop& l) { return l.name == name; }))
-      f.fail(key, "'" + name + "' names both a joint and a loop: rename one");
-  return out;
-}
-
-void read_outputs(const Fields& top, const Context& ctx, Scene& s) {
-  if (!top.has("outputs")) return;
-  Fields f(top.raw("outputs"), "outputs", ctx, {"constraint_forces", "bodies", "joints", "reactions", "shaking"});
-  read_constraint_force_requests(f, ctx, s);
-  read_output_bodies(f, s);
-  if (f.has("joints")) s.outputs.joints = read_names_or_all(f, s, "joints", false);
-  if (f.has("reactions")) {
-    s.outputs.reactions = read_names_or_all(f, s, "reactions", true);
-    const YAML::Node r = f.raw("reactions");
-    s.outputs.reactions_all = r.IsScalar() && r.Scalar() == "all";
-    note_key(s, f.ctx(), "outputs.reactions", f.raw("reactions"));
-  }
-  s.outputs.shaking = f.flag_or("shaking", false);
-}
-
-void read_simulation(const Fields& top, const Context& ctx, Scene& s) {
-  if (!top.has("simulation")) return;
-  Fields f(top.raw("simulation"), "simulation", ctx,
-           {"duration_s", "output_interval_s", "tolerance"});
-  s.simulation.duration_s = f.num_or("duration_s", s.simulation.duration_s);
-  s.simulation.output_interval_s = f.num_or("output_interval_s", s.simulation.output_interval_s);
-  s.simulation.tolerance = f.num_or("tolerance", s.simulation.tolerance);
-}
-
-// validation.calibrate: the operating point (cadence, and power or mean-speed mode) and the load
-// calibrated to reach it.
-void read_calibrate(const Fields& f, const Context& ctx, Scene& s) {
-  if (!f.has("calibrate")) return;
-  Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
-  s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
-  // power_W absent: mean-speed mode (the resistances stay as given).
-  s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
-  s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
-  if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
-  if (c.has("load") && s.validation.calibrate_load.empty())
-    c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");
-  // A present block with zeros would silently mean "off": refuse (ranges: check_scene).
-  if (!(s.validation.calibrate_cadence_Hz > 0)) c.fail("cadence_Hz", "must be positive");
-  if (c.has("power_W") && !(s.validation.calibrate_power_W > 0)) c.fail("power_W", "must be positive");
-}
-
-// Published values the report sets beside the calibration's (e.g. the original authors'
-// hip torque): plain text, HTML-escaped by the report.
-void read_compare(const Fields& f, const Context& ctx, Scene& s) {
-  for_each_item(f, "compare", [&](const YAML::Node& n, const std::string& path) {
-    Fields c(n, path, ctx, {"quantity", "value", "unit", "source", "explanation"});
-    CompareValue cv{c.str("quantity"), c.num("value"), c.str_or("unit", ""), c.str_or("source", ""),
-                    c.str_or("explanation", "")};
-    if (std::find(kCompareQuantities.begin(), kCompareQuantities.end(), cv.quantity) ==
-        kCompareQuantities.end())
-      c.fail("quantity", "expected drive_torque_Nm, peak_force_N, speed_fluctuation or mean_power_W");
-    if (!std::isfinite(cv.value)) c.fail("value", "must be a finite number");
-    if (!f.has("calibrate"))
-      c.fail("quantity", "compared values are calibration results: add validation.calibrate");
-    s.validation.compare.push_back(cv);
-  });
-}
-
-void read_validation(const Fields& top, const Context& ctx, Scene& s) {
-  if (!top.has("validation")) return;
-  Fields f(top.raw("validation"), "validation", ctx,
-           {"duration_s", "thresholds", "calibrate", "note", "reference_tolerance",
-            "reference_integrator", "compare"});
-  s.validation.duration_s = f.num_or("duration_s", 0.0);
-  s.validation.reference_tolerance = f.num_or("reference_tolerance", 1e-10);
-  s.validation.reference_integrator = f.str_or("reference_integrator", "rkmerson");
-  const auto& ri = s.validation.reference_integrator;
-  if (ri != "rkmerson" && ri != "rk3" && ri != "cpodes")
-    f.fail("reference_integrator", "expected rkmerson, rk3 or cpodes");
-  s.validation.note = f.str_or("note", "");
-  for_each_item(f, "thresholds", [&](const YAML::Node& n, const std::string& path) {
-    Fields t(n, path, ctx, {"quantity", "grid_deg", "interpolation", "max_error"});
-    Threshold th{t.str("quantity"), t.num_or("grid_deg", 10.0), t.str_or("interpolation", ""),
-                 t.num("max_error")};
-    // quantity, grid_deg, max_error: check_scene.
-    s.validation.thresholds.push_back(th);
-  });
-  read_calibrate(f, ctx, s);
-  read_compare(f, ctx, s);
 }
 
 // Reads the YAML tree into `s` (names and shapes checked here, values by check_scene), section
