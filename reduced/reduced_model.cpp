@@ -539,6 +539,70 @@ void mark_ahead(const ReducedModel& m, ReducedWorkspace& ws, size_t ng) {
 
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h) { return step_fixed_rk4(m, ws, h, nullptr); }
 
+namespace {
+
+// The fast path of step_fixed_rk4: no switch angle ahead within this step's reach (the record
+// mark_ahead left at this very state and gates): the step alone, without the prediction or the
+// check at its end, which would find nothing (the same arithmetic, the same result). Issue #11
+// item 6: the bicycle's RK4 steps cross an angle about one step in five. Returns true when the
+// step is done; otherwise the state is unchanged and k1 points to the start derivative (computed
+// into k1_storage when it was not given).
+bool step_clear_of_switches(const ReducedModel& m, ReducedWorkspace& ws, double h, const double*& k1,
+                            double k1_storage[2]) {
+  const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
+  if (!k1) {
+    calc_acceleration(m, ws, q0, v0, k1_storage[0], k1_storage[1]);
+    k1 = k1_storage;
+  }
+  const double dir = v0 > 0 ? 1.0 : -1.0, a0 = k1[0];
+  const double reach = dir * h * (v0 + 0.5 * a0 * h);  // predict_switch's
+  if (!(v0 * (v0 + a0 * h) > 0 && reach < dir * (ws.ahead_limit - q0))) return false;
+  rk4(m, ws, h, k1);
+  if (ws.qdot * v0 > 0 && dir * (ws.ahead_limit - ws.q) > 0) {
+    ws.ahead_q = ws.q, ws.ahead_qdot = ws.qdot;  // the same angle is still ahead
+    return true;
+  }
+  ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;  // it passed the angle after all: the full step
+  return false;
+}
+
+// Every gate agrees with its switching function's sign at the state: predictable gates are
+// checked by sign (no cosine); false as soon as one disagrees or one is not predictable (its
+// value is needed).
+bool gates_agree_by_sign(const ReducedModel& m, const ReducedWorkspace& ws, size_t ng) {
+  for (size_t g = 0; g < ng; ++g) {
+    const auto& gate = m.gates[g];
+    if (!predictable(gate)) return false;
+    const int s1 = switching_sign(gate, ws.q, ws.qdot);
+    if (s1 != 0 && static_cast<bool>(ws.gate_on[g]) != (s1 > 0)) return false;
+  }
+  return true;
+}
+
+// The check at a step's end from (q0, v0) to the workspace's state: the fraction of the step
+// where the first disagreeing gate's switching function crossed zero (linear interpolation
+// between the ends), fr[g] each gate's own (2 when it agrees at the end); > 1 when every gate
+// agrees.
+double first_switch_fraction(const ReducedModel& m, ReducedWorkspace& ws, double q0, double v0, size_t ng,
+                             double fr[32]) {
+  double s0[32];
+  const double q1 = ws.q, v1 = ws.qdot;
+  const double* sw = calc_switching_all(m, ws, q0, v0);
+  for (size_t g = 0; g < ng; ++g) s0[g] = sw[g];
+  double frac = 2.0;
+  const double* sw1 = calc_switching_all(m, ws, q1, v1);
+  for (size_t g = 0; g < ng; ++g) {
+    const double s1 = sw1[g];
+    fr[g] = 2.0;
+    if (s1 == 0.0 || static_cast<bool>(ws.gate_on[g]) == (s1 > 0)) continue;  // agrees at the end
+    fr[g] = ((s0[g] > 0) != (s1 > 0) && s0[g] != s1) ? s0[g] / (s0[g] - s1) : 0.0;
+    frac = std::min(frac, fr[g]);
+  }
+  return frac;
+}
+
+}  // namespace
+
 double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, const double* k1) {
   // Switches are handled one after another inside the step: a gate needs a flip in the
   // remaining interval exactly when it disagrees with the sign of its switching function at
@@ -553,35 +617,13 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   for (size_t g = 0; g < ng; ++g) all_predictable &= predictable(m.gates[g]);
   double t_first = NAN;
   double remaining = h;
-  // No switch angle ahead within this step's reach (the record mark_ahead left at this very
-  // state and gates): the step alone, without the prediction or the check at its end, which
-  // would find nothing (the same arithmetic, the same result). Issue #11 item 6: the bicycle's
-  // RK4 steps cross an angle about one step in five.
   double k1_ahead[2];  // outlives the block: k1 may point to it after
-  if (all_predictable && ws.q == ws.ahead_q && ws.qdot == ws.ahead_qdot && gate_mask(ws, ng) == ws.ahead_gates) {
-    const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
-    double* k1_own = k1_ahead;
-    const double* k1_now = k1;
-    if (!k1_now) {
-      calc_acceleration(m, ws, q0, v0, k1_own[0], k1_own[1]);
-      k1_now = k1_own;
-    }
-    const double dir = v0 > 0 ? 1.0 : -1.0, a0 = k1_now[0];
-    const double reach = dir * h * (v0 + 0.5 * a0 * h);  // predict_switch's
-    if (v0 * (v0 + a0 * h) > 0 && reach < dir * (ws.ahead_limit - q0)) {
-      rk4(m, ws, h, k1_now);
-      if (ws.qdot * v0 > 0 && dir * (ws.ahead_limit - ws.q) > 0) {
-        ws.ahead_q = ws.q, ws.ahead_qdot = ws.qdot;  // the same angle is still ahead
-        return t_first;
-      }
-      ws.q = q0, ws.qdot = v0, ws.t = t0, ws.work = w0;  // it passed the angle after all: the full step
-    }
-    k1 = k1_now;
-  }
+  if (all_predictable && ws.q == ws.ahead_q && ws.qdot == ws.ahead_qdot && gate_mask(ws, ng) == ws.ahead_gates &&
+      step_clear_of_switches(m, ws, h, k1, k1_ahead))
+    return t_first;
   bool agreed_at_end = false;
   for (int pass = 0; pass < 8 && remaining > 0; ++pass) {
     const double q0 = ws.q, v0 = ws.qdot, t0 = ws.t, w0 = ws.work;
-    double s0[32], fr[32];
     // The given start derivative holds until a gate flips (pass 0 and its shortened step).
     const double* k1_now = pass == 0 ? k1 : nullptr;
     double k1_own[2];
@@ -616,36 +658,9 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
     }
     rk4(m, ws, remaining, k1_now);
     // The check at the step's end: every gate agrees with its switching function's sign there,
-    // or the step is split where the first disagreeing one crossed zero (linear interpolation
-    // between the ends). Predictable gates are checked by sign first (no cosine); their values
-    // are computed only when one disagrees.
-    bool disagree = false;
-    for (size_t g = 0; g < ng && !disagree; ++g) {
-      const auto& gate = m.gates[g];
-      if (!predictable(gate)) {
-        disagree = true;  // checked on the values below
-        break;
-      }
-      const int s1 = switching_sign(gate, ws.q, ws.qdot);
-      disagree = s1 != 0 && static_cast<bool>(ws.gate_on[g]) != (s1 > 0);
-    }
-    if (!disagree) {
-      remaining = 0.0;  // the step to the end stands
-      agreed_at_end = true;
-      break;
-    }
-    const double q1 = ws.q, v1 = ws.qdot;
-    const double* sw = calc_switching_all(m, ws, q0, v0);
-    for (size_t g = 0; g < ng; ++g) s0[g] = sw[g];
-    double frac = 2.0;
-    const double* sw1 = calc_switching_all(m, ws, q1, v1);
-    for (size_t g = 0; g < ng; ++g) {
-      const double s1 = sw1[g];
-      fr[g] = 2.0;
-      if (s1 == 0.0 || static_cast<bool>(ws.gate_on[g]) == (s1 > 0)) continue;  // agrees at the end
-      fr[g] = ((s0[g] > 0) != (s1 > 0) && s0[g] != s1) ? s0[g] / (s0[g] - s1) : 0.0;
-      frac = std::min(frac, fr[g]);
-    }
+    // or the step is split where the first disagreeing one crossed zero.
+    double fr[32];
+    const double frac = gates_agree_by_sign(m, ws, ng) ? 2.0 : first_switch_fraction(m, ws, q0, v0, ng, fr);
     if (frac > 1.0) {
       remaining = 0.0;  // the step to the end stands
       agreed_at_end = true;

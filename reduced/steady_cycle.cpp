@@ -1,4 +1,5 @@
 #include "reduced/steady_cycle.hpp"
+#include "reduced/cycle_extremes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -45,86 +46,6 @@ constexpr double kFixedPointStagnation = 1e-9;
 // Quantities followed over the cycle at each point: |q̇|, −|q̇| (its minimum as a maximum),
 // then |F_E,k| per constraint force.
 int quantity_count(const ReducedModel& m) { return 2 + static_cast<int>(m.force_names.size()); }
-
-// Point i of m equal sub-intervals of [a, b] (the end exactly b).
-double sample_theta(double a, double b, int i, int m) { return i == m ? b : a + (b - a) * i / m; }
-
-// Max of f over [lo, hi] by golden-section search, given f at both ends, to a bracket of xtol
-// (at most 200 evaluations). A maximum at an end (a monotone piece, or a load switch at the
-// piece's end) is found as that end.
-template <typename F>
-void golden_max(F&& f, double lo, double hi, double f_lo, double f_hi, double xtol, double& x_best,
-                double& f_best) {
-  auto keep = [&](double x, double v) {
-    if (v > f_best) f_best = v, x_best = x;
-  };
-  keep(lo, f_lo);
-  keep(hi, f_hi);
-  constexpr double r = 0.6180339887498949;  // (√5 − 1)/2
-  double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
-  double f1 = f(x1), f2 = f(x2);
-  for (int it = 0; it < 200 && hi - lo > xtol; ++it) {
-    if (f1 < f2) {
-      lo = x1, x1 = x2, f1 = f2;
-      x2 = lo + r * (hi - lo);
-      f2 = f(x2);
-    } else {
-      hi = x2, x2 = x1, f2 = f1;
-      x1 = hi - r * (hi - lo);
-      f1 = f(x1);
-    }
-  }
-  keep(x1, f1);
-  keep(x2, f2);
-}
-
-// The cycle split into pieces [a_j, b_j] of θ (inside a piece every load is smooth); eval(j, θ,
-// out) gives the followed quantities at θ with piece j's gates. Samples every piece at
-// ≥ `samples` points per period P, then refines each quantity's largest sample by golden
-// section over the sub-intervals on either side of it (in the neighbouring piece when the
-// sample is a piece's end; the pieces wrap around: the cycle is periodic).
-template <typename Eval>
-void find_extremes(const std::vector<double>& a, const std::vector<double>& b, int samples, double P, int nq,
-                   Eval&& eval, std::vector<double>& value, std::vector<double>& where) {
-  const int pieces = static_cast<int>(a.size());
-  std::vector<int> subs(pieces);
-  struct Best {
-    double v = -INFINITY;
-    int piece = 0, i = 0;
-  };
-  std::vector<Best> best(nq);
-  std::vector<double> out(nq);
-  for (int j = 0; j < pieces; ++j) {
-    subs[j] = std::max(1, static_cast<int>(std::ceil((b[j] - a[j]) * samples / P - 1e-9)));
-    for (int i = 0; i <= subs[j]; ++i) {
-      eval(j, sample_theta(a[j], b[j], i, subs[j]), out.data());
-      for (int k = 0; k < nq; ++k)
-        if (out[k] > best[k].v) best[k] = {out[k], j, i};
-    }
-  }
-  value.assign(nq, 0.0);
-  where.assign(nq, 0.0);
-  const double xtol = 1e-10 * std::max(1.0, P);
-  for (int k = 0; k < nq; ++k) {
-    const Best& bk = best[k];
-    value[k] = bk.v;
-    where[k] = sample_theta(a[bk.piece], b[bk.piece], bk.i, subs[bk.piece]);
-    // Sub-intervals (piece, i_lo) on either side of the best sample.
-    std::pair<int, int> side[2];
-    const int jl = (bk.piece + pieces - 1) % pieces, jr = (bk.piece + 1) % pieces;
-    side[0] = bk.i > 0 ? std::make_pair(bk.piece, bk.i - 1) : std::make_pair(jl, subs[jl] - 1);
-    side[1] = bk.i < subs[bk.piece] ? std::make_pair(bk.piece, bk.i) : std::make_pair(jr, 0);
-    for (const auto& [j, i] : side) {
-      const double lo = sample_theta(a[j], b[j], i, subs[j]), hi = sample_theta(a[j], b[j], i + 1, subs[j]);
-      auto f = [&](double th) {
-        eval(j, th, out.data());
-        return out[k];
-      };
-      const double f_lo = f(lo), f_hi = f(hi);
-      golden_max(f, lo, hi, f_lo, f_hi, xtol, where[k], value[k]);
-    }
-  }
-}
 
 // Followed quantities at a state (q, q̇) with the workspace's gates.
 void quantities_at(const ReducedModel& m, ReducedWorkspace& ws, double q, double qdot, std::vector<double>& forces,
@@ -521,21 +442,28 @@ SteadyCycle calc_steady_cycle(const ReducedModel& m, const SteadyCycleOptions& o
   return c;
 }
 
-SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyCycleOptions& opt) {
-  check_steady_cycle_options(opt);
-  if (!m.table.periodic)
-    throw models::NumericalError("steady cycle: the table is not periodic (the independent coordinate does not turn "
-                                 "a full period), so there is no cycle");
+namespace {
+
+// The fixed point of the Poincaré map at the section q_s (time stepping): the section speed, the
+// period, and the revolutions and steps it took.
+struct SectionSpeed {
+  double qdot = NAN, period_s = NAN;
+  int passes = 0;
+  long steps = 0;
+};
+
+// Secant iteration on g(v) = Φ(v) − v, Φ(v) the q̇ after one period from (q_s, v); NumericalError
+// when it finds no cycle.
+SectionSpeed find_section_speed(const ReducedModel& m, const SteadyCycleOptions& opt) {
   const double s = opt.qdot_guess > 0 ? 1.0 : -1.0, P = m.table.period, qs = opt.q_section;
   // Each revolution may take 5·10⁴ steps (the bicycle's take ~200 at 1e-10): a crank held by
   // friction chatters at rest and would otherwise use the integrator's whole budget.
   IntegratorLimits limits;
   limits.max_steps = 50000;
-  int passes = 0;
-  long steps = 0;
-  // Poincaré map: q̇ after one period from (q_s, v); NaN when the period is not completed.
+  SectionSpeed out;
+  // Φ(v); NaN when the period is not completed.
   auto map = [&](double v, double& period) {
-    ++passes;
+    ++out.passes;
     AdaptiveIntegrator integ(m, opt.tolerance, "rk8pd", limits);
     integ.reset(0.0, qs, v);
     // A period takes P/|v| at the starting speed; allow 20 times that before calling it a stall.
@@ -545,7 +473,7 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
     } catch (const models::NumericalError&) {
       done = false;  // over its budget: a stall
     }
-    steps += integ.steps();
+    out.steps += integ.steps();
     period = integ.state().t;
     return done ? integ.state().qdot : NAN;
   };
@@ -553,7 +481,7 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
   double v0 = opt.qdot_guess, g0 = map(v0, p0) - v0;
   double v1 = std::isfinite(g0) ? v0 + g0 : v0 * 1.01, g1 = map(v1, p1) - v1;
   bool ok = false;
-  while (passes < opt.max_passes && std::isfinite(g0) && std::isfinite(g1)) {
+  while (out.passes < opt.max_passes && std::isfinite(g0) && std::isfinite(g1)) {
     if (std::abs(g1) < kFixedPointTolerance * std::abs(v1)) {
       ok = true;
       break;
@@ -568,60 +496,65 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
     throw models::NumericalError(fmt::format(
         "steady cycle (time stepping): no periodic cycle found in {} revolutions from q̇ = {:.6g} rad/s at q = {:.6g} "
         "rad ({})",
-        passes, opt.qdot_guess, qs,
+        out.passes, opt.qdot_guess, qs,
         std::isfinite(g1) ? fmt::format("the speed still changes by {:.3g} of itself per cycle", std::abs(g1 / v1))
                           : "a revolution was not completed: the mechanism stalls or turns back"));
-  SteadyCycle c;
-  c.method = CycleMethod::TimeStepping;
-  c.passes = passes;
-  c.qdot_section = v1;
-  c.period_s = p1;
+  out.qdot = v1;
+  out.period_s = p1;
+  return out;
+}
 
-  // The cycle once more, sampled at samples equal steps of θ = s·(q − q_s) by stopping at each.
+struct CycleSample {
+  double t, q, qdot, work;
+  std::vector<char> gates;
+};
+
+// The cycle from (q_s, v) sampled at N + 1 equal steps of θ = s·(q − q_s) by stopping at each.
+std::vector<CycleSample> sample_cycle(AdaptiveIntegrator& integ, const SteadyCycleOptions& opt, double P,
+                                      double v, double t_max) {
+  const double s = opt.qdot_guess > 0 ? 1.0 : -1.0, qs = opt.q_section;
   const int N = opt.samples;
-  struct Sample {
-    double t, q, qdot, work;
-    std::vector<char> gates;
-  };
-  std::vector<Sample> smp;
+  std::vector<CycleSample> smp;
   smp.reserve(N + 1);
-  limits.max_steps = 1000000;
-  AdaptiveIntegrator integ(m, opt.tolerance, "rk8pd", limits);
-  integ.reset(0.0, qs, v1);
-  smp.push_back({0.0, qs, v1, 0.0, integ.state().gate_on});
-  const double t_max = 20.0 * P / std::abs(v1) + 10.0 * p1;
+  integ.reset(0.0, qs, v);
+  smp.push_back({0.0, qs, v, 0.0, integ.state().gate_on});
   for (int i = 1; i <= N; ++i) {
     if (!integ.advance(t_max, qs + s * sample_theta(0.0, P, i, N)))
       throw models::NumericalError("steady cycle (time stepping): the cycle found does not complete a period");
     const auto& st = integ.state();
     smp.push_back({st.t, st.q, st.qdot, st.work, st.gate_on});
   }
-  ++c.passes;
+  return smp;
+}
+
+// Speed extremes and peak constraint forces over the sampled cycle (cycle_extremes.hpp): a point
+// between samples is reached by integrating from the sample before it, stopped there like an event.
+void fill_extremes(const ReducedModel& m, const SteadyCycleOptions& opt, const std::vector<CycleSample>& smp,
+                   AdaptiveIntegrator& integ, SteadyCycle& c) {
+  const double P = m.table.period, qs = opt.q_section, v = smp.front().qdot, s = opt.qdot_guess > 0 ? 1.0 : -1.0;
+  const int N = opt.samples;
+  const double dth = P / N;
   ReducedWorkspace ws(m);
   std::vector<double> forces(m.force_names.size()), value, where;
-  const double dth = P / N;
-  find_extremes(
-      std::vector<double>{0.0}, std::vector<double>{P}, N, P, quantity_count(m),
-      [&](int, double theta, double* out) {
-        int i = std::clamp(static_cast<int>(std::floor(theta / dth)), 0, N);
-        while (i > 0 && sample_theta(0.0, P, i, N) > theta) --i;
-        while (i < N && sample_theta(0.0, P, i + 1, N) <= theta) ++i;
-        // At a sample, or so close after it that the sample (stopped just past its angle) is
-        // already there: the sample itself.
-        const Sample& at = smp[i];
-        if (theta == sample_theta(0.0, P, i, N) || s * (at.q - (qs + s * theta)) >= 0) {
-          ws.gate_on = at.gates;
-          quantities_at(m, ws, at.q, at.qdot, forces, out);
-          return;
-        }
-        // Between samples: from sample i to q(θ), stopped there like an event.
-        integ.reset(at.t, at.q, at.qdot, at.work);
-        if (!integ.advance(at.t + 20.0 * P / std::abs(v1), qs + s * theta))
-          throw models::NumericalError("steady cycle (time stepping): the cycle found does not complete a period");
-        ws.gate_on = integ.state().gate_on;
-        quantities_at(m, ws, integ.state().q, integ.state().qdot, forces, out);
-      },
-      value, where);
+  auto eval = [&](int, double theta, double* out) {
+    int i = std::clamp(static_cast<int>(std::floor(theta / dth)), 0, N);
+    while (i > 0 && sample_theta(0.0, P, i, N) > theta) --i;
+    while (i < N && sample_theta(0.0, P, i + 1, N) <= theta) ++i;
+    // At a sample, or so close after it that the sample (stopped just past its angle) is already
+    // there: the sample itself.
+    const CycleSample& at = smp[i];
+    if (theta == sample_theta(0.0, P, i, N) || s * (at.q - (qs + s * theta)) >= 0) {
+      ws.gate_on = at.gates;
+      quantities_at(m, ws, at.q, at.qdot, forces, out);
+      return;
+    }
+    integ.reset(at.t, at.q, at.qdot, at.work);
+    if (!integ.advance(at.t + 20.0 * P / std::abs(v), qs + s * theta))
+      throw models::NumericalError("steady cycle (time stepping): the cycle found does not complete a period");
+    ws.gate_on = integ.state().gate_on;
+    quantities_at(m, ws, integ.state().q, integ.state().qdot, forces, out);
+  };
+  find_extremes(std::vector<double>{0.0}, std::vector<double>{P}, N, P, quantity_count(m), eval, value, where);
   c.speed_max = value[0];
   c.speed_min = -value[1];
   for (size_t k = 0; k < forces.size(); ++k) {
@@ -629,18 +562,46 @@ SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyC
     const double q = qs + s * where[2 + k];
     c.peak_force_q.push_back(q - P * std::floor((q - m.table.q0) / P));
   }
-  // Work of the resistances per cycle, ∫ F_b dq = s ∫ (P_b / q̇) dθ, by Simpson's rule over
-  // the samples (trapezoids for an odd count): the integrator only carries the total work.
+}
+
+// Work of the resistances per cycle, ∫ F_b dq = s ∫ (P_b / q̇) dθ, by Simpson's rule over the
+// samples (trapezoids for an odd count): the integrator only carries the total work.
+double brake_work_per_cycle(const ReducedModel& m, const std::vector<CycleSample>& smp, double s, double P) {
+  const int N = static_cast<int>(smp.size()) - 1;
+  const double dth = P / N;
   std::vector<double> fb(N + 1);
   for (int i = 0; i <= N; ++i) fb[i] = s * brake_power(m, smp[i].q, smp[i].qdot) / smp[i].qdot;
-  double work_brakes = 0.0;
+  double work = 0.0;
   if (N % 2 == 0) {
-    for (int i = 0; i < N; i += 2) work_brakes += dth / 3 * (fb[i] + 4 * fb[i + 1] + fb[i + 2]);
+    for (int i = 0; i < N; i += 2) work += dth / 3 * (fb[i] + 4 * fb[i + 1] + fb[i + 2]);
   } else {
-    for (int i = 0; i < N; ++i) work_brakes += 0.5 * dth * (fb[i] + fb[i + 1]);
+    for (int i = 0; i < N; ++i) work += 0.5 * dth * (fb[i] + fb[i + 1]);
   }
-  fill_work(c, P, smp.back().work, work_brakes);
-  c.steps = steps + integ.steps();
+  return work;
+}
+
+}  // namespace
+
+SteadyCycle calc_steady_cycle_time_stepping(const ReducedModel& m, const SteadyCycleOptions& opt) {
+  check_steady_cycle_options(opt);
+  if (!m.table.periodic)
+    throw models::NumericalError("steady cycle: the table is not periodic (the independent coordinate does not turn "
+                                 "a full period), so there is no cycle");
+  const double P = m.table.period;
+  const SectionSpeed section = find_section_speed(m, opt);
+  const double v1 = section.qdot, s = opt.qdot_guess > 0 ? 1.0 : -1.0;
+  SteadyCycle c;
+  c.method = CycleMethod::TimeStepping;
+  c.passes = section.passes + 1;  // and the sampled pass
+  c.qdot_section = v1;
+  c.period_s = section.period_s;
+  IntegratorLimits limits;
+  limits.max_steps = 1000000;
+  AdaptiveIntegrator integ(m, opt.tolerance, "rk8pd", limits);
+  const auto smp = sample_cycle(integ, opt, P, v1, 20.0 * P / std::abs(v1) + 10.0 * section.period_s);
+  fill_extremes(m, opt, smp, integ, c);
+  fill_work(c, P, smp.back().work, brake_work_per_cycle(m, smp, s, P));
+  c.steps = section.steps + integ.steps();
   // As the first integral's test: the energy gained per cycle (the work of every
   // non-conservative load) is below 1e-6 of the work flowing through it — not a runaway.
   const double flow = std::abs(c.drive_work_J) + std::abs(c.dissipated_work_J);
