@@ -8,8 +8,6 @@
 #include <cmath>
 #include <functional>
 
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_odeiv2.h>
 
 #include "analytic_source.hpp"
 #include "reduced/extract.hpp"
@@ -125,60 +123,6 @@ TEST(SimulateReduced, WallTimeBudgetStopsAdaptiveAndFixedStepRuns) {
   }
 }
 
-// AdaptiveIntegrator drives GSL's steppers itself (the start derivative and the end point come
-// from the previous step instead of two more right-hand sides): on a model without gates its
-// steps are gsl_odeiv2_evolve_apply's bit for bit, rejected steps included.
-struct GslRhs {
-  const ReducedModel* m;
-  ReducedWorkspace* ws;
-};
-int gsl_rhs(double, const double y[], double f[], void* p) {
-  auto* c = static_cast<GslRhs*>(p);
-  f[0] = y[1];
-  calc_acceleration(*c->m, *c->ws, y[0], y[1], f[1], f[2]);
-  return std::isfinite(f[1]) ? GSL_SUCCESS : GSL_EBADFUNC;
-}
-
-TEST(SimulateReduced, AdaptiveStepsAreGslEvolveApplyStepForStep) {
-  const auto m = free_crank();
-  for (const char* method : {"rk8pd", "rkf45"}) {
-    for (double tol : {1e-6, 1e-12}) {
-      AdaptiveIntegrator integ(m, tol, method);
-      integ.reset(0.0, 0.0, 10.0);
-      ReducedWorkspace ws(m);
-      GslRhs ctx{&m, &ws};
-      gsl_odeiv2_system sys{gsl_rhs, nullptr, 3, &ctx};
-      const auto* type = std::string(method) == "rk8pd" ? gsl_odeiv2_step_rk8pd : gsl_odeiv2_step_rkf45;
-      gsl_odeiv2_step* st = gsl_odeiv2_step_alloc(type, 3);
-      gsl_odeiv2_control* con = gsl_odeiv2_control_standard_new(tol, tol, 1.0, 1.0);
-      gsl_odeiv2_evolve* ev = gsl_odeiv2_evolve_alloc(3);
-      double t = 0.0, h = 1e-3, y[3] = {0.0, 10.0, 0.0};
-      long n = 0;
-      while (t < 1.0 && n < 100000) {
-        ASSERT_EQ(gsl_odeiv2_evolve_apply(ev, con, st, &sys, &t, 1.0, &h, y), GSL_SUCCESS);
-        integ.step(1.0);
-        ++n;
-        const auto& e = integ.step_end();
-        ASSERT_EQ(e.t, t) << method << " " << tol << " step " << n;
-        ASSERT_EQ(e.q, y[0]) << method << " " << tol << " step " << n;
-        ASSERT_EQ(e.qdot, y[1]) << method << " " << tol << " step " << n;
-        ASSERT_EQ(e.work, y[2]);
-        double f[3];
-        gsl_rhs(t, y, f, &ctx);
-        ASSERT_EQ(e.qddot, f[1]);  // the end point's q̈ is the stepper's own end derivative
-      }
-      EXPECT_EQ(integ.steps(), n);
-      EXPECT_EQ(integ.rejected(), static_cast<long>(ev->failed_steps));
-      if (tol == 1e-12) {
-        EXPECT_GT(integ.rejected(), 0) << method;  // the first 1 ms step is refused
-      }
-      gsl_odeiv2_evolve_free(ev);
-      gsl_odeiv2_control_free(con);
-      gsl_odeiv2_step_free(st);
-    }
-  }
-}
-
 TEST(SimulateReduced, AnEnergyBalanceOffByMoreThanOnePercentFailsTheRun) {
   // E − E0 − W over two rows against the scale max(|E|, |W|, range of E): 0.5 J of 10.5 J fails,
   // 0.05 J passes; a pendulum whose datum makes E ≡ 0 closes to rounding and passes.
@@ -218,26 +162,6 @@ TEST(SimulateReduced, NonFiniteOutputFailsTheRun) {
     EXPECT_NE(msg.find("q̈ is not finite"), std::string::npos) << integrator << ": " << msg;
     EXPECT_THROW(simulate_reduced(m, 0.0, 1e10, o), models::NumericalError);
   }
-}
-
-TEST(SimulateReduced, AStepThatMeetsANonFiniteAccelerationSaysSoInPlainWords) {
-  // Finite at the start, −∞ from 90° on (m2 = 1e300 at q̇ = 1e10 overflows): GSL reports
-  // GSL_EBADFUNC, whose own text ("problem with user-supplied function") must not reach users.
-  test::AnalyticSource src;
-  ExtractOptions eo;
-  eo.step_rad = 10 * M_PI / 180;
-  const auto scene = test::analytic_scene();
-  auto s = extract_samples(src, scene, eo);
-  auto& m2 = s.columns[s.require("m2")];
-  for (size_t i = 0; i < s.q.size(); ++i)
-    if (s.q[i] >= M_PI / 2) m2[i] = 1e300;
-  const auto m = make_reduced_model(s, scene, Interpolation::Linear);
-  AdaptiveIntegrator integ(m, 1e-8);
-  integ.reset(0.0, 0.0, 1e10);
-  const std::string msg = message_of([&] { integ.advance(1.0); });
-  EXPECT_EQ(msg.rfind("reduced integration failed at t = ", 0), 0u) << msg;
-  EXPECT_NE(msg.find("): the reduced model's acceleration q̈ is not finite there"), std::string::npos) << msg;
-  EXPECT_EQ(msg.find("user-supplied"), std::string::npos) << msg;
 }
 
 }  // namespace
