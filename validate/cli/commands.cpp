@@ -19,6 +19,7 @@
 #include "reduced/simulate_reduced.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/calibrated_scene.hpp"
 #include "validate/cli/cli_limits.hpp"
 #include "validate/io/escape.hpp"
 #include "validate/harness/harness.hpp"

@@ -2,6 +2,7 @@
 // (a flywheel against viscous resistance; a gated cylinder force), obeys the energy balance per
 // revolution, and refusals name the field.
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/calibrated_scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -96,49 +97,6 @@ TEST(Calibrate, LegPressIsConfirmedOverWholeRevolutionsAndItsWrittenSceneHoldsTh
   const double f = whole_turn_cadence(engine::simulate_full(engine::FullModel(written), fo));
   EXPECT_NEAR(f, 0.5, 0.01 * 0.5);
   EXPECT_NEAR(f, r.mean_cadence_hz_full, 1e-3 * 0.5);  // both steady: far inside the 1 %
-}
-
-TEST(Calibrate, WrittenSceneScalesProfiledLoadsWhereTheSceneListsThem) {
-  // bicycle-profile: hip_torque_Nm 0 (no generated torques) and two profiled hip torques under
-  // `loads`: the amplitudes are rewritten there, the generator's hip torque stays 0 (setting it
-  // would add constant hip torques beside the profiles).
-  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle-profile.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto scene = models::parse_scene(text.str(), "bicycle-profile.yaml");
-  CalibrationResult r;
-  r.torque_Nm = r.load_value = 12.5;  // every joint torque together: the magnitude each gets
-  r.steady_qdot = 6.0;
-  const std::string out = calibrated_scene_yaml("bicycle-profile.yaml", text.str(), {}, scene, CalibrationOptions{}, r);
-  const auto again = models::parse_scene(out, "written.yaml");
-  ASSERT_EQ(again.joint_torques.size(), 2u);
-  for (const auto& t : again.joint_torques) {
-    EXPECT_TRUE(t.profile) << t.name;
-    EXPECT_EQ(t.value, 12.5) << t.name;
-  }
-}
-
-TEST(Calibrate, WrittenSceneScalesPointForcesNamedTogether) {
-  // bicycle-muscle: two profiled point forces under `loads`, calibrated together by name; both
-  // tensions are rewritten (the profile's amplitude), nothing of the generator.
-  std::ifstream in(std::string(RDYN_SCENES) + "/bicycle-muscle.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto scene = models::parse_scene(text.str(), "bicycle-muscle.yaml");
-  CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
-  EXPECT_EQ(opt.load, "gluteus_r+gluteus_l");  // from its validation.calibrate block
-  CalibrationResult r;
-  r.load_value = 512.5;  // names joined by '+': the magnitude each gets
-  r.steady_qdot = 6.0;
-  const auto again =
-      models::parse_scene(calibrated_scene_yaml("bicycle-muscle.yaml", text.str(), {}, scene, opt, r), "w.yaml");
-  ASSERT_EQ(again.point_forces.size(), 2u);
-  for (const auto& f : again.point_forces) {
-    EXPECT_TRUE(f.profile && f.active_when) << f.name;
-    EXPECT_EQ(f.value, 512.5) << f.name;
-  }
-  EXPECT_TRUE(again.joint_torques.empty());
-  EXPECT_EQ(again.initial.qdot, 6.0);
 }
 
 TEST(Calibrate, HigherPowerNeedsProportionallyMoreTorque) {
