@@ -420,47 +420,6 @@ std::pair<StrategyResult, models::Scene> calc_strategy(const Workspace& w, const
 
 }  // namespace
 
-double calc_fourier_minimum(double a0, const std::vector<double>& a, const std::vector<double>& b) {
-  const size_t H = std::max(a.size(), b.size());
-  auto coef = [&](const std::vector<double>& c, size_t k) { return k < c.size() ? c[k] : 0.0; };
-  // τ, τ′, τ″ at θ.
-  auto eval = [&](double th, double& d1, double& d2) {
-    double v = a0;
-    d1 = d2 = 0.0;
-    for (size_t k = 0; k < H; ++k) {
-      const double n = static_cast<double>(k + 1), c = std::cos(n * th), s = std::sin(n * th);
-      const double ak = coef(a, k), bk = coef(b, k);
-      v += ak * c + bk * s;
-      d1 += n * (bk * c - ak * s);
-      d2 -= n * n * (ak * c + bk * s);
-    }
-    return v;
-  };
-  // A grid of N = 16(H + 1) angles (≥ 8 points per period of the highest harmonic): each local
-  // minimum of the samples brackets one of τ's (τ′ has at most 2H zeros), refined by Newton on
-  // τ′ within ± one spacing (quadratic convergence; 30 steps bound it).
-  const size_t N = 16 * (H + 1);
-  const double h = kTwoPi / static_cast<double>(N);
-  std::vector<double> v(N);
-  double d1 = 0.0, d2 = 0.0, lowest = HUGE_VAL;
-  for (size_t i = 0; i < N; ++i) v[i] = eval(h * static_cast<double>(i), d1, d2), lowest = std::min(lowest, v[i]);
-  for (size_t i = 0; i < N && H > 0; ++i) {
-    if (!(v[i] <= v[(i + N - 1) % N] && v[i] <= v[(i + 1) % N])) continue;
-    const double th0 = h * static_cast<double>(i);
-    double th = th0;
-    for (int it = 0; it < 30; ++it) {
-      eval(th, d1, d2);
-      if (!(d2 > 0)) break;  // not convex here: the samples already hold the minimum's value
-      const double step = d1 / d2;
-      th -= step;
-      if (std::abs(th - th0) > h) break;  // left its cell: another cell's minimum
-      lowest = std::min(lowest, eval(th, d1, d2));
-      if (std::abs(step) < 1e-14) break;
-    }
-  }
-  return lowest;
-}
-
 models::Scene scene_with_added_torques(const models::Scene& scene, const OptimizeOptions& opt) {
   models::Scene s = scene;
   for (const auto& j : opt.add_torques) {
@@ -535,13 +494,12 @@ void check_optimize_options(const models::Scene& scene, const OptimizeOptions& o
     fail("independent", "optimize shapes loads over a revolute independent coordinate that turns fully");
 }
 
-OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& opt, Progress& progress) {
-  const auto start = Clock::now();
-  const models::Scene scene = scene_with_added_torques(scene_in, opt);
-  check_optimize_options(scene, opt);
-  const models::OptimizeSpec spec = scene.optimize.value_or(models::OptimizeSpec{});
-  const Design design = resolve_design(scene, spec, opt);
+namespace {
 
+// Stage 1: what the result describes before any work: the objective, the design loads and their
+// shifts and groups, the force minimised (`force`: its index among the constraint forces).
+OptimizeResult describe_problem(const models::Scene& scene, const models::OptimizeSpec& spec, const Design& design,
+                                const OptimizeOptions& opt, int& force) {
   OptimizeResult r;
   r.scene = scene.name;
   r.objective = !opt.objective.empty() ? opt.objective : spec.objective;
@@ -555,7 +513,7 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   r.force_name = !opt.force_name.empty() ? opt.force_name
                  : !spec.force.empty()   ? spec.force
                                          : scene.outputs.constraint_forces[0].name;
-  int force = 0;
+  force = 0;
   while (scene.outputs.constraint_forces[force].name != r.force_name) ++force;
   for (const auto& dl : design.loads) {
     r.design_loads.push_back(scene.joint_torques[dl.torque].name);
@@ -571,8 +529,11 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
     r.same_as.push_back(same);
   }
   for (const auto& j : opt.add_torques) r.added_loads.push_back("torque_" + j);
+  return r;
+}
 
-  // Calibration as `rdyn calibrate` does it, every joint torque (the design loads) together.
+// Calibration as `rdyn calibrate` does it, every joint torque (the design loads) together.
+CalibrationOptions calibration_options_for(const OptimizeOptions& opt) {
   CalibrationOptions copt;
   copt.cadence_hz = opt.cadence_hz;
   copt.power_w = opt.power_w;
@@ -580,59 +541,38 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   copt.grid_deg = opt.grid_deg;
   copt.interpolation = opt.interpolation;
   copt.full_max_s = 0;
-  std::vector<double> x0(design.n, 0.0);
-  for (const auto& g : design.groups)
-    if (!g.fixed_a0) x0[g.offset] = g.a0_start;
-  const models::Scene s0 = shaped_scene(scene, design, x0.data());  // the constant strategy, profiled
-  check_calibratable(s0, copt);
-  r.resistance_coefficient = calc_resistance_coefficient(s0, copt);
+  return copt;
+}
 
-  // One extraction; the shape's angle is q itself or the joint-position column of `of`.
-  progress.note("optimize: extracting the reduced table");
+// Stage 2: the one extraction; the shape's angle is q itself or the joint-position column of `of`.
+reduced::Samples extract_for_design(const models::Scene& s0, const Design& design, const models::Scene& scene,
+                                    const OptimizeOptions& opt) {
   models::Scene s_extract = s0;
   if (design.of != scene.independent &&
       std::find(s_extract.outputs.joints.begin(), s_extract.outputs.joints.end(), design.of) ==
           s_extract.outputs.joints.end())
     s_extract.outputs.joints.push_back(design.of);
-  Workspace w;
-  w.design = &design;
-  w.copt = copt;
-  w.interp = reduced::parse_interpolation(opt.interpolation);
-  const reduced::Samples samples = extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
-  const reduced::ReducedModel base = reduced::make_reduced_model(samples, with_unit_load(s0, copt), w.interp);
-  w.samples = &samples;
-  w.base = &base;
-  w.scene = &scene;
-  w.force = force;
-  w.pnorm = r.objective == "pnorm";
-  w.p = r.p;
-  w.max_evaluations = opt.max_evaluations + 1;
+  return extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
+}
 
-  // The constant strategy: its refusals are the scene's (exit 2), its failure exit 1.
-  {
-    const auto s0u = with_unit_load(s0, copt);
-    Progress silent(false);
-    const auto cal = calibrate_reduced(base, s0u, copt, silent);
-    (void)cal;
-  }
-  const Evaluation e0 = evaluate(w, x0.data());
-  if (!e0.ok) throw models::NumericalError("optimize: the constant strategy has no steady cycle holding the cadence");
-  w.objective_scale = e0.objective > 0 ? e0.objective : 1.0;
-  r.max_load = design.groups[0].bound > 0 ? design.groups[0].bound : 5.0 * std::abs(e0.cal.load_value);
-  std::vector<Group> groups = design.groups;
-  for (auto& g : groups)
-    if (!(g.bound > 0)) g.bound = r.max_load;  // the documented default: 5× the constant strategy's value
+// The design with every group's bound set: the documented default is 5× the constant strategy's
+// value.
+Design bounded_design(const Design& design, double max_load) {
   Design bounded = design;
-  bounded.groups = groups;
-  w.design = &bounded;
-  w.last = Evaluation{};
+  for (auto& g : bounded.groups)
+    if (!(g.bound > 0)) g.bound = max_load;
+  return bounded;
+}
 
-  // COBYLA: derivative-free, handles the sampled inequality constraints directly.
-  progress.note("optimize: searching");
+// Stage 3: COBYLA (derivative-free, handles the sampled inequality constraints directly) from
+// x0; returns the point NLopt ends at and records the stop reason and counts in r.
+std::vector<double> search(Workspace& w, const Design& bounded, const std::vector<double>& x0,
+                           const OptimizeOptions& opt, Progress& progress, OptimizeResult& r) {
   const auto t_search = Clock::now();
-  nlopt_opt o = nlopt_create(NLOPT_LN_COBYLA, static_cast<unsigned>(design.n));
+  const unsigned n = static_cast<unsigned>(bounded.n);
+  nlopt_opt o = nlopt_create(NLOPT_LN_COBYLA, n);
   std::unique_ptr<nlopt_opt_s, decltype(&nlopt_destroy)> guard(o, nlopt_destroy);
-  std::vector<double> lb(design.n, -kCoefficientBound), ub(design.n, kCoefficientBound);
+  std::vector<double> lb(n, -kCoefficientBound), ub(n, kCoefficientBound);
   for (const auto& g : bounded.groups)
     if (!g.fixed_a0 && g.nonnegative) lb[g.offset] = 0.0;
   nlopt_set_lower_bounds(o, lb.data());
@@ -650,20 +590,26 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   double fmin = 0.0;
   w.evaluations = 0;
   w.progress = &progress;
-  const nlopt_result res = design.n > 0 ? nlopt_optimize(o, x.data(), &fmin) : NLOPT_SUCCESS;
-  r.stop_reason = res == NLOPT_MAXEVAL_REACHED ? "max_evaluations"
-                  : res == NLOPT_XTOL_REACHED  ? "xtol"
-                  : res == NLOPT_FTOL_REACHED  ? "ftol"
+  const nlopt_result res = n > 0 ? nlopt_optimize(o, x.data(), &fmin) : NLOPT_SUCCESS;
+  r.stop_reason = res == NLOPT_MAXEVAL_REACHED    ? "max_evaluations"
+                  : res == NLOPT_XTOL_REACHED     ? "xtol"
+                  : res == NLOPT_FTOL_REACHED     ? "ftol"
                   : res == NLOPT_ROUNDOFF_LIMITED ? "roundoff"
-                  : res > 0                    ? "converged"
-                                               : fmt::format("nlopt error {}", static_cast<int>(res));
+                  : res > 0                       ? "converged"
+                                                  : fmt::format("nlopt error {}", static_cast<int>(res));
   r.evaluations = w.evaluations;
   r.failed_evaluations = w.failures;
   r.optimise_wall_s = std::chrono::duration<double>(Clock::now() - t_search).count();
-  // COBYLA meets its constraints only to its own tolerance (the bicycle's optimum dipped to
-  // −1.3e-4 of the mean): lift each nonnegative shape to τ ≥ 0 at every angle, then recalibrate.
+  return x;
+}
+
+// Stage 4: the search's end point made exactly nonnegative where asked and re-evaluated; kept
+// only when it is feasible and better than the constant strategy (x, best ← x0, e0 otherwise).
+// COBYLA meets its constraints only to its own tolerance (the bicycle's optimum dipped to
+// −1.3e-4 of the mean): each nonnegative shape is lifted to τ ≥ 0 at every angle, then recalibrated.
+Evaluation keep_feasible_optimum(Workspace& w, const Design& bounded, std::vector<double>& x,
+                                 const std::vector<double>& x0, const Evaluation& e0, OptimizeResult& r) {
   r.nonnegative_repair = repair_nonnegative(bounded, x);
-  // NLopt returns the best feasible point it saw; a search that found nothing better keeps x0.
   Evaluation best = evaluate(w, x.data());
   bool feasible = best.ok;
   for (size_t g = 0; g < bounded.groups.size() && feasible; ++g) {
@@ -675,8 +621,13 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
     x = x0;
     best = e0;
   }
+  return best;
+}
 
-  // Both strategies, each from its own calibrated scene: curves over the angle and the full model.
+// Stage 5: both strategies on the full model, the optimised scene, and the comparisons.
+void finish_strategies(const Workspace& w, const Design& bounded, const std::vector<double>& x0, const Evaluation& e0,
+                       const std::vector<double>& x, const Evaluation& best, const models::Scene& scene,
+                       const OptimizeOptions& opt, Progress& progress, OptimizeResult& r) {
   progress.note("optimize: full model, constant strategy");
   const auto c0 = calc_strategy(w, bounded, x0, e0, opt, "constant").first;
   progress.note("optimize: full model, optimised strategy");
@@ -687,7 +638,7 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   if (std::isfinite(r.resistance_coefficient)) r.resistance_coefficient = best.cal.resistance_coefficient;
   scene1.optimize.reset();
   scene1.description = fmt::format("{} Optimised by rdyn optimize: {} shaped over {} to minimise the peak {} force at {:g} Hz.",
-                                   scene.description.substr(0, 3000), fmt::join(r.design_loads, ", "), design.of,
+                                   scene.description.substr(0, 3000), fmt::join(r.design_loads, ", "), bounded.of,
                                    r.force_name, opt.cadence_hz);
   r.optimised_scene = scene1;
   // The published values beside a calibration (validation.compare) describe the scene's own
@@ -699,6 +650,58 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   auto cadence_ok = [&](double f) { return std::isfinite(f) && std::abs(f - opt.cadence_hz) <= kFullCadenceTolerance * opt.cadence_hz; };
   r.full_cadence_ok = cadence_ok(c0.cadence_full_hz) && cadence_ok(c1.cadence_full_hz);
   r.full_better = std::isfinite(c1.peak_full_N) && c1.peak_full_N < c0.peak_full_N;
+}
+
+}  // namespace
+
+OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& opt, Progress& progress) {
+  const auto start = Clock::now();
+  const models::Scene scene = scene_with_added_torques(scene_in, opt);
+  check_optimize_options(scene, opt);
+  const models::OptimizeSpec spec = scene.optimize.value_or(models::OptimizeSpec{});
+  const Design design = resolve_design(scene, spec, opt);
+  int force = 0;
+  OptimizeResult r = describe_problem(scene, spec, design, opt, force);
+  const CalibrationOptions copt = calibration_options_for(opt);
+  std::vector<double> x0(design.n, 0.0);
+  for (const auto& g : design.groups)
+    if (!g.fixed_a0) x0[g.offset] = g.a0_start;
+  const models::Scene s0 = shaped_scene(scene, design, x0.data());  // the constant strategy, profiled
+  check_calibratable(s0, copt);
+  r.resistance_coefficient = calc_resistance_coefficient(s0, copt);
+
+  progress.note("optimize: extracting the reduced table");
+  Workspace w;
+  w.design = &design;
+  w.copt = copt;
+  w.interp = reduced::parse_interpolation(opt.interpolation);
+  const reduced::Samples samples = extract_for_design(s0, design, scene, opt);
+  const reduced::ReducedModel base = reduced::make_reduced_model(samples, with_unit_load(s0, copt), w.interp);
+  w.samples = &samples;
+  w.base = &base;
+  w.scene = &scene;
+  w.force = force;
+  w.pnorm = r.objective == "pnorm";
+  w.p = r.p;
+  w.max_evaluations = opt.max_evaluations + 1;
+
+  // The constant strategy: its refusals are the scene's (exit 2), its failure exit 1.
+  {
+    Progress silent(false);
+    (void)calibrate_reduced(base, with_unit_load(s0, copt), copt, silent);
+  }
+  const Evaluation e0 = evaluate(w, x0.data());
+  if (!e0.ok) throw models::NumericalError("optimize: the constant strategy has no steady cycle holding the cadence");
+  w.objective_scale = e0.objective > 0 ? e0.objective : 1.0;
+  r.max_load = design.groups[0].bound > 0 ? design.groups[0].bound : 5.0 * std::abs(e0.cal.load_value);
+  const Design bounded = bounded_design(design, r.max_load);
+  w.design = &bounded;
+  w.last = Evaluation{};
+
+  progress.note("optimize: searching");
+  std::vector<double> x = search(w, bounded, x0, opt, progress, r);
+  const Evaluation best = keep_feasible_optimum(w, bounded, x, x0, e0, r);
+  finish_strategies(w, bounded, x0, e0, x, best, scene, opt, progress, r);
   r.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return r;
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "models/scene.hpp"
+#include "validate/analysis/fourier_minimum.hpp"
 #include "validate/io/progress.hpp"
 
 namespace rdyn::validate {
@@ -22,11 +23,6 @@ namespace rdyn::validate {
 // Ranges of the options (SceneError naming the option, before any work).
 inline constexpr int kMaxOptimizeEvaluations = 100000;
 inline constexpr double kMinOptimizeFullDuration_s = 4.0, kMaxOptimizeFullDuration_s = 600.0;
-
-// min_θ of τ(θ) = a0 + Σ a_k cos kθ + b_k sin kθ (degree H = max(|a|, |b|)): the least of
-// 16(H + 1) equally spaced samples, each local minimum among them refined by Newton on τ′ —
-// the exact minimum to rounding, not a sample of it (`nonnegative` constrains this value).
-double calc_fourier_minimum(double a0, const std::vector<double>& a, const std::vector<double>& b);
 
 struct OptimizeOptions {
   double cadence_hz = 1.0;  // mean cadence the amplitude holds [rev/s]
