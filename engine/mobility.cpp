@@ -181,18 +181,25 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
 void throw_singular_start(const FullModel::Impl& m, const State& s) {
   // The local count at the singular threshold the extraction uses (kSingularConditioning): an
   // assembly lands ~1e-6 rad from an aligned position (its closure error is quadratic there),
-  // where the rank at kRankTolerance is still full.
+  // where the rank at kRankTolerance is still full. Closer than the assembly's accuracy the rank
+  // at that threshold may be full too (the smallest singular value just above it): then the
+  // conditioning is what says so, not a "rank 2 of 2".
   const Mobility here = calc_mobility(m, s, kSingularConditioning);
   const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
+  const std::string local =
+      here.rank < here.rows
+          ? fmt::format("rank {} of {} loop and gear rows over {} joint coordinates, singular values below {:g} of "
+                        "the largest dropped: locally {} degrees of freedom, 1 beside it",
+                        here.rank, here.rows, here.mobilities, kSingularConditioning, here.mobilities - here.rank)
+          : fmt::format("its conditioning is {:.2g}, at the threshold {:g} below which the extraction treats a "
+                        "configuration as singular; 1 degree of freedom beside it",
+                        calc_loop_conditioning(m, s), kSingularConditioning);
   throw models::SceneError(
       m.scene.source_file, m.scene.line_of("initial"), "initial",
       fmt::format("the mechanism starts at a singular configuration of '{}' ({}): the loop Jacobian loses rank there "
-                  "(rank {} of {} loop and gear rows over {} joint coordinates, singular values below {:g} of the "
-                  "largest dropped: locally {} degrees of freedom, 1 beside it) and assembly branches cross there, "
-                  "so neither the branch to follow nor the velocities and constraint forces are determined; start "
-                  "it a little away from there",
-                  m.scene.independent, format_coordinate(m.joint_q(s, m.independent), rev), here.rank, here.rows,
-                  here.mobilities, kSingularConditioning, here.mobilities - here.rank));
+                  "({}) and assembly branches cross there, so neither the branch to follow nor the velocities and "
+                  "constraint forces are determined; start it a little away from there",
+                  m.scene.independent, format_coordinate(m.joint_q(s, m.independent), rev), local));
 }
 
 void calc_mobility_count(const FullModel::Impl& m, const State& s, int& mobilities, int& rows, int& rank) {

@@ -1,5 +1,7 @@
 #include "reduced/samples.hpp"
 
+#include "models/scene_hash.hpp"
+
 #include <cmath>
 #include <cerrno>
 #include <cstdio>
@@ -105,6 +107,11 @@ std::string format_samples_csv(const Samples& s) {
     for (const auto& c : s.columns) t += fmt::format(",{:.17g}", c[i]);
     t += '\n';
   }
+  // The content checksum (FNV-1a of the whole text without it) goes at the end of the first line:
+  // an edited value, row or metadata field is refused on reading instead of silently changing
+  // the model (parse_samples_csv).
+  const std::string sum = fmt::format(" content={:016x}", models::fnv1a64(t));
+  t.insert(t.find('\n'), sum);
   return t;
 }
 
@@ -195,6 +202,8 @@ void read_metadata(TableReader& r, Samples& s) {
       }
     } else if (k == "grid_deg") {
       grid = r.number(v, "field 'grid_deg'");
+    } else if (k == "content") {
+      // checked by check_content before the metadata is read
     } else {
       r.fail(1, "unknown metadata field '" + k.substr(0, 40) + "'");
     }
@@ -318,14 +327,41 @@ void check_rows(const TableReader& r, const Samples& s) {
     r.fail(1, "a periodic table must cover exactly one turn (step × points = 360°)");
 }
 
+// The content checksum of the first line (" content=<16 hex digits>", format_samples_csv) against
+// the text without it, line ends normalised to \n and a final \n (an editor that writes CRLF or
+// drops the last newline changes no value). Returns whether the table has one; a mismatch is a
+// TableError: a value, row or metadata field was changed after extraction.
+bool check_content(const TableReader& r, const std::string& text) {
+  const size_t eol = std::min(text.find('\n'), text.size());
+  const size_t at = text.rfind(" content=", eol);
+  if (at == std::string::npos || at > eol) return false;
+  const size_t end = std::min(text.find(' ', at + 1), eol);
+  std::string value = text.substr(at + 9, end - at - 9);
+  if (!value.empty() && value.back() == '\r') value.pop_back();
+  if (value.size() != 16 || value.find_first_not_of("0123456789abcdef") != std::string::npos)
+    r.fail(1, "field 'content': the checksum must be 16 lowercase hexadecimal digits");
+  std::string body = text.substr(0, at) + text.substr(end);
+  std::string normal;
+  normal.reserve(body.size() + 1);
+  for (size_t i = 0; i < body.size(); ++i)
+    if (!(body[i] == '\r' && i + 1 < body.size() && body[i + 1] == '\n')) normal += body[i];
+  while (!normal.empty() && normal.back() == '\r') normal.pop_back();
+  if (normal.empty() || normal.back() != '\n') normal += '\n';
+  if (fmt::format("{:016x}", models::fnv1a64(normal)) != value)
+    r.fail(1, "the table's content does not match its checksum (field 'content'): a value, row or metadata field was "
+              "changed after `rdyn extract` wrote it, which would silently change the model; extract it again");
+  return true;
+}
+
 }  // namespace
 
 Samples parse_samples_csv(const std::string& text, const std::string& name) {
-  TableReader r{text, name};
+  TableReader r{text, name, 0, 0, {}};
   if (static_cast<long long>(text.size()) > kMaxTableBytes)
     r.fail(1, fmt::format("the table has {} bytes, more than the limit of {} bytes", text.size(), kMaxTableBytes));
   Samples s;
   s.file = name;
+  s.content_checked = check_content(r, text);
   read_metadata(r, s);
   if (!read_annotations(r, s)) r.fail(r.ln + 1, "missing the column header line (q_deg or q_m, then the columns)");
   const auto header = read_column_header(r, s);

@@ -34,6 +34,9 @@ struct Samples {
   // scene with another hash. Empty only for samples assembled by hand.
   std::optional<std::uint64_t> scene_hash;
   std::string file;          // the file it was read from (for messages); empty when extracted
+  // Read from a file whose content checksum matched (format_samples_csv writes one); false for a
+  // table written before checksums (its edits cannot be detected) and for extracted samples.
+  bool content_checked = false;
   long header_line = 0;      // line of the column header in `file` (for messages); 0 when extracted
   std::string method;        // extraction method
   bool periodic = true;      // one period 2π of a revolute coordinate
@@ -83,7 +86,8 @@ inline constexpr long kMaxTableBytes = 256L << 20;
 std::string format_samples_csv(const Samples& s);
 void write_samples_csv(const std::string& path, const Samples& s);
 // Parses the text of a table; `name` is used in messages. Throws TableError naming the file,
-// line and field on malformed content: a missing or older header (re-extract), values that are
+// line and field on malformed content: a content checksum that does not match (an edited table),
+// a missing or older header (re-extract), values that are
 // not finite, a grid that is not increasing and uniform, duplicate or unknown column names,
 // ragged rows, an m1 that is not positive, or a table over the limits above.
 Samples parse_samples_csv(const std::string& text, const std::string& name);

@@ -72,6 +72,45 @@ TEST(Samples, CsvRoundTripKeepsEveryBitTheRootsAndTheSceneHash) {
   std::remove(path.c_str());
 }
 
+// The content checksum: any edit of a value, a row or a metadata field after writing is refused
+// naming line 1; line-end conversions are not edits; a table without one is read, unchecked.
+TEST(Samples, TheContentChecksumRefusesEditsButNotLineEndings) {
+  Samples s;
+  s.scene = "x";
+  s.scene_hash = 0x0123456789abcdefull;
+  s.method = "kinetostatic";
+  s.step = 2 * M_PI / 8;
+  for (int i = 0; i < 8; ++i) s.q.push_back(i * s.step);
+  s.add("m1", {1, 2, 3, 4, 5, 6, 7, 8});
+  s.add("m2", {0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7, -0.8});
+  s.periodic = true;
+  const std::string text = format_samples_csv(s);
+  ASSERT_NE(text.substr(0, text.find('\n')).find(" content="), std::string::npos) << text;
+  EXPECT_TRUE(parse_samples_csv(text, "t.csv").content_checked);
+  auto refused = [](const std::string& t) { return error_of(t).find("t.csv:1: the table's content does not match"); };
+  // m1 of the third row (after the metadata and column lines) from 3 to 9.
+  std::string edited = text;
+  size_t row = 0;
+  for (int i = 0; i < 4; ++i) row = edited.find('\n', row) + 1;
+  const size_t m1 = edited.find(',', row) + 1;
+  ASSERT_EQ(edited.substr(m1, 2), "3,") << edited;
+  edited[m1] = '9';
+  EXPECT_NE(refused(edited), std::string::npos) << error_of(edited);
+  std::string flag = text;
+  flag.replace(flag.find("periodic=1"), 10, "periodic=0");
+  EXPECT_NE(refused(flag), std::string::npos);
+  std::string crlf;
+  for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_TRUE(parse_samples_csv(crlf, "t.csv").content_checked);
+  EXPECT_TRUE(parse_samples_csv(text.substr(0, text.size() - 1), "t.csv").content_checked);  // no last newline
+  std::string unchecked = text;
+  unchecked.erase(unchecked.find(" content="), 25);
+  EXPECT_FALSE(parse_samples_csv(unchecked, "t.csv").content_checked);
+  std::string malformed = text;
+  malformed.replace(malformed.find(" content=") + 9, 3, "XYZ");
+  EXPECT_NE(error_of(malformed).find("field 'content'"), std::string::npos) << error_of(malformed);
+}
+
 TEST(Samples, SamplesWithoutASceneHashAreNotWritten) {
   Samples s;
   s.step = 1;

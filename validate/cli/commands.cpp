@@ -169,6 +169,11 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
         throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
       samples = reduced::read_samples_csv(a.table);
       run["table"] = a.table;
+      if (!samples.content_checked)
+        std::fprintf(stderr,
+                     "rdyn: warning: %s has no content checksum (written before rdyn recorded one): an edit of its "
+                     "values cannot be detected; extract it again to have it checked\n",
+                     a.table.c_str());
     } else {
       auto e = extract_from_full(rscene, a.grid_deg, reduced::parse_method(a.method));
       samples = std::move(e.samples);
@@ -257,11 +262,16 @@ int run_extract(const ExtractArgs& a) {
     if (e.dead_min && e.dead_max)
       range += fmt::format(", dead points at {:.9g}{} and {:.9g}{}", *e.dead_min * k, unit, *e.dead_max * k, unit);
   }
+  // A slider's grid is a length: --grid-deg sets its intervals per range (360/grid, as a turn's).
+  const std::string grid =
+      e.samples.revolute
+          ? fmt::format("{}° grid", a.grid_deg)
+          : fmt::format("{:.6g} m grid: {} intervals from --grid-deg {}", e.samples.step,
+                        e.samples.q.size() > 0 ? e.samples.q.size() - 1 : 0, a.grid_deg);
   std::fprintf(stderr, "%s\n",
-               fmt::format("rdyn: extracted {} ({}, {}° grid, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
+               fmt::format("rdyn: extracted {} ({}, {}, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
                            "wrote {}",
-                           scene.name, a.method, a.grid_deg, e.samples.q.size(), range, e.extraction_ms, e.calls,
-                           a.out)
+                           scene.name, a.method, grid, e.samples.q.size(), range, e.extraction_ms, e.calls, a.out)
                    .c_str());
   return 0;
 }

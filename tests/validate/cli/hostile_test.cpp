@@ -868,11 +868,19 @@ void issue23(std::vector<Case>& cs) {
                   {{"s.yaml", as_speed}}, nullptr, "o"});
   }
   // A table file edited by hand: a negative m1, a missing column. Each names the table's line.
-  auto edited_table = [](std::function<std::string(std::vector<std::vector<std::string>>&)> change) {
-    return [change](const fs::path& d) {
+  // An extracted table, edited. Its content checksum is dropped (keep_checksum false) so that the
+  // checks behind it are reached (a table without one is read, with a warning); kept, the edit is
+  // refused by the checksum itself.
+  auto edited_table = [](std::function<std::string(std::vector<std::vector<std::string>>&)> change,
+                         bool keep_checksum = false) {
+    return [change, keep_checksum](const fs::path& d) {
       const RdynRun r = run_rdyn({"extract", "fourbar", "--out", "t.csv"}, d);
       ASSERT_EQ(r.status, 0) << r.err;
-      std::istringstream in(slurp(d / "t.csv"));
+      std::string text = slurp(d / "t.csv");
+      const size_t sum = text.find(" content=");
+      ASSERT_NE(sum, std::string::npos) << "extract writes a content checksum";
+      if (!keep_checksum) text.erase(sum, 9 + 16);
+      std::istringstream in(text);
       std::vector<std::vector<std::string>> cells;  // comment lines as one cell
       for (std::string line; std::getline(in, line);) {
         cells.emplace_back();
@@ -908,6 +916,21 @@ void issue23(std::vector<Case>& cs) {
                 }),
                 "o", {}, [](const fs::path&, const RdynRun& r) {
                   EXPECT_TRUE(std::regex_search(r.err, std::regex("t\\.csv:[0-9]+: column 'm1'"))) << r.err;
+                }});
+  cs.push_back({"table_value_edited_under_its_checksum",
+                {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--out", "o"}, 2,
+                "the table's content does not match its checksum", {},
+                edited_table(
+                    [=](std::vector<std::vector<std::string>>& cells) {
+                      // m1 and m2 of one row ×3: a consistent-looking edit the other checks accept.
+                      auto& row = cells[header_index(cells) + 3];
+                      row[1] = fmt::format("{:.17g}", 3 * std::stod(row[1]));
+                      row[2] = fmt::format("{:.17g}", 3 * std::stod(row[2]));
+                      return join(cells);
+                    },
+                    true),
+                "o", {}, [](const fs::path&, const RdynRun& r) {
+                  EXPECT_TRUE(std::regex_search(r.err, std::regex("t\\.csv:1: "))) << r.err;
                 }});
   cs.push_back({"table_missing_column",
                 {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--out", "o"}, 2,
