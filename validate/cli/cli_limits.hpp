@@ -17,7 +17,7 @@ namespace rdyn::validate::cli_limits {
 
 inline constexpr double kMaxDuration_s = 1e5;
 inline constexpr double kMinOutputInterval_s = 1e-6;
-inline constexpr double kMaxOutputRows = 1e7;  // ~1.5 GB of CSV at most
+inline constexpr double kMaxOutputRows = 1e7;  // rows written, t = 0 included (~1.5 GB of CSV at most)
 inline constexpr double kMinTolerance = 1e-14, kMaxTolerance = 1e-1;
 inline constexpr double kMinFixedStep_s = 1e-7, kMaxFixedStep_s = 1.0;
 inline constexpr double kMaxFixedSteps = 1e8;  // ~20 s of RK4 steps

@@ -14,6 +14,7 @@
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
+#include "models/timeseries.hpp"
 #include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
@@ -73,9 +74,12 @@ void require_grid(const std::string& option, double g) {
 void require_timing(double duration, double dt_out) {
   require_positive_up_to("--duration", duration, cli_limits::kMaxDuration_s, " s");
   require_in("--dt-out", dt_out, cli_limits::kMinOutputInterval_s, duration, " s (and at most --duration)");
-  if (duration / dt_out > cli_limits::kMaxOutputRows)
-    throw ArgumentError(fmt::format("--dt-out: {:g} s over {:g} s makes {:.3g} rows; at most {:g}", dt_out, duration,
-                                    duration / dt_out, cli_limits::kMaxOutputRows));
+  // Rows as the simulations count them (t = 0, then one per interval, the last at the duration:
+  // models::calc_output_rows), so that no run the CLI accepts meets their own, wordier refusal.
+  const double rows = static_cast<double>(models::calc_output_rows(duration, dt_out)) + 1;
+  if (rows > cli_limits::kMaxOutputRows)
+    throw ArgumentError(fmt::format("--dt-out: {:g} s over {:g} s makes {:.8g} rows; at most {:g}", dt_out, duration,
+                                    rows, cli_limits::kMaxOutputRows));
 }
 
 // Recognisers of rdyn's own single-file outputs, so a re-run may replace them.

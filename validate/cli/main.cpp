@@ -4,6 +4,8 @@
 // output destination, a mechanism that cannot assemble), with the file, line and field.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "engine/full_model.hpp"
 #include "models/scene.hpp"
@@ -312,6 +314,37 @@ void add_expand_command(CLI::App& app, ExpandArgs& exp) {
   expand->add_flag("--force", exp.force, kForceHelpFile);
 }
 
+// The first argument when it is neither an option nor a subcommand ("" otherwise), control
+// characters shown as \xNN.
+std::vector<const CLI::App*> subcommands(const CLI::App& app) {
+  return app.get_subcommands([](const CLI::App*) { return true; });
+}
+
+std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return "";
+  for (const CLI::App* sub : subcommands(app))
+    if (sub->check_name(argv[1])) return "";
+  std::string shown;
+  for (const char* c = argv[1]; *c; ++c) {
+    const auto b = static_cast<unsigned char>(*c);
+    if (b < 0x20 || b == 0x7f) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", b);
+      shown += hex;
+    } else {
+      shown += *c;
+    }
+  }
+  return shown;
+}
+
+std::string subcommand_names(const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* sub : subcommands(app))
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  return names;
+}
+
 // Every subcommand's arguments, filled while the command line is parsed.
 struct CommandArgs {
   SimulateArgs sim;
@@ -401,6 +434,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    // CLI11 reports a mistyped subcommand as a missing one: name it instead.
+    if (const std::string typed = unknown_subcommand(app, argc, argv); !typed.empty()) {
+      std::fprintf(stderr, "rdyn: error: unknown subcommand '%s' (%s); run with --help for more information\n",
+                   typed.c_str(), subcommand_names(app).c_str());
+      return kExitBadInput;
+    }
     app.exit(e);
     return kExitBadInput;
   }

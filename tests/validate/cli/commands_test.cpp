@@ -1,4 +1,5 @@
-// The rdyn binary end to end: outputs, exit statuses and messages on bad input.
+// The subcommands of validate/cli/commands.cpp end to end (simulate, extract, calibrate, validate,
+// sweep): outputs, exit statuses and messages on bad input. Help and dispatch: main_test.cpp.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -93,13 +94,6 @@ TEST_F(Cli, BadTableIsRefused) {
   const std::string f = write("table.csv", "# rdyn reduced table: scene=x method=k periodic=1 q0=0 step=1\nq_deg,m1\n0,zz\n");
   expect_refused("simulate bicycle --model reduced --table " + f, "table.csv");
   expect_refused("simulate bicycle --model reduced --grid-deg 7", "7");
-}
-
-TEST_F(Cli, HelpExplainsItself) {
-  const CliRun r = rdyn("--help");
-  EXPECT_EQ(r.status, 0);
-  EXPECT_NE(r.output.find("simulate"), std::string::npos);
-  EXPECT_EQ(rdyn("simulate --help").status, 0);
 }
 
 TEST_F(Cli, MissingSceneFile) { expect_refused("simulate /no/such/scene.yaml", "/no/such/scene.yaml"); }
