@@ -3,6 +3,7 @@
 // coordinate couplers or folded onto their driver, constraint actuators as prescribed
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
+#include "engine/branch_guard.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/inspect.hpp"  // kFarFromGuess_deg
 #include "engine/kinetostatic.hpp"
@@ -407,13 +408,21 @@ double assemble(const FullModel::Impl& m, State& s, bool lock_independent) {
 // joint at its guess, the independent coordinate too, and free — then walk the independent to
 // the initial q in moves of at most 2°, each assembled from the last. The state is left at the
 // last move that closed; true when it reached the initial q.
-bool assemble_by_continuation(const FullModel::Impl& m, State& s) {
+// How a continuation from the guesses' configuration to the initial q ended.
+enum class Walk {
+  Reached,               // s holds the start, on the guesses' branch
+  GuessesDoNotAssemble,  // the guesses describe no configuration (s unchanged)
+  SingularBetween,       // a configuration where the loop Jacobian loses rank lies between
+  NoProgress,            // moves stopped closing
+};
+
+Walk assemble_by_continuation(const FullModel::Impl& m, State& s) {
   const State start = s;
   m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.joints[m.independent].guess);
   m.set_law(s, 0, poly_law(m.scene.joints[m.independent].guess, 0.0, 0.0));
   if (!(assemble(m, s, false) <= 1e-8)) {
     s = start;
-    return false;
+    return Walk::GuessesDoNotAssemble;
   }
   const double q_to = m.scene.initial.q;
   const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
@@ -436,14 +445,14 @@ bool assemble_by_continuation(const FullModel::Impl& m, State& s) {
     const double step = std::min(move, max_move * std::max(1e-6, std::min(1.0, lowest / kFarConditioning)));
     // Steps shrinking far from the target: a singular configuration lies between (a walk from
     // 90° to 270° through a chain's flat position at 180°); do not creep up to it.
-    if (step < 1e-3 * std::abs(q_to - q)) return false;
+    if (step < 1e-3 * std::abs(q_to - q)) return Walk::SingularBetween;
     const double q_next = std::abs(q_to - q) <= step ? q_to : q + std::copysign(step, q_to - q);
     State next = s;
     m.joint_mobod[m.independent].setOneQ(next, MobilizerQIndex(0), q_next);
     m.set_law(next, 0, poly_law(q_next, 0.0, 0.0));  // the prescribed position the assembly keeps
     if (assemble(m, next, true) <= 1e-8) {
       const double k = calc_loop_conditioning(m, next);
-      if (lowest < kSingularWindow && k > 2 * lowest) return false;
+      if (lowest < kSingularWindow && k > 2 * lowest) return Walk::SingularBetween;
       lowest = std::min(lowest, k);
       s = next, q = q_next;
       move = std::min(max_move, 2 * move);
@@ -451,7 +460,7 @@ bool assemble_by_continuation(const FullModel::Impl& m, State& s) {
       move *= 0.5;
     }
   }
-  return q == q_to;
+  return q == q_to ? Walk::Reached : Walk::NoProgress;
 }
 
 bool far_from_guesses(const FullModel::Impl& m, const State& s) {
@@ -478,6 +487,67 @@ void wrap_to_guesses(const FullModel::Impl& m, State& s) {
   m.system.realize(s, Stage::Position);
 }
 
+// The direct assembly landed far from the guesses and the walk from the guesses' configuration
+// stopped at a configuration where the loop Jacobian loses rank (`walked`: where it stopped):
+// branches cross there, so the guesses do not say which branch the start is on, and the one the
+// assembler landed on is an accident (a parallelogram chain started at −30° with its 90° guesses
+// came out folded: its cranks no longer turn alike). Unless a loop names its branch (checked
+// after assembly), that is a scene error naming `initial`.
+void refuse_branch_across_singularity(const FullModel::Impl& m, const State& s, const State& walked) {
+  for (const auto& l : m.scene.loops)
+    if (l.branch) return;
+  const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  std::string far;
+  for (size_t j = 0; j < m.scene.joints.size() && far.empty(); ++j) {
+    if (m.joint_fold[j] || static_cast<int>(j) == m.independent) continue;
+    if (m.scene.joints[j].type != models::JointType::Revolute) continue;
+    const double q = m.joint_mobod[j].getOneQ(s, MobilizerQIndex(0)), g = m.scene.joints[j].guess;
+    if (std::abs(std::remainder(q - g, 2 * M_PI)) > kFarFromGuess_deg * M_PI / 180)
+      far = fmt::format("joint '{}' at {:.4g}° against its guess {:.4g}°", m.scene.joints[j].name, q * 180 / M_PI,
+                        g * 180 / M_PI);
+  }
+  throw models::SceneError(
+      m.scene.source_file, m.scene.line_of("initial"), "initial",
+      fmt::format("the start of '{}' ({}) lies across a singular configuration (near {}) from the configuration "
+                  "the joints' guesses describe ({}): assembly branches cross there, so the guesses do not say which "
+                  "branch the start is on, and the assembly landed elsewhere ({}); give guesses that describe the "
+                  "configuration at this start, or name the branch with a loop's `branch`",
+                  m.scene.independent, format_coordinate(m.scene.initial.q, rev),
+                  format_coordinate(m.joint_q(walked, m.independent), rev),
+                  format_coordinate(m.scene.joints[m.independent].guess, rev), far));
+}
+
+// The guesses' configuration (assembled at the guessed independent coordinate) followed to the
+// initial q by follow_branch, with the branch guard's moves; the workspace's continuation history
+// is left empty. False when a move cannot be made.
+bool continue_through_singularity(const FullModel& model, FullWorkspace& ws, const State& guesses) {
+  const auto& m = model.impl();
+  auto& w = ws.impl();
+  State& s = w.state;
+  s = guesses;
+  const double guess = m.scene.joints[m.independent].guess;
+  m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), guess);
+  m.set_law(s, 0, poly_law(guess, 0.0, 0.0));
+  bool ok = assemble(m, s, false) <= 1e-8;
+  if (ok) {
+    const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+    const double scale = calc_length_scale(m.scene);
+    double tolerance = kBranchTolerance_rad;
+    for (const auto& j : m.scene.joints)
+      if (j.type == models::JointType::Prismatic) tolerance = std::min(tolerance, kBranchTolerance_rel * scale);
+    try {
+      follow_branch(model, ws, m.scene.initial.q, rev ? kBranchMaxMove_rad : kBranchMaxMove_rel * scale,
+                    kBranchCorrectionFraction * tolerance);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  w.hist_n = 0;
+  w.anchor_set = false;
+  m.set_law(s, 0, poly_law(m.scene.initial.q, 0.0, 0.0));
+  return ok && assemble(m, s, true) <= 1e-8;
+}
+
 }  // namespace
 
 FullWorkspace::FullWorkspace(const FullModel& model)
@@ -498,11 +568,23 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   const bool direct = assemble(m, s, true) <= 1e-8;
   if (!direct || far_from_guesses(m, s)) {
     State walked = guesses;
-    if (assemble_by_continuation(m, walked)) {
+    const Walk walk = assemble_by_continuation(m, walked);
+    if (walk == Walk::Reached) {
       s = walked;
     } else if (!direct) {
       s = guesses;  // report the direct attempt's gap
       assemble(m, s, true);
+    } else if (walk == Walk::SingularBetween) {
+      // Through the singular configuration along the guesses' branch, as the extraction and the
+      // dynamics continue (follow_branch: the chord of the last move there, the smooth
+      // continuation, not the branch that crosses); where that fails, the start's branch is not
+      // determined by the guesses: refused unless a loop names it.
+      const State direct_state = s;
+      if (!continue_through_singularity(model, *this, guesses)) {
+        s = direct_state;
+        wrap_to_guesses(m, s);
+        refuse_branch_across_singularity(m, s, walked);
+      }
     }
   }
   wrap_to_guesses(m, s);
