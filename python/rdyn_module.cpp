@@ -18,7 +18,9 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/runtime.hpp"
 #include "reduced/samples.hpp"
+#include "validate/analysis/sweep.hpp"
 #include "validate/cli/commands.hpp"
+#include "validate/cli/drive_command.hpp"
 #include "validate/cli/inspect.hpp"
 #include "validate/io/output_dir.hpp"
 #include "validate/io/progress.hpp"
@@ -56,6 +58,23 @@ py::list timeseries_columns(const rm::TimeSeries& ts) {
   add("work", ts.work);
   for (size_t c = 0; c < ts.forces.size(); ++c) add("F_" + ts.force_names[c], ts.forces[c]);
   for (size_t c = 0; c < ts.columns.size(); ++c) add(ts.column_names[c], ts.columns[c]);
+  return out;
+}
+
+// `rdyn drive`'s timeseries.csv columns, in its order (validate/cli/drive_command.hpp); every
+// value was checked finite by the drive itself.
+py::list drive_columns(const rv::DriveRun& d) {
+  const auto& r = d.rows;
+  std::vector<const std::vector<double>*> cols{&r.t, &r.q, &r.qdot, &r.qddot, &r.drive, &r.power};
+  for (const auto& c : r.forces) cols.push_back(&c);
+  for (const auto& c : r.columns) cols.push_back(&c);
+  const auto names = rv::drive_column_names(r, d.revolute);
+  py::list out;
+  for (size_t c = 0; c < names.size(); ++c) {
+    for (double v : *cols[c])
+      if (!std::isfinite(v)) throw rm::NumericalError("the drive has a non-finite " + names[c]);
+    out.append(py::make_tuple(names[c], to_array(*cols[c])));
+  }
   return out;
 }
 
@@ -221,6 +240,57 @@ PYBIND11_MODULE(_rdyn, m) {
     return rv::calibration_json(scene, opt, r).dump();
   });
 
+  py::class_<rv::DriveArgs>(m, "DriveArgs", "rdyn drive's options (docs/cli.md)")
+      .def(py::init<>())
+      .def_readwrite("cadence_hz", &rv::DriveArgs::cadence_hz)
+      .def_readwrite("profile", &rv::DriveArgs::profile)
+      .def_readwrite("model", &rv::DriveArgs::model)
+      .def_readwrite("duration", &rv::DriveArgs::duration)
+      .def_readwrite("dt_out", &rv::DriveArgs::dt_out)
+      .def_readwrite("grid_deg", &rv::DriveArgs::grid_deg)
+      .def_readwrite("interpolation", &rv::DriveArgs::interpolation)
+      .def_readwrite("motor", &rv::DriveArgs::motor);
+  m.def("drive", [](const rm::Scene& scene, const rv::DriveArgs& a, const rr::Samples* table) {
+    rv::DriveRun r;
+    {
+      py::gil_scoped_release free;
+      r = rv::drive_scene(scene, a, table);
+    }
+    return py::make_tuple(drive_columns(r), r.run.dump());
+  }, py::arg("scene"), py::arg("args"), py::arg("table").none(true));
+
+  m.def("validate", [](const rm::Scene& scene, const std::string& out, bool quick, bool force,
+                       const std::vector<std::string>& peers) {
+    rv::ValidateArgs a;
+    a.out = out, a.quick = quick, a.force = force, a.peers = peers;
+    py::gil_scoped_release free;
+    rdyn::validate::Progress quiet(false);
+    return rv::validate_scene(scene, a, quiet).dump();
+  });
+
+  // Sweeps: a plan (checked, as `rdyn sweep` checks it), then cases by index, each alone — so a
+  // Python pool can map over the indices — or all in C++ threads (run_sweep, as the CLI).
+  py::class_<rv::SweepPlan>(m, "SweepPlan", "A checked sweep (rdyn sweep)")
+      .def_property_readonly("header", [](const rv::SweepPlan& p) { return p.header; })
+      .def_property_readonly("cases", [](const rv::SweepPlan& p) { return p.id.total; });
+  m.def("plan_sweep", [](const std::string& scene, const std::vector<std::string>& sets,
+                         const std::vector<std::string>& vary, std::optional<double> cadence_hz,
+                         std::optional<double> power_w, const std::string& load, double grid_deg,
+                         std::optional<double> drive_cadence_hz, std::optional<int> threads) {
+    rv::SweepArgs a;  // checked as `rdyn sweep` checks its options (ArgumentError names them)
+    a.inputs = {scene}, a.sets = sets, a.vary = vary, a.cadence_hz = cadence_hz, a.power_w = power_w;
+    a.load = load, a.grid_deg = grid_deg, a.drive_cadence_hz = drive_cadence_hz, a.threads = threads;
+    return rv::plan_sweep(rv::check_sweep_args(a));
+  });
+  m.def("sweep_case", [](const rv::SweepPlan& plan, long index) {
+    py::gil_scoped_release free;
+    return rv::run_sweep_case(plan, index);
+  });
+  m.def("run_sweep", [](const rv::SweepPlan& plan) {
+    py::gil_scoped_release free;
+    return rv::run_sweep(plan, nullptr).csv;
+  });
+
   py::class_<Runtime>(m, "Runtime")
       .def(py::init([](const rr::Samples& s, const rm::Scene& scene, std::optional<std::string> interpolation,
                        bool energy_consistent) {
@@ -246,6 +316,13 @@ PYBIND11_MODULE(_rdyn, m) {
              raise_status(rr::reset(r.model, r.ws, q, qdot, drive_of(torque, scale)));
            },
            py::arg("q"), py::arg("qdot"), py::arg("torque").none(true) = py::none(), py::arg("scale").none(true) = py::none())
+      .def("drive_torque",
+           [](Runtime& r, double q, double qdot, double qddot) {
+             double d = 0.0;
+             raise_status(rr::calc_drive_torque(r.model, r.ws, q, qdot, qddot, d));
+             return d;
+           },
+           py::arg("q"), py::arg("qdot"), py::arg("qddot"))
       .def_property_readonly("t", [](const Runtime& r) { return r.ws.get_t(); })
       .def_property_readonly("q", [](const Runtime& r) { return r.ws.get_q(); })
       .def_property_readonly("qdot", [](const Runtime& r) { return r.ws.get_qdot(); })

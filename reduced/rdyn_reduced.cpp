@@ -165,6 +165,12 @@ rdyn_status rdyn_step(const rdyn_model* model, rdyn_workspace* workspace, double
   return to_c(rdyn::reduced::step(model->model, workspace->ws, dt, to_cpp(drive)));
 }
 
+rdyn_status rdyn_drive_torque(const rdyn_model* model, rdyn_workspace* workspace, double q,
+                              double qdot, double qddot, double* drive) {
+  if (!model || !workspace || !drive) return RDYN_BAD_ARGUMENT;
+  return to_c(rdyn::reduced::calc_drive_torque(model->model, workspace->ws, q, qdot, qddot, *drive));
+}
+
 rdyn_status rdyn_get_state(const rdyn_workspace* workspace, rdyn_state* state) {
   if (!workspace || !state) return RDYN_BAD_ARGUMENT;
   const auto& w = workspace->ws;

@@ -11,6 +11,7 @@
  *   rdyn_drive d = {RDYN_DRIVE_TORQUE, 69.7};
  *   rdyn_step(m, ws, 1e-3, d);
  *   rdyn_state s; rdyn_get_state(ws, &s);   (s.q, s.qdot, s.qddot)
+ *   double T; rdyn_drive_torque(m, ws, q, qdot, qddot, &T);   (inverse: feed-forward)
  *   rdyn_workspace_free(ws); rdyn_model_free(m);
  */
 #ifndef RDYN_REDUCED_H
@@ -93,6 +94,15 @@ rdyn_status rdyn_step(const rdyn_model* model, rdyn_workspace* workspace, double
                       rdyn_drive drive);
 
 rdyn_status rdyn_get_state(const rdyn_workspace* workspace, rdyn_state* state);
+/* The inverse of rdyn_step: the generalized force [N·m or N] the drive must add on q for the
+ * reduced model to move with (q, q̇, q̈): m1(q) q̈ + m2(q) q̇² − F*(q, q̇), every scene load in
+ * F* with the joint torques as last commanded (the scene's until a reset or step commands
+ * others), gates from the sign of q̇ — what `rdyn drive --model reduced` gives per row. Inputs
+ * must be finite, |q̇| ≤ 1e4, |q̈| ≤ 1e8, q in the table (else RDYN_BAD_STATE; *drive untouched).
+ * Does not change the workspace's state; allocates nothing. */
+rdyn_status rdyn_drive_torque(const rdyn_model* model, rdyn_workspace* workspace, double q,
+                              double qdot, double qddot, double* drive);
+
 /* Copies min(n, number of forces) constraint forces F_E,k [N] into forces. */
 rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int n);
 

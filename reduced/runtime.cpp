@@ -72,7 +72,9 @@ RuntimeWorkspace::RuntimeWorkspace(const RuntimeModel& model)
     : state_(model.reduced),
       forces_(model.reduced.force_names.size()),
       saved_(model.reduced),
-      forces_saved_(model.reduced.force_names.size()) {
+      forces_saved_(model.reduced.force_names.size()),
+      inverse_(model.reduced),
+      forces_inverse_(model.reduced.force_names.size()) {
   // The scene's initial state was checked with the scene (limits::kMaxRate, kMaxAngle_rad);
   // a non-periodic table may still not cover it, which the first reset() would report.
   if (reset(model, *this, model.initial_q, model.initial_qdot) != Status::Ok) {
@@ -87,7 +89,11 @@ bool RuntimeWorkspace::fits(const RuntimeModel& model) const {
          state_.scratch.size() == m.rhs_cols.size() &&
          state_.scratch_out.size() == m.out_cols.size() &&
          state_.scratch_rec.size() == m.record_cols.size() &&
-         forces_.size() == m.force_names.size();
+         forces_.size() == m.force_names.size() &&
+         inverse_.scratch_rec.size() == m.record_cols.size() &&
+         inverse_.gate_on.size() == m.gates.size() &&
+         inverse_.torque_value.size() == m.torques.size() &&
+         forces_inverse_.size() == m.force_names.size();
 }
 
 // Checks the whole command before writing any torque, so a refused drive changes nothing.
@@ -183,6 +189,25 @@ Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
   }
   ++ws.steps_;
   if (!std::isnan(t_switch)) ++ws.switches_;
+  return Status::Ok;
+}
+
+Status calc_drive_torque(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double qdot,
+                         double qddot, double& drive) noexcept {
+  if (!ws.fits(model)) return Status::WrongWorkspace;
+  const double q_max =
+      model.revolute ? models::limits::kMaxAngle_rad : models::limits::kMaxCoordinate_m;
+  if (!(std::abs(q) <= q_max) || !(std::abs(qdot) <= models::limits::kMaxRate) ||
+      !(std::abs(qddot) <= kMaxDriveAcceleration) || !model.reduced.table.in_range(q))
+    return Status::BadState;
+  // The joint torques as commanded now; gates of its own (calc_drive sets them from q̇, q̈).
+  std::copy(ws.state_.torque_value.begin(), ws.state_.torque_value.end(),
+            ws.inverse_.torque_value.begin());
+  double power_nc = 0.0;
+  const double d =
+      calc_drive(model.reduced, ws.inverse_, q, qdot, qddot, power_nc, ws.forces_inverse_.data());
+  if (!std::isfinite(d)) return Status::NonFinite;
+  drive = d;
   return Status::Ok;
 }
 

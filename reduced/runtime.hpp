@@ -5,6 +5,7 @@
 //   RuntimeWorkspace ws(m);                                          // allocates, once
 //   Status s = step(m, ws, 1e-3, Drive::torque(T_cmd_Nm));           // allocation-free, noexcept
 //   ws.get_qdot(), ws.get_forces()[k] ...
+//   calc_drive_torque(m, ws, q, qdot, qddot, drive_Nm);                // inverse: feed-forward
 //
 // step() is the fixed RK4 of reduced_model.hpp (step_fixed_rk4, the same one `rdyn simulate
 // --reduced-integrator rk4-fixed` runs) on Eksergian's equation m1 q̈ + m2 q̇² = F*, with the
@@ -28,7 +29,8 @@ enum class Status : int {
   Ok = 0,
   BadStep = 1,         // dt not finite or outside [kMinFixedStep_s, kMaxFixedStep_s]
   BadDrive = 2,        // drive not finite, or a resulting joint torque beyond ±limits::kMaxForce
-  BadState = 3,        // reset: q or q̇ not finite, |q̇| > limits::kMaxRate, q outside the table
+  BadState = 3,        // reset, calc_drive_torque: q, q̇ (q̈) not finite, |q̇| > limits::kMaxRate
+                       // (|q̈| > kMaxDriveAcceleration), q outside the table
   WrongWorkspace = 4,  // the workspace was made for a model of another shape
   NonFinite = 5,       // the step produced a non-finite state or output
   LeftTable = 6,       // q left the range of a non-periodic table
@@ -100,6 +102,8 @@ class RuntimeWorkspace {
   friend Status reset(const RuntimeModel&, RuntimeWorkspace&, double, double,
                       const Drive&) noexcept;
   friend Status step(const RuntimeModel&, RuntimeWorkspace&, double, const Drive&) noexcept;
+  friend Status calc_drive_torque(const RuntimeModel&, RuntimeWorkspace&, double, double, double,
+                                  double&) noexcept;
   bool fits(const RuntimeModel& model) const;
   Status apply_drive(const RuntimeModel& model, const Drive& drive);
   Status calc_outputs(const RuntimeModel& model);
@@ -112,6 +116,9 @@ class RuntimeWorkspace {
   // Scratch for rolling back a failed step.
   ReducedWorkspace saved_;
   std::vector<double> forces_saved_;
+  // Scratch for calc_drive_torque, which sets gates of its own and must not touch the state.
+  ReducedWorkspace inverse_;
+  std::vector<double> forces_inverse_;
 };
 
 // Sets t = 0, W = 0, the state (q, q̇) and the drive, and the load gates from that state.
@@ -125,5 +132,23 @@ Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double q
 // left as it was. Allocation-free and exception-free.
 Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
             const Drive& drive) noexcept;
+
+// Largest |q̈| calc_drive_torque accepts [rad/s² or m/s²]: limits::kMaxRate reached from rest
+// within 1e-4 s.
+inline constexpr double kMaxDriveAcceleration = 1e8;
+
+// The inverse of step(): the generalized force the drive must add on q [N·m or N] for the
+// reduced model to move with (q, q̇, q̈) — Eksergian's equation solved for it (docs/theory.md
+// §11, reduced::calc_drive):
+//   drive = m1(q) q̈ + m2(q) q̇² − F*(q, q̇),
+// F* holding every load of the scene, with the joint torques as last commanded (the scene's
+// values until a reset() or step() commands others) and the load gates set by the sign of q̇
+// (of q̈ where q̇ = 0), as `rdyn drive --model reduced` computes each row. A feed-forward
+// term for a motor on q. Returns BadState (q, q̇ or q̈ not finite, |q̇| > limits::kMaxRate,
+// |q̈| > kMaxDriveAcceleration, q outside the table), WrongWorkspace or NonFinite, and then
+// leaves `drive` unchanged. The state (t, q, q̇, gates, outputs) is never changed.
+// Allocation-free and exception-free.
+Status calc_drive_torque(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double qdot,
+                         double qddot, double& drive) noexcept;
 
 }  // namespace rdyn::reduced

@@ -13,6 +13,9 @@ Errors: ``rdyn.SceneError`` (attributes file, line, field), ``rdyn.NumericalErro
 ``rdyn.ArgumentError`` (also a ValueError), ``rdyn.TableError``, ``rdyn.OutputError``; all
 derive from ``rdyn.Error``.
 """
+import builtins as _builtins
+import csv as _csv
+import io as _io
 import json as _json
 import os as _os
 from collections.abc import Mapping as _Mapping
@@ -28,7 +31,8 @@ from . import _rdyn
 from ._rdyn import (Error, SceneError, NumericalError, ArgumentError, TableError,  # noqa: F401
                     OutputError)
 
-__all__ = ["load_scene", "extract", "load_table", "simulate", "calibrate", "validate", "Runtime",
+__all__ = ["load_scene", "extract", "load_table", "simulate", "calibrate", "drive", "validate", "sweep",
+           "Runtime",
            "Scene", "Table", "Run", "Error", "SceneError", "NumericalError", "ArgumentError",
            "TableError", "OutputError"]
 
@@ -160,6 +164,115 @@ def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=10, inte
                                        interpolation))
 
 
+def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, table=None, dt_out=None,
+          grid_deg=10, interpolation="fourier", motor=None):
+    """``rdyn drive``: the independent coordinate follows a constant rate ``cadence_hz`` [rev/s]
+    or a ``profile`` (a CSV t,q_deg or t,q_m), every other load of the scene applied; returns a
+    Run whose columns are timeseries.csv's (t, q, qdot, qddot, drive_Nm or drive_N, drive_W,
+    F_<force>…) and whose ``info`` is run.json (drive_rms, drive_peak, mean_power_W, …).
+    ``model`` "reduced" or "full"; ``table`` a Table for the reduced model (None: extract at
+    ``grid_deg``); ``motor`` (stall, no_load_speed) checks a torque–speed line (info["motor_check"])."""
+    if model not in ("reduced", "full"):
+        raise ArgumentError(f"model: must be reduced or full (got {model!r})")
+    args = _rdyn.DriveArgs()
+    args.model = model
+    if cadence_hz is not None:
+        args.cadence_hz = float(cadence_hz)
+    if profile is not None:
+        args.profile = _os.fspath(profile)
+    if duration is not None:
+        args.duration = float(duration)
+    if dt_out is not None:
+        args.dt_out = float(dt_out)
+    args.grid_deg = float(grid_deg)
+    args.interpolation = interpolation
+    if motor is not None:
+        args.motor = motor if isinstance(motor, str) else ",".join(repr(float(v)) for v in motor)
+    columns, info = _rdyn.drive(scene._scene, args, None if table is None else table._samples)
+    return Run(columns, _json.loads(info))
+
+
+def validate(scene, out, quick=False, force=False, peers=()):
+    """``rdyn validate SCENE --out DIR``: runs the validation, writes the report into ``out``
+    (atomically; a folder holding files rdyn did not write needs force=True) and returns
+    summary.json's content as a dict. ``summary["status"]`` is "pass" or "fail" (the CLI's exit
+    0 or 1; the report is written either way)."""
+    return _json.loads(_rdyn.validate(scene._scene, _os.fspath(out), bool(quick), bool(force), list(peers)))
+
+
+def _axis_text(key, spec):
+    # --vary's syntax: key=a:b:n; a (a, b, n) tuple is written with repr's round-trip digits.
+    if isinstance(spec, str):
+        return f"{key}={spec}"
+    a, b, n = spec
+    return f"{key}={float(a)!r}:{float(b)!r}:{int(n)}"
+
+
+def _sweep_values(header, values):
+    # One CSV row of `rdyn sweep` as a dict: case an int, status and error strings, every other
+    # field a float (None where the CSV leaves it empty).
+    out = {}
+    for name, value in zip(header, values):
+        if name == "case":
+            out[name] = int(value)
+        elif name in ("status", "error"):
+            out[name] = value
+        else:
+            out[name] = float(value) if value != "" else None
+    return out
+
+
+def _csv_rows(text):
+    # RFC 4180 rows (an error message may hold commas, quotes or line breaks).
+    return list(_csv.reader(_io.StringIO(text)))
+
+
+_plans = {}  # a worker's plans by their definition: a process pool's worker plans each sweep once
+
+
+def _plan(spec):
+    if spec not in _plans:
+        scene, sets, vary, cadence_hz, power_w, load, grid_deg, drive_cadence_hz = spec
+        _plans[spec] = _rdyn.plan_sweep(scene, list(sets), list(vary), cadence_hz, power_w, load, grid_deg,
+                                        drive_cadence_hz, None)
+    return _plans[spec]
+
+
+def sweep_case(case):
+    """One case of a sweep, ``case`` = (spec, index) as ``sweep`` hands it to ``map``: the row
+    (a CSV line of ``rdyn sweep``) of that case. A module-level function of small, picklable
+    arguments, so any executor's map (threads, processes, a dask client) can run it."""
+    spec, index = case
+    return _rdyn.sweep_case(_plan(spec), int(index))
+
+
+def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_deg=10, drive_cadence_hz=None,
+          threads=None):
+    """``rdyn sweep``: every combination of the ``vary`` axes ({scene key: (a, b, n)} or
+    {key: "a:b:n"}), each case calibrated on the reduced model (or, with ``drive_cadence_hz``,
+    driven at that constant rate for one revolution). Returns one dict per case in case order
+    with the CLI CSV's columns (case, the varied keys, status, …, error).
+
+    ``map``: any executor's map (``ThreadPoolExecutor().map``, ``ProcessPoolExecutor().map``,
+    a dask client's map followed by gather, …) over the cases; the work item is a small tuple
+    and the worker ``rdyn.sweep_case``. None: the C++ sweep in ``threads`` threads (None: the
+    hardware's), reusing a thread's table between cases as the CLI does."""
+    spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
+            tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
+            None if cadence_hz is None else float(cadence_hz), None if power_w is None else float(power_w),
+            load or "", float(grid_deg), None if drive_cadence_hz is None else float(drive_cadence_hz))
+    plan = _plan(spec)  # checked here, before any case runs: bad input raises at once
+    header = _csv_rows(plan.header)[0]
+    if map is None:
+        if threads is not None:
+            plan = _rdyn.plan_sweep(*spec, int(threads))
+        text = _rdyn.run_sweep(plan)
+        rows = _csv_rows(text[text.index("\n") + 1:])[1:]  # after the metadata line and the header
+    else:
+        rows = [_csv_rows(row)[0] for row in map(sweep_case, [(spec, i) for i in range(plan.cases)])]
+    return [_sweep_values(header, r) for r in rows]
+
+
 class Runtime:
     """The embedding runtime (docs/embedding.md): a fixed-step RK4 reduced model, allocation-free
     and releasing the GIL while it steps.
@@ -188,6 +301,13 @@ class Runtime:
     q = property(lambda self: self._rt.q, doc="independent coordinate [rad or m]")
     qdot = property(lambda self: self._rt.qdot, doc="its rate [rad/s or m/s]")
     qddot = property(lambda self: self._rt.qddot, doc="its acceleration [rad/s² or m/s²]")
+
+    def drive_torque(self, q, qdot, qddot):
+        """The inverse of step: the generalized force [N·m or N] a drive on q must add for the
+        reduced model to move with (q, qdot, qddot) — m1 q̈ + m2 q̇² − F*, every scene load in F*
+        with the joint torques as last commanded — as ``rdyn drive --model reduced`` gives per
+        row. Raises ArgumentError for a state out of range; the state is not changed."""
+        return self._rt.drive_torque(q, qdot, qddot)
     energy = property(lambda self: self._rt.energy, doc="kinetic + potential energy [J]")
     work = property(lambda self: self._rt.work, doc="work of the non-conservative loads [J]")
     forces = property(lambda self: self._rt.forces, doc="constraint forces [N] (force_names order)")

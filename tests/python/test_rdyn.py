@@ -184,3 +184,155 @@ def test_run_to_pandas():
     run = rdyn.simulate(rdyn.load_scene("fourbar"), duration=0.2)
     df = run.to_pandas()
     assert isinstance(df, pandas.DataFrame) and list(df.columns) == list(run.keys())
+
+
+def read_sweep_csv(path):
+    """`rdyn sweep`'s CSV as the module returns it: one dict per row, after the metadata line."""
+    import csv
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))[1:]
+    header = rows[0]
+    out = []
+    for r in rows[1:]:
+        d = {}
+        for name, value in zip(header, r):
+            if name == "case":
+                d[name] = int(value)
+            elif name in ("status", "error"):
+                d[name] = value
+            else:
+                d[name] = float(value) if value != "" else None
+        out.append(d)
+    return out
+
+
+@pytest.mark.parametrize("model", ["reduced", "full"])
+def test_drive_matches_cli(rdyn_cli, tmp_path, model):
+    scene = rdyn.load_scene("fourbar")
+    run = rdyn.drive(scene, cadence_hz=2, model=model)
+    rdyn_cli("drive", "fourbar", "--cadence-hz", "2", "--model", model, "--out", str(tmp_path / "cli"))
+    cli = read_csv(tmp_path / "cli" / "timeseries.csv")
+    assert list(run.keys()) == list(cli.keys()) == ["t", "q", "qdot", "qddot", "drive_Nm", "drive_W",
+                                                    "F_rocker_axial"]
+    np.testing.assert_allclose(run["t"], cli["t"], rtol=1e-9, atol=0)  # the CSV's t has 10 digits
+    for name in list(cli)[1:]:  # 17 digits: the same code path agrees bit for bit
+        assert np.array_equal(run[name], np.array(cli[name])), name
+    info = read_json(tmp_path / "cli" / "run.json")
+    assert set(run.info) == set(info)
+    for key in set(info) - {"wall_s", "extraction_ms"}:
+        assert run.info[key] == info[key], key
+    assert run.info["drive_peak"] > 0.1
+
+
+def test_drive_profile_table_and_motor(tmp_path):
+    # A profile through a table from extract, and the motor check: the same numbers as extracting there.
+    scene = rdyn.load_scene("fourbar")
+    profile = tmp_path / "p.csv"
+    profile.write_text("t,q_deg\n" + "".join(f"{0.05 * i!r},{30 + 200 * np.sin(np.pi * 0.05 * i)!r}\n"
+                                             for i in range(21)))
+    table = rdyn.extract(scene, grid_deg=10)
+    a = rdyn.drive(scene, profile=profile, table=table, motor=(5, 20))
+    b = rdyn.drive(scene, profile=profile)
+    assert np.array_equal(a["drive_Nm"], b["drive_Nm"])
+    assert a.info["table"] == "(in memory)"
+    assert a.info["motor_check"]["stall"] == 5.0 and "covers" in a.info["motor_check"]
+    assert a["qdot"].min() < 0 < a["qdot"].max() and a["qddot"].min() < 0  # there and back
+
+
+def test_drive_errors_have_their_fields(tmp_path):
+    scene = rdyn.load_scene("fourbar")
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.drive(scene)  # neither a rate nor a profile
+    assert e.value.field == "--cadence-hz" and e.value.file == scene.source_file and e.value.line == 0
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.drive(scene, cadence_hz=1, motor=(5, -20))
+    assert e.value.field == "--motor"
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,q_deg\n0,0\n1,10\n0.5,20\n2,30\n")
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.drive(scene, profile=bad)
+    assert (e.value.file, e.value.line, e.value.field) == (str(bad), 4, "t")
+    with pytest.raises(rdyn.ArgumentError):
+        rdyn.drive(scene, cadence_hz=1, model="neither")
+
+
+def test_runtime_drive_torque_is_the_drive_commands_rows(tmp_path):
+    # Runtime.drive_torque(q, qdot, qddot) at rdyn drive's rows (a profile: q̈ ≠ 0, both signs
+    # of q̇) gives its drive_Nm: the C API's and the CLI's one Eksergian inverse.
+    scene = rdyn.load_scene("fourbar")
+    table = rdyn.extract(scene, grid_deg=10)
+    profile = tmp_path / "p.csv"
+    profile.write_text("t,q_deg\n" + "".join(f"{0.05 * i!r},{30 + 300 * np.sin(np.pi * 0.05 * i)!r}\n"
+                                             for i in range(41)))
+    run = rdyn.drive(scene, profile=profile, table=table)
+    rt = rdyn.Runtime(table, scene)
+    got = np.array([rt.drive_torque(q, qd, qdd) for q, qd, qdd in zip(run["q"], run["qdot"], run["qddot"])])
+    np.testing.assert_allclose(got, run["drive_Nm"], rtol=1e-9, atol=1e-12)
+    assert rt.t == 0.0  # the state is not changed
+    with pytest.raises(rdyn.ArgumentError):
+        rt.drive_torque(float("nan"), 1.0, 0.0)
+
+
+def test_validate_matches_cli(rdyn_cli, tmp_path):
+    scene = rdyn.load_scene("fourbar")
+    summary = rdyn.validate(scene, out=tmp_path / "py", quick=True)
+    assert summary == read_json(tmp_path / "py" / "summary.json")
+    assert (tmp_path / "py" / "report.html").exists()
+    rdyn_cli("validate", "fourbar", "--quick", "--out", str(tmp_path / "cli"))
+    cli = read_json(tmp_path / "cli" / "summary.json")
+    assert summary["status"] == cli["status"] == "pass"
+    assert summary["quantities"] == cli["quantities"]
+    # The same runs with the same errors (deterministic); their wall times are measured.
+    assert [r["label"] for r in summary["runs"]] == [r["label"] for r in cli["runs"]]
+    for a, b in zip(summary["runs"], cli["runs"]):
+        assert a["errors"] == b["errors"], a["label"]
+    with pytest.raises(rdyn.OutputError):  # a folder holding files rdyn did not write
+        (tmp_path / "foreign").mkdir()
+        (tmp_path / "foreign" / "mine.txt").write_text("x")
+        rdyn.validate(scene, out=tmp_path / "foreign", quick=True)
+
+
+def test_sweep_on_any_pool_is_the_cli_sweep(rdyn_cli, tmp_path):
+    from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+    scene = rdyn.load_scene("bicycle")
+    vary = {"bicycle_leg.crank_length_m": (0.16, 0.18, 3)}
+    rdyn_cli("sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:3", "--drive-cadence-hz", "1",
+             "--out", str(tmp_path / "cli.csv"))
+    cli = read_sweep_csv(tmp_path / "cli.csv")
+    in_process = rdyn.sweep(scene, vary, drive_cadence_hz=1)
+    with ThreadPoolExecutor(2) as pool:
+        threaded = rdyn.sweep(scene, vary, drive_cadence_hz=1, map=pool.map)
+    with ProcessPoolExecutor(2) as pool:
+        processes = rdyn.sweep(scene, vary, drive_cadence_hz=1, map=pool.map)
+    assert in_process == threaded == processes == cli
+    assert [r["status"] for r in cli] == ["ok"] * 3
+    assert list(cli[0]) == ["case", "bicycle_leg.crank_length_m", "status", "drive_rms_Nm", "drive_peak_Nm",
+                            "drive_mean_Nm", "mean_power_w", "peak_power_w", "peak_knee_force_N", "error"]
+    # Each case is `rdyn drive --model reduced` of that scene over one revolution on 1° rows.
+    rdyn_cli("drive", "bicycle", "--set", "bicycle_leg.crank_length_m=0.17", "--cadence-hz", "1", "--model",
+             "reduced", "--dt-out", repr(1 / 360), "--out", str(tmp_path / "drive"))
+    one = read_json(tmp_path / "drive" / "run.json")
+    for key, col in (("drive_rms", "drive_rms_Nm"), ("drive_peak", "drive_peak_Nm"), ("mean_power_W", "mean_power_w")):
+        assert abs(cli[1][col] - one[key]) <= 1e-9 * abs(one[key]), key
+
+
+def test_calibrating_sweep_on_a_thread_pool_is_the_cli_sweep(rdyn_cli, tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+    scene = rdyn.load_scene("bicycle")
+    rdyn_cli("sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:2", "--out", str(tmp_path / "c.csv"))
+    with ThreadPoolExecutor(2) as pool:
+        rows = rdyn.sweep(scene, {"bicycle_leg.crank_length_m": "0.16:0.18:2"}, map=pool.map)
+    assert rows == read_sweep_csv(tmp_path / "c.csv")
+    assert rows[0]["drive_torque_Nm"] > rows[1]["drive_torque_Nm"] > 0  # a longer crank needs less torque
+
+
+def test_sweep_errors_have_their_fields():
+    scene = rdyn.load_scene("bicycle")
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.sweep(scene, {"no.such.key": (1, 2, 2)}, drive_cadence_hz=1)
+    assert "no.such.key" in str(e.value)
+    with pytest.raises(rdyn.ArgumentError, match="--drive-cadence-hz"):
+        rdyn.sweep(scene, {"bicycle_leg.crank_length_m": (0.16, 0.18, 2)}, drive_cadence_hz=0)
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.sweep(scene, {"bicycle_leg.crank_length_m": (0.16, 0.18, 2)}, drive_cadence_hz=1, cadence_hz=1)
+    assert e.value.field == "--drive-cadence-hz"

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
 #include <set>
 #include <string>
 
@@ -144,6 +147,92 @@ TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
   rdyn_workspace_free(fb_ws);
   rdyn_model_free(m);
   rdyn_model_free(fb);
+}
+
+// A body on a pivot with gravity and a viscous bearing: m = 2 kg, centre of mass l = 0.3 m from
+// the pivot, I_G = 0.01 kg·m², so I = I_G + m l² = 0.19 kg·m² about the pivot and
+//   drive = I q̈ + m g l cos q + c q̇   (q from the x axis, gravity along −y, c = 0.02 N·m·s).
+constexpr double kPendulumI = 0.19, kPendulumMgl = 2 * 9.81 * 0.3, kPendulumC = 0.02;
+constexpr const char* kPendulumYaml = R"(name: pivot-pendulum
+ground_points: {O: [0, 0]}
+bodies:
+  - {name: arm, mass_kg: 2, com_m: [0.3, 0], inertia_kgm2: 0.01}
+joints:
+  - {name: pivot, type: revolute, parent: ground, parent_point: O, child: arm}
+independent: pivot
+loads:
+  - {type: resistance, name: bearing, body: arm, law: viscous, coefficient: 0.02}
+gravity: {enabled: true, g_m_s2: [0, -9.81]}
+initial: {q_deg: 20, qdot: 3.0}
+simulation: {duration_s: 2, output_interval_s: 0.01}
+)";
+
+// The rows of a CSV with a header line: column name → values.
+std::map<std::string, std::vector<double>> read_csv_columns(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  for (std::string n; std::getline(header, n, ',');) names.push_back(n);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    std::string v;
+    for (size_t c = 0; c < names.size() && std::getline(row, v, ','); ++c) cols[names[c]].push_back(std::stod(v));
+  }
+  return cols;
+}
+
+// rdyn_drive_torque against the pendulum's closed form, and against `rdyn drive --model
+// reduced` (a profile with q̈ ≠ 0 through both signs of q̇) row by row: the same drive.
+TEST_F(CApi, DriveTorqueIsThePendulumsClosedFormAndTheDriveCommandsRows) {
+  const fs::path scene = dir_ / "pendulum.yaml", table = dir_ / "pendulum.csv", profile = dir_ / "profile.csv";
+  std::ofstream(scene) << kPendulumYaml;
+  {
+    std::ofstream p(profile);
+    p << "t,q_deg\n";
+    for (int i = 0; i <= 40; ++i) {  // q = 20° + 300° sin(πt) over 2 s: q̇ changes sign
+      const double t = 0.05 * i;
+      p << t << "," << 20 + 300 * std::sin(M_PI * t) << "\n";
+    }
+  }
+  ASSERT_EQ(test::extract_table_with_cli(scene.string(), "10", table.string()), 0);
+  ASSERT_EQ(test::run_rdyn_cli({"drive", scene.string(), "--profile", profile.string(), "--model", "reduced",
+                                "--grid-deg", "10", "--dt-out", "0.01", "--out", (dir_ / "drive").string(), "--force"}),
+            0);
+  char msg[512];
+  rdyn_model* m = nullptr;
+  ASSERT_EQ(rdyn_model_load(table.c_str(), scene.c_str(), &m, msg, sizeof msg), RDYN_OK) << msg;
+  rdyn_workspace* ws = nullptr;
+  ASSERT_EQ(rdyn_workspace_new(m, &ws), RDYN_OK);
+  const auto rows = read_csv_columns(dir_ / "drive" / "timeseries.csv");
+  const auto& q = rows.at("q");
+  ASSERT_EQ(q.size(), 201u);
+  double worst_cli = 0.0, worst_closed = 0.0, peak = 0.0;
+  for (size_t i = 0; i < q.size(); ++i) {
+    const double qd = rows.at("qdot")[i], qdd = rows.at("qddot")[i], want = rows.at("drive_Nm")[i];
+    double d = NAN;
+    ASSERT_EQ(rdyn_drive_torque(m, ws, q[i], qd, qdd, &d), RDYN_OK) << i;
+    worst_cli = std::max(worst_cli, std::abs(d - want) / (1 + std::abs(want)));
+    const double closed = kPendulumI * qdd + kPendulumMgl * std::cos(q[i]) + kPendulumC * qd;
+    worst_closed = std::max(worst_closed, std::abs(d - closed));
+    peak = std::max(peak, std::abs(closed));
+  }
+  EXPECT_LT(worst_cli, 1e-9);
+  // A 10° Fourier table of constant m1 and m g l cos q is exact up to the extraction's rounding.
+  EXPECT_LT(worst_closed, 1e-8 * peak) << "peak " << peak;
+  EXPECT_GT(peak, 10.0);  // I q̈ reaches 0.19·(300° in rad)·π² ≈ 9.8, m g l = 5.9, c q̇ ≈ 0.3
+  // Refusals: null pointers, a state outside the checks; *drive untouched.
+  double d = 7.0;
+  EXPECT_EQ(rdyn_drive_torque(m, ws, 0.1, 1.0, 0.0, nullptr), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_drive_torque(nullptr, ws, 0.1, 1.0, 0.0, &d), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_drive_torque(m, nullptr, 0.1, 1.0, 0.0, &d), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_drive_torque(m, ws, NAN, 1.0, 0.0, &d), RDYN_BAD_STATE);
+  EXPECT_EQ(rdyn_drive_torque(m, ws, 0.1, 1.0, INFINITY, &d), RDYN_BAD_STATE);
+  EXPECT_EQ(d, 7.0);
+  rdyn_workspace_free(ws);
+  rdyn_model_free(m);
 }
 
 TEST(CApiStatus, EveryStatusHasItsOwnSentence) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <tuple>
 
 #include "analytic_source.hpp"
 #include "cli_table.hpp"
@@ -258,6 +259,78 @@ TEST(Runtime, DivergenceIsReported) {
   for (int i = 0; i < 20 && st == Status::Ok; ++i) st = step(model, ws, 1.0, Drive{});
   EXPECT_EQ(st, Status::Diverged);
   for (double v : snapshot(ws)) EXPECT_TRUE(std::isfinite(v));
+}
+
+// calc_drive_torque against Eksergian's equation written out for the analytic slider-crank:
+// drive = m1 q̈ + m2 q̇² − F*, F* = −k sin q (potential) + T·cos q (the lever's torque, on while
+// the lever's rate cos q · q̇ > 0) − c q̇ (the brake on the crank).
+TEST(Runtime, DriveTorqueIsEksergianSolvedForTheDrive) {
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  const test::SliderCrank sc;
+  auto closed_form = [&](double q, double qd, double qdd, double T) {
+    const bool on = std::cos(q) * qd > 0;
+    return sc.m1(q) * qdd + sc.m2(q) * qd * qd + 0.01 * std::sin(q) - (on ? T * std::cos(q) : 0.0) + 1e-4 * qd;
+  };
+  const auto before = snapshot(ws);
+  for (double q : {0.1, 1.0, 2.0, 3.5, 5.0})
+    for (double qd : {-7.0, 0.5, 12.0})
+      for (double qdd : {-30.0, 0.0, 4.0}) {
+        double d = NAN;
+        ASSERT_EQ(calc_drive_torque(model, ws, q, qd, qdd, d), Status::Ok);
+        // 5° cubic-spline table: its interpolation error in m1, m2 (~1e-6 relative).
+        const double want = closed_form(q, qd, qdd, 0.05);
+        EXPECT_NEAR(d, want, 2e-5 * (1 + std::abs(want)) + 1e-5 * sc.m1(q) * std::abs(qdd)) << q << " " << qd << " " << qdd;
+      }
+  EXPECT_EQ(snapshot(ws), before);  // the state and its gates untouched
+  // The joint torques as last commanded: after a step at T = 0.2 the lever's share changes.
+  ASSERT_EQ(step(model, ws, 1e-3, Drive::torque(0.2)), Status::Ok);
+  double d05 = NAN, d2 = NAN;
+  RuntimeWorkspace fresh(model);
+  ASSERT_EQ(calc_drive_torque(model, fresh, 0.4, 3.0, 1.0, d05), Status::Ok);
+  ASSERT_EQ(calc_drive_torque(model, ws, 0.4, 3.0, 1.0, d2), Status::Ok);
+  // The lever's ratio cos q from the 5° cubic-spline table (~1e-7 relative).
+  EXPECT_NEAR(d05 - d2, (0.2 - 0.05) * std::cos(0.4), 1e-6 * 0.15);
+}
+
+// Two routes: the forward step's own acceleration needs no drive beyond the commanded torques,
+// at every state of a run through the gate switches.
+TEST(Runtime, DriveTorqueOfTheModelsOwnAccelerationIsZero) {
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.0, 10.0, Drive::torque(0.08)), Status::Ok);
+  const long before = g_allocations;
+  double worst = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    ASSERT_EQ(step(model, ws, 1e-3, Drive::torque(0.08)), Status::Ok);
+    double d = NAN;
+    ASSERT_EQ(calc_drive_torque(model, ws, ws.get_q(), ws.get_qdot(), ws.get_qddot(), d), Status::Ok);
+    worst = std::max(worst, std::abs(d));
+  }
+  EXPECT_EQ(g_allocations - before, 0);  // allocation-free
+  EXPECT_LT(worst, 1e-12);               // [N·m]; the torques themselves are 0.08
+  EXPECT_GT(ws.get_switches(), 4);
+}
+
+TEST(Runtime, DriveTorqueRefusesBadStatesAndLeavesTheResult) {
+  const auto model = driven_model(0.05);
+  RuntimeWorkspace ws(model);
+  for (auto [q, qd, qdd] : std::initializer_list<std::tuple<double, double, double>>{
+           {NAN, 1.0, 0.0}, {0.0, INFINITY, 0.0}, {0.0, 1.0, NAN}, {0.0, 1.1e4, 0.0}, {0.0, 1.0, 2e8}, {2e6, 0.0, 0.0}}) {
+    double d = -3.0;
+    EXPECT_EQ(calc_drive_torque(model, ws, q, qd, qdd, d), Status::BadState) << q << " " << qd << " " << qdd;
+    EXPECT_EQ(d, -3.0);
+  }
+  auto s = analytic_samples(driven_scene(0.05));
+  s.periodic = false;
+  const auto ranged = make_runtime_model(s, driven_scene(0.05), {});
+  RuntimeWorkspace rws(ranged);
+  double d = 0.0;
+  EXPECT_EQ(calc_drive_torque(ranged, rws, -0.1, 1.0, 0.0, d), Status::BadState);  // outside [0°, 355°]
+  auto plain_scene = test::analytic_scene();
+  const auto plain = make_runtime_model(analytic_samples(plain_scene), plain_scene, {});
+  RuntimeWorkspace pws(plain);
+  EXPECT_EQ(calc_drive_torque(model, pws, 0.0, 1.0, 0.0, d), Status::WrongWorkspace);
 }
 
 TEST(Runtime, StatusMessagesExistForEveryStatus) {

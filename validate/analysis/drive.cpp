@@ -66,6 +66,13 @@ PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s,
   return m;
 }
 
+PrescribedMotion revolution_motion(double q0, double cadence_hz) {
+  const double period = 1.0 / std::abs(cadence_hz);
+  PrescribedMotion m = constant_rate_motion(q0, 2 * M_PI * cadence_hz, period, period / 360);
+  m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°, one revolution", cadence_hz, q0 * 180 / M_PI);
+  return m;
+}
+
 PrescribedMotion profile_motion(const std::string& path, bool revolute, std::optional<double> duration_opt, double dt_s,
                                 double max_rows) {
   // Checked before opening: a FIFO without a writer would block, a device never ends.
@@ -300,6 +307,29 @@ MotorCheck calc_motor_check(const DriveRecord& r, double stall, double no_load_s
   }
   c.covers = c.min_margin >= 0;
   c.min_margin_fraction = c.min_margin / std::abs(stall);
+  return c;
+}
+
+DriveCycleComparison calc_drive_cycle_comparison(const models::Scene& scene, const reduced::ReducedModel& model,
+                                                 double cadence_hz) {
+  DriveCycleComparison c;
+  c.cadence_hz = cadence_hz;
+  c.q0 = scene.initial.q;
+  const PrescribedMotion motion = revolution_motion(c.q0, cadence_hz);
+  c.full = calc_drive_full(scene, motion);
+  c.reduced = calc_drive_reduced(model, motion);
+  c.full_stats = calc_drive_stats(c.full);
+  c.reduced_stats = calc_drive_stats(c.reduced);
+  // The difference's RMS over time by the trapezoidal rule, as calc_drive_stats's RMS.
+  DriveRecord diff;
+  diff.t = motion.t;
+  for (size_t i = 0; i < motion.t.size(); ++i) {
+    const double d = c.reduced.drive[i] - c.full.drive[i];
+    diff.drive.push_back(d);
+    diff.power.push_back(0.0);
+    c.max_difference = std::max(c.max_difference, std::abs(d));
+  }
+  c.rms_difference = calc_drive_stats(diff).rms;
   return c;
 }
 

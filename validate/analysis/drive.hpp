@@ -24,6 +24,11 @@ struct PrescribedMotion {
 // q = q0 + rate·t on [0, duration] every dt (the last row at the duration itself).
 PrescribedMotion constant_rate_motion(double q0, double rate, double duration_s, double dt_s);
 
+// One revolution at a constant F rev/s (sign: direction) from q0, rows 1° of q apart (361 rows,
+// the last at 1/|F| s): the motion the validate report and `sweep --drive-cadence-hz` drive —
+// the rows of `rdyn drive --cadence-hz F --dt-out 1/(360|F|)`.
+PrescribedMotion revolution_motion(double q0, double cadence_hz);
+
 // A profile t,q_deg (revolute) or t,q_m (prismatic) from a CSV file, interpolated by a natural
 // cubic spline (GSL; q̇ and q̈ its first and second derivatives), sampled every dt from its first
 // time over `duration_s` (≤ its span; empty: the span). Throws models::SceneError naming the
@@ -88,5 +93,21 @@ struct MotorCheck {
   double min_margin_fraction = 0.0;         // min_margin / |stall|
 };
 MotorCheck calc_motor_check(const DriveRecord& r, double stall, double no_load_speed);
+
+// The drive over one revolution at a constant rate from both models (the validate report's
+// drive figure): the full model's inverse dynamics and the reduced model's inverse Eksergian
+// equation on the same rows (revolution_motion), every load of the scene applied.
+struct DriveCycleComparison {
+  double cadence_hz = 0.0;   // [rev/s]
+  double q0 = 0.0;           // [rad]
+  DriveRecord full, reduced;  // the same t, q rows
+  DriveStats full_stats, reduced_stats;
+  double max_difference = 0.0;  // max |drive_reduced − drive_full| over the rows [N·m]
+  double rms_difference = 0.0;  // RMS of that difference over the revolution [N·m]
+};
+// `model`: a reduced model built from `scene` (its loads). Throws as calc_drive_full /
+// calc_drive_reduced.
+DriveCycleComparison calc_drive_cycle_comparison(const models::Scene& scene, const reduced::ReducedModel& model,
+                                                 double cadence_hz);
 
 }  // namespace rdyn::validate

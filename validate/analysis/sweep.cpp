@@ -14,7 +14,10 @@
 #include "models/scene_hash.hpp"
 #include "models/scene_write.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/reduced_model.hpp"
+#include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/drive.hpp"
 #include "validate/io/escape.hpp"
 #include "validate/io/progress.hpp"
 
@@ -37,6 +40,7 @@ std::string sweep_defining_text(const models::Scene& base, const SweepPlan& p) {
   }
   const CalibrationOptions& c = p.calibration;
   t += fmt::format("cadence {:a} power {:a} grid {:a}\n", c.cadence_hz, c.power_w, c.grid_deg);
+  if (p.opt.drive_cadence_hz != 0) t += fmt::format("drive {:a}\n", p.opt.drive_cadence_hz);
   str(p.opt.load);
   str(p.header);
   return t;
@@ -97,7 +101,85 @@ RunOrder run_order(const SweepPlan& plan, int threads) {
   return r;
 }
 
+// The last table a worker extracted, by table_key: cases that differ only in load values,
+// resistance coefficients, cadence or power share it (the extraction and fit are 3/4 of a
+// calibrated case; run_order puts the cases of one mechanism next to each other).
+struct TableCache {
+  std::optional<std::pair<std::string, CalibrationTable>> calibration;
+  std::optional<std::pair<std::string, reduced::Samples>> drive;  // a drive sweep's
+  long extracted = 0;
+};
+
+// A calibrated case's fields after its status.
+std::string calibrated_fields(const SweepPlan& plan, const models::Scene& scene, TableCache& cache) {
+  const std::string key = table_key(scene);
+  if (!cache.calibration || cache.calibration->first != key) {
+    cache.calibration.reset();  // a failed extraction leaves none
+    ++cache.extracted;
+    cache.calibration.emplace(key, extract_calibration_table(scene, plan.calibration));
+  }
+  Progress quiet(false);
+  const auto r = calibrate(scene, cache.calibration->second, plan.calibration, quiet);
+  // No constraint force requested: an empty field, never NaN.
+  const std::string peak = plan.force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
+  return fmt::format("{:.10g},{:.10g},{:.10g},{},{:.10g},", r.load_value, r.mean_cadence_hz_reduced, r.mean_power_w,
+                     peak, r.speed_fluctuation);
+}
+
+// A driven case's fields after its status: the reduced model over one revolution at the rate.
+std::string driven_fields(const SweepPlan& plan, const models::Scene& scene, TableCache& cache) {
+  const std::string key = table_key(scene);
+  if (!cache.drive || cache.drive->first != key) {
+    cache.drive.reset();
+    ++cache.extracted;
+    cache.drive.emplace(key, extract_from_full(scene, plan.opt.grid_deg, reduced::Method::Kinetostatic).samples);
+  }
+  const auto model = reduced::make_reduced_model(cache.drive->second, scene, reduced::Interpolation::Fourier);
+  const DriveRecord r = calc_drive_reduced(model, revolution_motion(scene.initial.q, plan.opt.drive_cadence_hz));
+  const DriveStats st = calc_drive_stats(r);
+  const std::string peak = st.force_peaks.empty() ? std::string() : fmt::format("{:.10g}", st.force_peaks[0]);
+  return fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},", st.rms, st.peak, st.mean, st.mean_power_W,
+                     st.peak_power_W, peak);
+}
+
+// Case `index`'s row; `ok` false when it failed (its row then has status "error" and the message).
+std::string case_row(const SweepPlan& plan, long index, TableCache& cache, bool& ok) {
+  const SweepCase c = sweep_case(plan, index);
+  const bool drive = plan.opt.drive_cadence_hz != 0;
+  try {
+    const auto scene = models::load_scene(plan.opt.scene, c.overrides);
+    const std::string fields = drive ? driven_fields(plan, scene, cache) : calibrated_fields(plan, scene, cache);
+    ok = true;
+    return fmt::format("{}{},ok,{}", index, c.params, fields);
+  } catch (const std::exception& e) {
+    ok = false;
+    return fmt::format("{}{},error,{}{}", index, c.params, drive ? ",,,,,," : ",,,,,", csv_field(e.what()));
+  }
+}
+
 }  // namespace
+
+SweepCase sweep_case(const SweepPlan& plan, long index) {
+  SweepCase c;
+  c.overrides = plan.fixed;
+  long rest = index;
+  const auto& axes = plan.opt.axes;
+  for (auto it = axes.rbegin(); it != axes.rend(); ++it) {  // last axis varies fastest
+    const double v = it->values[rest % it->values.size()];
+    rest /= static_cast<long>(it->values.size());
+    c.overrides.push_back({it->key, fmt::format("{:.17g}", v)});
+    c.params = fmt::format(",{:.10g}", v) + c.params;
+  }
+  return c;
+}
+
+std::string run_sweep_case(const SweepPlan& plan, long index) {
+  if (index < 0 || index >= plan.id.total)
+    throw models::SceneError("", 0, "case", fmt::format("no case {} (the sweep has {})", index, plan.id.total));
+  TableCache cache;
+  bool ok = false;
+  return case_row(plan, index, cache, ok);
+}
 
 SweepPlan plan_sweep(const SweepOptions& opt) {
   if (opt.shards < 1 || opt.shard < 0 || opt.shard >= opt.shards)
@@ -108,14 +190,31 @@ SweepPlan plan_sweep(const SweepOptions& opt) {
   const auto& fixed = plan.fixed;
   // The base scene must load (fails early, before any thread starts).
   const models::Scene base = models::load_scene(opt.scene, fixed);
-  // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
-  CalibrationOptions copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
-  copt.grid_deg = opt.grid_deg;
-  copt.full_max_s = 0.0;  // reduced model only: this is what sweeps are for
-  if (!(copt.cadence_hz > 0))
-    throw models::SceneError(base.source_file, 0, "--cadence-hz",
-                             "give it, or a validation.calibrate block in the scene");
-  check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
+  const bool drive = opt.drive_cadence_hz != 0;
+  CalibrationOptions copt;
+  if (drive) {
+    // A drive sweep calibrates nothing: the cases run at the rate given.
+    if (opt.cadence_hz > 0 || opt.power_w > 0 || !opt.load.empty())
+      throw models::SceneError(base.source_file, 0, "--drive-cadence-hz",
+                               "a drive sweep does not calibrate: give --drive-cadence-hz without --cadence-hz, "
+                               "--power-w and --load");
+    if (!std::isfinite(opt.drive_cadence_hz))  // its range: the command line's (validate/cli)
+      throw models::SceneError(base.source_file, 0, "--drive-cadence-hz", "must be a finite, non-zero rate");
+    if (base.find_joint(base.independent)->type != models::JointType::Revolute)
+      throw models::SceneError(base.source_file, 0, "--drive-cadence-hz",
+                               "a constant rate needs a revolute independent coordinate");
+    copt.grid_deg = opt.grid_deg;
+    copt.cadence_hz = 0.0;
+  } else {
+    // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
+    copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
+    copt.grid_deg = opt.grid_deg;
+    copt.full_max_s = 0.0;  // reduced model only: this is what sweeps are for
+    if (!(copt.cadence_hz > 0))
+      throw models::SceneError(base.source_file, 0, "--cadence-hz",
+                               "give it, or a validation.calibrate block in the scene");
+    check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
+  }
   // Every axis at both ends of its range on the base scene: unknown keys and values out of
   // range fail here, before any thread starts. Ends of two tables: the axis changes the mechanism.
   for (const auto& a : opt.axes) {
@@ -143,8 +242,14 @@ SweepPlan plan_sweep(const SweepOptions& opt) {
   plan.force = base.outputs.constraint_forces.empty() ? "" : base.outputs.constraint_forces[0].name;
   plan.header = "case";
   for (const auto& a : opt.axes) plan.header += "," + csv_field(a.key);
-  plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error",
-                             load_value_column(base, copt), plan.force.empty() ? "constraint" : plan.force);
+  const std::string force_column = plan.force.empty() ? "constraint" : plan.force;
+  if (drive)
+    plan.header += fmt::format(",status,drive_rms_Nm,drive_peak_Nm,drive_mean_Nm,mean_power_w,peak_power_w,peak_{}_force_N,"
+                               "error",
+                               force_column);
+  else
+    plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error",
+                               load_value_column(base, copt), force_column);
   plan.id.total = total;
   plan.id.scene_hex = models::scene_hash_hex(models::scene_hash(base));
   plan.id.sweep_hex = models::scene_hash_hex(models::fnv1a64(sweep_defining_text(base, plan)));
@@ -156,9 +261,6 @@ SweepResult run_sweep(const SweepOptions& opt) { return run_sweep(plan_sweep(opt
 
 SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   const SweepOptions& opt = plan.opt;
-  const auto& fixed = plan.fixed;
-  const CalibrationOptions& copt = plan.calibration;
-  const std::string& force = plan.force;
   const long first = plan.range.first;
   const long n = plan.range.end - plan.range.first;
   const auto t0 = std::chrono::steady_clock::now();
@@ -170,46 +272,18 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   std::vector<std::string> rows(n);
   std::atomic<long> next{0}, done{0}, failed{0}, tables{0};
   auto work = [&] {
-    Progress quiet(false);
-    // The last table this thread extracted, by table_key: cases that differ only in load
-    // values, resistance coefficients, cadence or power share it (calibrate's extraction and
-    // fit are 3/4 of a case; run_order puts the cases of one mechanism next to each other).
-    std::optional<std::pair<std::string, CalibrationTable>> last;
+    TableCache cache;
     for (long c; (c = next.fetch_add(1)) < chunks;) {
       for (long k = order.chunks[c]; k < order.chunks[c + 1]; ++k) {
         const long index = order.cases[k];
-        std::vector<models::Override> o = fixed;
-        std::string params;
-        long rest = index;
-        for (auto it = opt.axes.rbegin(); it != opt.axes.rend(); ++it) {  // last axis varies fastest
-          const double v = it->values[rest % it->values.size()];
-          rest /= static_cast<long>(it->values.size());
-          o.push_back({it->key, fmt::format("{:.17g}", v)});
-          params = fmt::format(",{:.10g}", v) + params;
-        }
-        std::string row;
-        try {
-          const auto scene = models::load_scene(opt.scene, o);
-          const std::string key = table_key(scene);
-          if (!last || last->first != key) {
-            last.reset();  // a failed extraction leaves none
-            ++tables;
-            last.emplace(key, extract_calibration_table(scene, copt));
-          }
-          const auto r = calibrate(scene, last->second, copt, quiet);
-          // No constraint force requested: an empty field, never NaN.
-          const std::string peak = force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
-          row = fmt::format("{}{},ok,{:.10g},{:.10g},{:.10g},{},{:.10g},", index, params, r.load_value,
-                            r.mean_cadence_hz_reduced, r.mean_power_w, peak, r.speed_fluctuation);
-        } catch (const std::exception& e) {
-          row = fmt::format("{}{},error,,,,,,{}", index, params, csv_field(e.what()));
-          ++failed;
-        }
-        rows[index - first] = row;
+        bool ok = false;
+        rows[index - first] = case_row(plan, index, cache, ok);
+        if (!ok) ++failed;
         const long d = ++done;
         if (progress) progress->done(d);
       }
     }
+    tables += cache.extracted;
   };
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);

@@ -31,6 +31,11 @@ struct SweepOptions {
   int shard = 0, shards = 1;
   int threads = 0;          // 0: hardware threads
   double grid_deg = 10.0;
+  // Non-zero: a drive sweep — each case is driven at this constant rate [rev/s] for one
+  // revolution (reduced model, revolution_motion in drive.hpp) instead of calibrated, and its
+  // row gives the drive's RMS, peak and mean, the mean and peak power and the peak constraint
+  // force (what `rdyn drive --model reduced` reports). Excludes cadence_hz, power_w and load.
+  double drive_cadence_hz = 0.0;
 };
 
 // A sweep checked and described before any case runs.
@@ -47,7 +52,8 @@ struct SweepPlan {
 
 // Loads the base scene and checks everything before work: every axis key is applied at both
 // ends of its range to the base scene, so an unknown key or an out-of-range value is a
-// SceneError here; the scene must be calibratable; at most 1e6 cases.
+// SceneError here; the scene must be calibratable (a drive sweep: revolute, the rate finite);
+// at most 1e6 cases.
 SweepPlan plan_sweep(const SweepOptions& opt);
 
 struct SweepResult {
@@ -67,5 +73,17 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress);
 
 // plan_sweep then run_sweep without progress.
 SweepResult run_sweep(const SweepOptions& opt);
+
+// The scene overrides of case `index` (the fixed ones, then one per axis, the last axis varying
+// fastest) and the varied values as the row writes them (",v1,v2…").
+struct SweepCase {
+  std::vector<models::Override> overrides;
+  std::string params;
+};
+SweepCase sweep_case(const SweepPlan& plan, long index);
+
+// One case's CSV row (no line break), computed alone (no table reuse): what run_sweep writes
+// for it. A failing case gives its "error" row. The Python module maps this over a pool.
+std::string run_sweep_case(const SweepPlan& plan, long index);
 
 }  // namespace rdyn::validate

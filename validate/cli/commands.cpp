@@ -474,12 +474,9 @@ int run_sweep_merge(const SweepArgs& a) {
 
 }  // namespace
 
-int run_sweep_command(const SweepArgs& a) {
-  if (!a.merge.empty()) return run_sweep_merge(a);
+SweepOptions check_sweep_args(const SweepArgs& a) {
   if (a.inputs.size() != 1)
-    throw ArgumentError(fmt::format("sweep: give one scene (got {}); several files are for --merge OUT.csv PART...",
-                                    a.inputs.size()));
-  if (a.out.empty()) throw ArgumentError("--out: give the output CSV file");
+    throw ArgumentError(fmt::format("sweep: give one scene (got {})", a.inputs.size()));
   SweepOptions o;
   o.scene = a.inputs.front();
   o.sets = a.sets;
@@ -489,6 +486,13 @@ int run_sweep_command(const SweepArgs& a) {
   o.threads = a.threads.value_or(0);  // 0: the hardware's threads
   o.grid_deg = a.grid_deg;
   require_grid("--grid-deg", a.grid_deg);
+  if (a.drive_cadence_hz) {  // a typed 0 is refused, not "no drive sweep"
+    const double f = *a.drive_cadence_hz;
+    if (!(std::isfinite(f) && f != 0 && std::abs(f) <= cli_limits::kMaxCadence_Hz))
+      throw ArgumentError(fmt::format("--drive-cadence-hz: must be a finite, non-zero rate with |F| ≤ {:g} rev/s (got {})",
+                                      cli_limits::kMaxCadence_Hz, f));
+    o.drive_cadence_hz = f;
+  }
   // A typed value is checked even when it is 0: `--threads 0` meant no default (issue #23).
   if (a.threads) require_in("--threads", *a.threads, 1, cli_limits::kMaxThreads, "");
   if (a.cadence_hz) require_positive_up_to("--cadence-hz", *a.cadence_hz, cli_limits::kMaxCadence_Hz, " Hz");
@@ -502,6 +506,16 @@ int run_sweep_command(const SweepArgs& a) {
   }
   if (a.vary.empty()) throw ArgumentError("--vary: give at least one key=a:b:n");
   for (const auto& v : a.vary) o.axes.push_back(parse_sweep_axis(v));
+  return o;
+}
+
+int run_sweep_command(const SweepArgs& a) {
+  if (!a.merge.empty()) return run_sweep_merge(a);
+  if (a.inputs.size() != 1)
+    throw ArgumentError(fmt::format("sweep: give one scene (got {}); several files are for --merge OUT.csv PART...",
+                                    a.inputs.size()));
+  if (a.out.empty()) throw ArgumentError("--out: give the output CSV file");
+  const SweepOptions o = check_sweep_args(a);
   const std::string what = "sweep shard " + a.shard;
   const SweepPlan plan = plan_sweep(o);
   // Only a file can hold a finished part: a device or FIFO at --out (/dev/stdout) is written.
@@ -666,17 +680,30 @@ int run_validate(const ValidateArgs& a) {
   Progress progress;
   if (!a.suite.empty()) return run_suite(a, progress);
   const auto scene = load(a.scene, a.sets);
+  const nlohmann::json summary = validate_scene(scene, a, progress);
+  const bool pass = summary.value("status", std::string()) == "pass";
+  std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
+  if (!pass) {
+    std::string why;
+    for (const auto& f : summary.value("failures", nlohmann::json::array()))
+      why += (why.empty() ? "" : "; ") + f.get<std::string>();
+    std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), why.c_str());
+  }
+  return pass ? 0 : 1;
+}
+
+nlohmann::json validate_scene(const models::Scene& scene, const ValidateArgs& a, Progress& progress) {
+  check_peers(a.peers);  // before any work: a peer this build cannot run is exit 2
+  if (a.quick && a.thorough) throw ArgumentError("--quick and --thorough: give one of them");
   OutputDir out(a.out, a.force);
   ValidationOptions opt;
   opt.quick = a.quick;
   opt.peers = a.peers;
   const ValidationResult v = run_validation(scene, opt, progress);
-  const nlohmann::json summary = with_drawing(summary_json(v), scene);
+  nlohmann::json summary = with_drawing(summary_json(v), scene);
   render_report(summary, out.file(""));
   out.commit();
-  std::printf("%s\n\nReport: %s/report.html\n", headline(summary).c_str(), a.out.c_str());
-  if (!v.pass) std::fprintf(stderr, "rdyn: validation of %s FAILED: %s\n", scene.name.c_str(), v.failure_summary().c_str());
-  return v.pass ? 0 : 1;
+  return summary;
 }
 
 int run_export_mjcf(const ExportMjcfArgs& a) {

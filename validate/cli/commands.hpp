@@ -13,7 +13,9 @@
 #include "models/timeseries.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/sweep.hpp"
 #include "validate/io/argument_error.hpp"
+#include "validate/io/progress.hpp"
 
 namespace rdyn::validate {
 
@@ -98,6 +100,11 @@ struct ValidateArgs {
   std::vector<std::string> peers;  // peer engines beside the full model (validate/harness/peers.hpp)
 };
 int run_validate(const ValidateArgs& args);
+// What `rdyn validate SCENE --out DIR` does for a loaded scene (the Python module's validate):
+// the peers checked, the validation run, its report written into args.out (atomically; args.force
+// as --force) and summary.json's content returned ("status": "pass" or "fail", the CLI's exit 0
+// or 1). args.scene, suite and sets are not read. `progress` reports the stages.
+nlohmann::json validate_scene(const models::Scene& scene, const ValidateArgs& args, Progress& progress);
 
 // Re-renders a report from a summary.json written by `rdyn validate`.
 struct ReportArgs {
@@ -116,12 +123,16 @@ struct SweepArgs {
   std::optional<int> threads;                  // none: the hardware's threads
   std::optional<double> cadence_hz, power_w;   // none: the scene's validation.calibrate
   std::string load;  // --load, as for calibrate
+  std::optional<double> drive_cadence_hz;      // a drive sweep at this rate [rev/s] (no calibration)
   double grid_deg = 10.0;
   bool force = false;
   bool resume = false;  // skip when --out already holds this shard complete
   std::string merge;    // OUT.csv of `--merge OUT.csv PART...` ("" runs a sweep)
 };
 int run_sweep_command(const SweepArgs& args);
+// The sweep's options from the command line's, every number checked as `rdyn sweep` checks it
+// (ArgumentError names the option; an axis text a SceneError); out, force, resume, merge not read.
+SweepOptions check_sweep_args(const SweepArgs& args);
 
 // `rdyn export-mjcf`: the scene as MJCF (MuJoCo XML), its loops closed at the assembled initial
 // configuration (models/mjcf_export.hpp).

@@ -46,9 +46,8 @@ DriveRecord every_kth_row(const DriveRecord& r, long k) {
 
 void write_drive_csv(const std::string& path, const DriveRecord& r, bool revolute) {
   TextSink sink(path);
-  std::string header = revolute ? "t,q,qdot,qddot,drive_Nm,drive_W" : "t,q,qdot,qddot,drive_N,drive_W";
-  for (const auto& n : r.force_names) header += ",F_" + n;  // names are checked by the scene reader
-  for (const auto& n : r.column_names) header += "," + n;
+  std::string header;
+  for (const auto& n : drive_column_names(r, revolute)) header += (header.empty() ? "" : ",") + n;
   sink.add(header + "\n");
   for (size_t i = 0; i < r.t.size(); ++i) {
     std::string row = fmt::format("{:.10g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.t[i], r.q[i], r.qdot[i],
@@ -158,12 +157,18 @@ DriveMotion calc_drive_motion(const DriveArgs& a, const models::Scene& scene, bo
 
 // The drive the chosen model needs along the motion; the reduced model's settings go into `run`.
 DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, const PrescribedMotion& motion,
-                              nlohmann::json& run) {
+                              const reduced::Samples* table, nlohmann::json& run) {
   if (a.model == "full") return calc_drive_full(scene, motion);
   // Joint outputs as `simulate --model reduced` gives them: `reactions: all` those it can (the
   // others named), listed ones or refused.
   const models::Scene oscene = reduced_output_scene(scene, run);
   const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
+  if (table) {  // a table in memory (the Python module's Table)
+    const auto model = reduced::make_reduced_model(*table, rscene, reduced::parse_interpolation(a.interpolation));
+    run.update({{"table", table->file.empty() ? std::string("(in memory)") : table->file},
+                {"interpolation", model.table.fit}});
+    return calc_drive_reduced(oscene, model, motion);
+  }
   auto e = extract_from_full(rscene, a.grid_deg, reduced::Method::Kinetostatic);
   const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
   DriveRecord r = calc_drive_reduced(oscene, model, motion);
@@ -212,38 +217,77 @@ void add_drive_results(nlohmann::json& run, const PrescribedMotion& motion, cons
 
 }  // namespace
 
+std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute) {
+  std::vector<std::string> names{"t", "q", "qdot", "qddot", revolute ? "drive_Nm" : "drive_N", "drive_W"};
+  for (const auto& n : r.force_names) names.push_back("F_" + n);  // names are checked by the scene reader
+  for (const auto& n : r.column_names) names.push_back(n);
+  return names;
+}
+
+namespace {
+
+// Everything checked and planned before any work or output: the option values, the motor and
+// the motion (a profile is read here).
+struct DrivePlan {
+  bool revolute = true;
+  double dt = 0.0;  // output interval [s]
+  std::optional<std::pair<double, double>> motor;
+  DriveMotion d;
+};
+
+DrivePlan plan_drive(const models::Scene& scene, const DriveArgs& a) {
+  DrivePlan p;
+  p.revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  p.dt = a.dt_out.value_or(scene.simulation.output_interval_s);
+  check_drive_arguments(a, scene, p.revolute, p.dt);
+  p.motor = parse_motor_option(a, scene, p.revolute);
+  p.d = calc_drive_motion(a, scene, p.revolute, p.dt);
+  return p;
+}
+
+DriveRun run_drive_plan(const models::Scene& scene, const DriveArgs& a, const DrivePlan& p,
+                        const reduced::Samples* table) {
+  nlohmann::json run = {{"scene", scene.name}, {"scene_file", scene.source_file}, {"model", a.model}};
+  if (a.cadence_hz) run["cadence_hz"] = *a.cadence_hz;
+  else run["profile"] = a.profile;
+  const DriveRecord r = calc_drive_record(a, scene, p.d.motion, table, run);
+  const DriveStats st = calc_drive_stats(r);
+  std::optional<MotorCheck> mc;
+  if (p.motor) mc = calc_motor_check(r, p.motor->first, p.motor->second);
+  add_drive_results(run, p.d.motion, r, st, p.dt, p.revolute, mc);
+  return {every_kth_row(r, p.d.k), std::move(run), p.revolute};
+}
+
+}  // namespace
+
+DriveRun drive_scene(const models::Scene& scene, const DriveArgs& a, const reduced::Samples* table) {
+  return run_drive_plan(scene, a, plan_drive(scene, a), table);
+}
+
 int run_drive(const DriveArgs& a) {
   std::vector<models::Override> overrides;
   for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
   const models::Scene scene = models::load_scene(a.scene, overrides);
-  const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
-  const double dt = a.dt_out.value_or(scene.simulation.output_interval_s);
-  check_drive_arguments(a, scene, revolute, dt);
-  const auto motor = parse_motor_option(a, scene, revolute);
-  const DriveMotion d = calc_drive_motion(a, scene, revolute, dt);
-
-  nlohmann::json run = {{"scene", scene.name}, {"scene_file", scene.source_file}, {"model", a.model}};
-  if (a.cadence_hz) run["cadence_hz"] = *a.cadence_hz;
-  else run["profile"] = a.profile;
-  OutputDir out(a.out, a.force);  // fails early on an unusable folder
-  const DriveRecord r = calc_drive_record(a, scene, d.motion, run);
-  const DriveStats st = calc_drive_stats(r);
-  std::optional<MotorCheck> mc;
-  if (motor) mc = calc_motor_check(r, motor->first, motor->second);
-  add_drive_results(run, d.motion, r, st, dt, revolute, mc);
-
-  write_drive_csv(out.file("timeseries.csv"), every_kth_row(r, d.k), revolute);
-  write_text_file(out.file("run.json"), run.dump(2) + "\n");
+  const DrivePlan plan = plan_drive(scene, a);  // every argument before the output folder is touched
+  OutputDir out(a.out, a.force);                // fails early on an unusable folder
+  const DriveRun d = run_drive_plan(scene, a, plan, nullptr);
+  write_drive_csv(out.file("timeseries.csv"), d.rows, d.revolute);
+  write_text_file(out.file("run.json"), d.run.dump(2) + "\n");
   out.commit();
-  const char* unit = revolute ? "N·m" : "N";
+  const char* unit = d.revolute ? "N·m" : "N";
+  const auto& run = d.run;
   std::fprintf(stderr, "rdyn: %s (%s model) driven by %s: drive RMS %.4g %s, peak %.4g %s, mean power %.4g W; wrote %s\n",
-               scene.name.c_str(), a.model.c_str(), d.motion.how.c_str(), st.rms, unit, st.peak, unit, st.mean_power_W,
-               (a.out + "/timeseries.csv").c_str());
-  if (mc)
+               scene.name.c_str(), a.model.c_str(), run["motion"].get<std::string>().c_str(),
+               run["drive_rms"].get<double>(), unit, run["drive_peak"].get<double>(), unit,
+               run["mean_power_W"].get<double>(), (a.out + "/timeseries.csv").c_str());
+  if (run.contains("motor_check")) {
+    const auto& mc = run["motor_check"];
+    const double at_q = mc["at_q"].get<double>() * (d.revolute ? M_PI / 180 : 1.0);
     std::fprintf(stderr, "rdyn: motor %s: %s (smallest margin %.4g %s, %.3g %% of stall, at t = %.6g s, %s)\n",
-                 a.motor.c_str(), mc->covers ? "covers the drive at every row" : "does NOT cover the drive",
-                 mc->min_margin, unit, 100 * mc->min_margin_fraction, mc->at_t,
-                 engine_free_coordinate(mc->at_q, revolute).c_str());
+                 a.motor.c_str(), mc["covers"].get<bool>() ? "covers the drive at every row" : "does NOT cover the drive",
+                 mc["min_margin"].get<double>(), unit, 100 * mc["min_margin_fraction_of_stall"].get<double>(),
+                 mc["at_t_s"].get<double>(), engine_free_coordinate(at_q, d.revolute).c_str());
+  }
   return 0;
 }
 

@@ -6,6 +6,12 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "models/scene.hpp"
+#include "reduced/samples.hpp"
+#include "validate/analysis/drive.hpp"
+
 namespace rdyn::validate {
 
 struct DriveArgs {
@@ -24,5 +30,20 @@ struct DriveArgs {
 };
 
 int run_drive(const DriveArgs& args);
+
+// What `rdyn drive` computes for a loaded scene, without writing it (the Python module's drive):
+// the arguments checked as the CLI checks them (models::SceneError naming the option), the
+// drive along the motion and run.json's content. `rows` are timeseries.csv's rows (every
+// k-th statistics row and the last). args.scene, sets, out and force are not read; `table`, when
+// given, is the reduced model's table (else extracted at args.grid_deg).
+struct DriveRun {
+  DriveRecord rows;
+  nlohmann::json run;
+  bool revolute = true;  // drive_Nm (else drive_N)
+};
+DriveRun drive_scene(const models::Scene& scene, const DriveArgs& args, const reduced::Samples* table = nullptr);
+// timeseries.csv's header names of a run's rows, in order (t, q, qdot, qddot, drive_Nm or
+// drive_N, drive_W, F_<force>…, joint outputs…).
+std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute);
 
 }  // namespace rdyn::validate

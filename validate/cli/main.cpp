@@ -176,6 +176,11 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
   auto* load = sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")
                    ->check(names_a_load());
   auto* grid = sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+  auto* drive = sweep->add_option_function<double>(
+      "--drive-cadence-hz", [&sw](const double& v) { sw.drive_cadence_hz = v; },
+      "Drive each case at this constant rate [rev/s] for one revolution (reduced model, as rdyn drive) instead of "
+      "calibrating it: the rows give the drive's RMS, peak and mean, the mean and peak power");
+  drive->excludes(cadence)->excludes(power)->excludes(load);
   sweep->add_option("--merge", sw.merge,
                     "OUT.csv: merge the part CSVs given as positional arguments (one sweep, every case once) into "
                     "one file in case order")
@@ -188,7 +193,8 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       ->excludes(cadence)
       ->excludes(power)
       ->excludes(load)
-      ->excludes(grid);
+      ->excludes(grid)
+      ->excludes(drive);
 }
 
 void add_inspect_command(CLI::App& app, InspectArgs& ins) {

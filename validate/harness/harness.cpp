@@ -444,6 +444,14 @@ void analyse_runs(ValidationResult& v) {
   analyse_peers(v);
 }
 
+void calc_drive_cycle(const models::Scene& scene, ValidationResult& v) {
+  const double cadence = scene.validation.calibrate_cadence_Hz;
+  const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+  if (!(cadence > 0) || !revolute || v.samples10.q.empty() || !v.samples10.periodic) return;
+  const auto model = reduced::make_reduced_model(v.samples10, extraction_scene(scene), reduced::Interpolation::Fourier);
+  v.drive_cycle = calc_drive_cycle_comparison(scene, model, cadence);
+}
+
 void calc_first_screen(ValidationResult& v) {
   // A scene judged on the defaults must also reach the validation's own target: a reduced
   // setting within it on the speed and the headline quantity; none is a failure, not a pass with
@@ -522,6 +530,8 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     progress.note(scene.name + ": calibrating the drive load");
     run_stage(v, "calibration", [&] { v.calibration = calibrate(scene, v.calibration_options, progress); });
   }
+  // 5b. The drive over one revolution at that cadence from both models (the report's figure).
+  run_stage(v, "drive cycle", [&] { calc_drive_cycle(scene, v); });
   // 6–7. Thresholds, then the first screen: verdicts, baselines, error budget.
   run_stage(v, "thresholds", [&] { judge_thresholds(scene, v); });
   calc_first_screen(v);

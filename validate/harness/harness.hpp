@@ -12,6 +12,7 @@
 #include "reduced/samples.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/drive.hpp"
 #include "validate/harness/compare.hpp"
 #include "validate/harness/convergence.hpp"
 #include "validate/io/progress.hpp"
@@ -80,6 +81,9 @@ struct ValidationResult {
   std::vector<std::string> dense_names;
   std::optional<CalibrationResult> calibration;
   CalibrationOptions calibration_options;
+  // The drive over one revolution at the scene's cadence (validation.calibrate) from both
+  // models (calc_drive_cycle): scenes with a cadence whose coordinate turns fully.
+  std::optional<DriveCycleComparison> drive_cycle;
   std::vector<ThresholdResult> thresholds;
   bool default_thresholds = false;  // the scene declares none: judged on thresholds_of's defaults
   bool pass = true;
@@ -112,6 +116,13 @@ void mark_stopped(RunRecord& r, const std::string& why, const std::vector<std::s
 // Stage 4 (no simulation): Pareto front, matched-error speedup, recommended setting and
 // convergence series from v.runs.
 void analyse_runs(ValidationResult& v);
+
+// Stage 5b: the drive both models need to turn one revolution at the scene's cadence
+// (validation.calibrate's cadence_Hz) with every load of the scene applied — `rdyn drive
+// --cadence-hz F` of each model on 1° rows, the reduced model from the 10° table — into
+// v.drive_cycle. Nothing when the scene declares no cadence, its coordinate is prismatic or does
+// not turn fully (a range table), or the 10° table is missing.
+void calc_drive_cycle(const models::Scene& scene, ValidationResult& v);
 
 // Stage 7 (no simulation): verdicts, baselines and error budget at the recommended setting.
 void calc_first_screen(ValidationResult& v);

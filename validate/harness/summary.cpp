@@ -93,6 +93,38 @@ nlohmann::json figures_json(const ValidationResult& v) {
   return f;
 }
 
+// The drive over one revolution from both models (validate/report/drive_figure.hpp draws it):
+// each model's RMS, peak and mean [N·m], mean and peak power [W], their differences, and the
+// curve on the 1° rows.
+nlohmann::json drive_cycle_json(const DriveCycleComparison& c) {
+  auto stats = [](const DriveStats& st, double wall_s) {
+    return nlohmann::json{{"rms_Nm", num(st.rms)},           {"peak_Nm", num(st.peak)},
+                          {"mean_Nm", num(st.mean)},         {"mean_power_W", num(st.mean_power_W)},
+                          {"peak_power_W", num(st.peak_power_W)}, {"wall_s", num(wall_s)}};
+  };
+  std::vector<std::vector<double>> cols(4);
+  for (size_t i = 0; i < c.full.t.size(); ++i) {
+    cols[0].push_back(c.full.q[i] * 180 / M_PI);
+    cols[1].push_back(c.full.t[i]);
+    cols[2].push_back(c.full.drive[i]);
+    cols[3].push_back(c.reduced.drive[i]);
+  }
+  const double peak = c.full_stats.peak;
+  return {{"cadence_hz", num(c.cadence_hz)},
+          {"q0_deg", num(c.q0 * 180 / M_PI)},
+          {"unit", "N·m"},
+          {"rows", c.full.t.size()},
+          {"full", stats(c.full_stats, c.full.wall_s)},
+          {"reduced", stats(c.reduced_stats, c.reduced.wall_s)},
+          {"peak_difference_Nm", num(c.reduced_stats.peak - c.full_stats.peak)},
+          {"rms_difference_Nm", num(c.reduced_stats.rms - c.full_stats.rms)},
+          {"mean_power_difference_W", num(c.reduced_stats.mean_power_W - c.full_stats.mean_power_W)},
+          {"max_abs_difference_Nm", num(c.max_difference)},
+          {"max_abs_difference_rel_peak", num(peak > 0 ? c.max_difference / peak : NAN)},
+          {"rms_of_difference_Nm", num(c.rms_difference)},
+          {"curve", table_json({"q_deg", "t", "drive_full_Nm", "drive_reduced_Nm"}, cols)}};
+}
+
 // The calibration result under neutral names (kCompareQuantities), with what the scene
 // compares it to.
 nlohmann::json calibration_json(const ValidationResult& v) {
@@ -270,6 +302,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
   }
   j["peers"] = peers;
   if (v.calibration) j["calibration"] = calibration_json(v);
+  if (v.drive_cycle) j["drive_cycle"] = drive_cycle_json(*v.drive_cycle);
   nlohmann::json th = nlohmann::json::array();
   for (const auto& t : v.thresholds)
     th.push_back({{"quantity", t.threshold.quantity},

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "validate/io/escape.hpp"
+#include "validate/report/drive_figure.hpp"
 #include "validate/io/output_dir.hpp"
 #include "validate/io/run_program.hpp"
 
@@ -653,6 +654,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   }
   h += " Below that floor an error measures the reference, not the table.</p>";
   if (s.contains("calibration")) h += calibration_section(s);
+  if (s.contains("drive_cycle")) h += drive_cycle_section(s.at("drive_cycle"), figures);
   if (!s.at("thresholds").empty()) {
     h += "<h2>Acceptance thresholds</h2>";
     if (s.value("thresholds_are_defaults", false))
@@ -736,6 +738,11 @@ void render_report(const json& s, const std::string& dir) {
     write_text_file(dir + "/joint_outputs.csv", table_csv(fig.at("joint_outputs")));
     write_text_file(dir + "/joint_outputs.gp", joint_outputs_gp(fig.at("joint_outputs")));
     names.push_back("joint_outputs");
+  }
+  if (s.contains("drive_cycle")) {  // validate/report/drive_figure.hpp
+    write_text_file(dir + "/drive.csv", drive_cycle_csv(s.at("drive_cycle")));
+    write_text_file(dir + "/drive.gp", drive_cycle_gp(s.at("drive_cycle")));
+    names.push_back("drive");
   }
   write_pareto(s, dir);
   write_convergence(s, dir);

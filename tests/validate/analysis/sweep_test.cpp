@@ -191,6 +191,79 @@ TEST(Sweep, NamedMotorLoadFollowsItsClosedForm) {
     }
 }
 
+// A drive sweep (--drive-cadence-hz) of a wheel whose centre of mass sits l = 0.1 m off its
+// axle, with viscous drag c, turned at a constant ω from q = 0: drive = c ω + m g l cos q, so
+// RMS² = (cω)² + (m g l)²/2, peak = c ω + m g l (the row at q = 0), mean = c ω, mean power c ω².
+// The inertia changes the mechanism (another table) but not the drive at a constant rate.
+TEST(Sweep, DriveSweepFollowsItsClosedForm) {
+  namespace fs = std::filesystem;
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_drive_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ofstream(scene) << "name: eccentric-wheel\n"
+                          "bodies: [{name: wheel, mass_kg: 2.0, com_m: [0.1, 0], inertia_kgm2: 0.05}]\n"
+                          "joints: [{name: wheel, type: revolute, parent: ground, parent_point: [0, 0], child: wheel}]\n"
+                          "independent: wheel\n"
+                          "loads:\n"
+                          "  - {type: resistance, name: drag, body: wheel, law: viscous, coefficient: 0.02}\n"
+                          "gravity: {enabled: true, g_m_s2: [0, -9.81]}\n"
+                          "initial: {q_deg: 0, qdot: 5.0}\n";
+  SweepOptions o;
+  o.scene = scene.string();
+  o.drive_cadence_hz = 1.5;
+  o.axes = {parse_sweep_axis("bodies.wheel.inertia_kgm2=0.05:0.1:2"), parse_sweep_axis("loads.drag.coefficient=0.01:0.03:3")};
+  o.threads = 2;
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_EQ(rows[0], "case,bodies.wheel.inertia_kgm2,loads.drag.coefficient,status,drive_rms_Nm,drive_peak_Nm,"
+                     "drive_mean_Nm,mean_power_w,peak_power_w,peak_constraint_force_N,error");
+  const double w = 2 * M_PI * 1.5, mgl = 2.0 * 9.81 * 0.1;
+  size_t k = 1;
+  for (int inertia = 0; inertia < 2; ++inertia)
+    for (double c : {0.01, 0.02, 0.03}) {
+      const std::string& line = rows[k++];
+      double rms = 0, peak = 0, mean = 0, power = 0, peak_power = 0;
+      ASSERT_EQ(std::sscanf(line.substr(line.find(",ok,") + 4).c_str(), "%lf,%lf,%lf,%lf,%lf", &rms, &peak, &mean,
+                            &power, &peak_power),
+                5)
+          << line;
+      // A 10° Fourier table of a constant m1 and cos q: exact to rounding; the trapezoidal
+      // rule over a whole period integrates cos² exactly.
+      EXPECT_NEAR(rms, std::sqrt(c * w * c * w + mgl * mgl / 2), 1e-8) << line;
+      EXPECT_NEAR(peak, c * w + mgl, 1e-8) << line;
+      EXPECT_NEAR(mean, c * w, 1e-8) << line;
+      EXPECT_NEAR(power, c * w * w, 1e-7) << line;
+      EXPECT_NEAR(peak_power, (c * w + mgl) * w, 1e-7) << line;
+      EXPECT_NE(line.find(",ok,"), std::string::npos);
+      EXPECT_EQ(line.back(), ',');  // no error message, no force requested: an empty field
+    }
+  // A case alone (the Python module's map) is the row the threaded sweep wrote.
+  const SweepPlan plan = plan_sweep(o);
+  EXPECT_EQ(run_sweep_case(plan, 4), rows[5]);
+  EXPECT_THROW(run_sweep_case(plan, 6), models::SceneError);
+  // A drive sweep calibrates nothing: with a calibration option it is refused before work.
+  SweepOptions both = o;
+  both.cadence_hz = 1.0;
+  try {
+    plan_sweep(both);
+    ADD_FAILURE() << "a drive sweep with --cadence-hz was accepted";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "--drive-cadence-hz") << e.what();
+  }
+}
+
+// A calibrating sweep's case alone is its row in the sweep (the Python module maps over them).
+TEST(Sweep, ACaseAloneIsItsRowInTheSweep) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.crank_length_m=0.16:0.18:2")};
+  o.threads = 1;
+  const auto rows = successful_rows(o);
+  ASSERT_EQ(rows.size(), 3u);
+  const SweepPlan plan = plan_sweep(o);
+  EXPECT_EQ(run_sweep_case(plan, 0), rows[1]);
+  EXPECT_EQ(run_sweep_case(plan, 1), rows[2]);
+}
+
 // The loops' branch checks are not in the scene hash (they only refuse an assembly): a case
 // whose check fails is an error row whatever case ran before it in the thread, never a reused
 // table of the other branch.

@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -109,6 +110,32 @@ TEST_F(SweepCli, MergeRefusesPartsThatAreNotOneWholeSweep) {
   EXPECT_EQ(two.status, 2) << two.err;
   EXPECT_NE(two.err.find("give one scene"), std::string::npos) << two.err;
   EXPECT_FALSE(fs::exists(dir / "x.csv"));
+}
+
+// --drive-cadence-hz through the binary: the drive's columns in place of the calibration's
+// (their values: tests/validate/analysis/sweep_test.cpp, tests/python), and the option refused
+// (exit 2, nothing written) when zero, out of range or beside a calibration option.
+TEST_F(SweepCli, DriveCadenceGivesTheDrivesColumns) {
+  const auto r = sweep({"--drive-cadence-hz", "1", "--out", "drive.csv"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string csv = test::slurp(dir / "drive.csv");
+  EXPECT_NE(csv.find("\ncase,bicycle_leg.crank_length_m,bicycle_leg.resistance.power_W,status,drive_rms_Nm,"
+                     "drive_peak_Nm,drive_mean_Nm,mean_power_w,peak_power_w,peak_knee_force_N,error\n"),
+            std::string::npos)
+      << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 8);  // metadata, header, six cases
+  EXPECT_EQ(csv.find(",error,"), std::string::npos) << csv;
+  for (const auto& more : std::vector<std::vector<std::string>>{{"--drive-cadence-hz", "0"},
+                                                                 {"--drive-cadence-hz", "2000"},
+                                                                 {"--drive-cadence-hz", "nan"},
+                                                                 {"--drive-cadence-hz", "1", "--cadence-hz", "1"},
+                                                                 {"--drive-cadence-hz", "1", "--power-w", "100"}}) {
+    std::vector<std::string> args = more;
+    args.insert(args.end(), {"--out", "bad.csv"});
+    const auto b = sweep(args);
+    EXPECT_EQ(b.status, 2) << more[1] << " " << b.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.csv")) << more[1];
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "models/scene_yaml.hpp"
+#include "validate/analysis/build_reduced.hpp"
 #include "tests/validate/harness/validation_fixture.hpp"
 
 namespace rdyn::validate {
@@ -47,6 +48,42 @@ TEST(Harness, TooFewSamplesFailAndClaimNoSpeedup) {
   analyse_runs(w);
   EXPECT_GE(w.matched_full, 0);
   EXPECT_FALSE(w.speedup_at_matched_error);
+}
+
+// Stage 5b on the hard parallelogram (constant m1, no losses): turned at a constant rate the
+// drive only holds gravity, k cos q, in both models; over the revolution its RMS is k/√2 and
+// its mean power 0, and the 1° rows from q0 = 30° pass q = 0, where it peaks at k.
+TEST(Harness, DriveCycleOfTheParallelogramIsItsGravityTerm) {
+  auto scene = models::load_scene(RDYN_SCENES "/hard/parallelogram.yaml");
+  ValidationResult v;
+  v.samples10 = extract_from_full(scene, 10, reduced::Method::Kinetostatic).samples;
+  calc_drive_cycle(scene, v);
+  EXPECT_FALSE(v.drive_cycle);  // the scene declares no cadence
+  scene.validation.calibrate_cadence_Hz = 0.5;
+  calc_drive_cycle(scene, v);
+  ASSERT_TRUE(v.drive_cycle);
+  const auto& c = *v.drive_cycle;
+  const double k = 9.81 * (0.5 * 0.05 + 0.7 * 0.05 + 1.2 * 0.1);
+  ASSERT_EQ(c.full.t.size(), 361u);
+  EXPECT_DOUBLE_EQ(c.full.t.back(), 2.0);  // one revolution at 0.5 rev/s
+  for (size_t i = 0; i < c.full.t.size(); ++i) {
+    EXPECT_NEAR(c.full.drive[i], k * std::cos(c.full.q[i]), 1e-6 * k) << i;
+    EXPECT_NEAR(c.reduced.drive[i], k * std::cos(c.full.q[i]), 1e-6 * k) << i;
+  }
+  for (const auto* st : {&c.full_stats, &c.reduced_stats}) {
+    EXPECT_NEAR(st->rms, k / std::sqrt(2.0), 1e-6 * k);
+    EXPECT_NEAR(st->peak, k, 1e-6 * k);
+    EXPECT_NEAR(st->mean_power_W, 0.0, 1e-6 * k);
+  }
+  EXPECT_LT(c.max_difference, 2e-6 * k);
+  EXPECT_LE(c.rms_difference, c.max_difference);
+  // No cycle to drive without a full turn: a prismatic coordinate gets none.
+  ValidationResult w;
+  auto slider = models::load_scene("slider-crank-slider");
+  slider.validation.calibrate_cadence_Hz = 1.0;
+  w.samples10 = v.samples10;
+  calc_drive_cycle(slider, w);
+  EXPECT_FALSE(w.drive_cycle);
 }
 
 TEST(Harness, AnalysisAndFirstScreenFromRecords) {

@@ -70,6 +70,41 @@ TEST(Summary, CalibrationUnderNeutralNamesWithTheScenesComparison) {
   EXPECT_FALSE(cal.contains("hip_torque_Nm"));
 }
 
+// The drive cycle's record: each model's statistics, reduced − full differences, the curve in
+// degrees (a record the report re-draws from alone).
+TEST(Summary, DriveCycleRecordHoldsBothModelsAndTheirDifference) {
+  auto v = test::synthetic_validation();
+  DriveCycleComparison c;
+  c.cadence_hz = 1.0;
+  c.q0 = M_PI / 2;
+  for (int i = 0; i <= 4; ++i) {
+    c.full.t.push_back(0.25 * i), c.full.q.push_back(M_PI / 2 + i * M_PI / 2);
+    c.full.drive.push_back(10.0 + i);
+  }
+  c.reduced = c.full;
+  c.reduced.drive = {10.5, 11, 12, 13, 14};
+  c.full_stats.rms = 12.0, c.full_stats.peak = 14.0, c.full_stats.mean_power_W = 75.0;
+  c.reduced_stats.rms = 12.1, c.reduced_stats.peak = 14.0, c.reduced_stats.mean_power_W = 76.0;
+  c.max_difference = 0.5;
+  c.rms_difference = 0.2;
+  v.drive_cycle = c;
+  const auto s = summary_json(v);
+  expect_finite(s);
+  const auto& d = s["drive_cycle"];
+  EXPECT_DOUBLE_EQ(d["q0_deg"].get<double>(), 90.0);
+  EXPECT_DOUBLE_EQ(d["full"]["rms_Nm"].get<double>(), 12.0);
+  EXPECT_DOUBLE_EQ(d["reduced"]["rms_Nm"].get<double>(), 12.1);
+  EXPECT_NEAR(d["rms_difference_Nm"].get<double>(), 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(d["peak_difference_Nm"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(d["mean_power_difference_W"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(d["max_abs_difference_rel_peak"].get<double>(), 0.5 / 14.0);
+  ASSERT_EQ(d["curve"]["rows"].size(), 5u);
+  EXPECT_EQ(d["curve"]["names"][3], "drive_reduced_Nm");
+  EXPECT_DOUBLE_EQ(d["curve"]["rows"][4][0].get<double>(), 450.0);  // q [deg]
+  EXPECT_DOUBLE_EQ(d["curve"]["rows"][0][3].get<double>(), 10.5);
+  EXPECT_FALSE(summary_json(test::synthetic_validation()).contains("drive_cycle"));
+}
+
 // The comparison lives in the scene (validation.compare), read with file, line and field.
 TEST(Summary, SceneDeclaresItsComparison) {
   const auto bicycle = models::load_scene("bicycle");
