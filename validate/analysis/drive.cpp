@@ -181,9 +181,17 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
                                                "budget of {:g} s",
                                                motion.t[i], kDriveMaxWall_s));
     follow(motion.q[i]);
-    auto k = inverse(motion.q[i], i);
-    std::vector<double> cols = joint_outputs ? engine::calc_joint_output_row(model, ws) : std::vector<double>{};
-    if (engine::calc_loop_conditioning(model, ws) < engine::kSingularConditioning) {
+    // At a singular configuration the velocity projection itself may fail (a profile starting on
+    // an isosceles slider-crank's folded position): nothing is asked of the model there but the
+    // limits below.
+    const bool singular = engine::calc_loop_conditioning(model, ws) < engine::kSingularConditioning;
+    engine::KinetostaticResult k;
+    std::vector<double> cols;
+    if (!singular) {
+      k = inverse(motion.q[i], i);
+      if (joint_outputs) cols = engine::calc_joint_output_row(model, ws);
+    }
+    if (singular) {
       // At a singular configuration the constraint forces (and with them T_act) are a
       // least-squares split of no branch (a parallelogram's drive came out 0.31 k for k): the
       // limit along the branch from both sides, as the extraction's singular samples
@@ -197,6 +205,8 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
         if (joint_outputs) side_cols.push_back(engine::calc_joint_output_row(model, ws));
       }
       auto limit = [](double m1, double m2, double p2, double p1) { return (2 * (m2 + p2) - 0.5 * (m1 + p1)) / 3; };
+      k = side[0];
+      if (joint_outputs) cols.assign(side_cols[0].size(), 0.0);
       for (size_t c = 0; c < cols.size(); ++c)
         cols[c] = limit(side_cols[0][c], side_cols[1][c], side_cols[2][c], side_cols[3][c]);
       k.driving_force = limit(side[0].driving_force, side[1].driving_force, side[2].driving_force,

@@ -122,6 +122,31 @@ TEST(Drive, FullModelAtASingularRowTakesTheBranchLimit) {
 
 // The bicycle with its hip torque gate, brake and knee force: full inverse dynamics against the
 // 5° table's inverse Eksergian equation, both ways through the gate switches.
+TEST(Drive, AProfileStartingOnTheSingularConfigurationTakesItsLimitThere) {
+  // The isosceles slider-crank driven from its slider, q(t) = 0.1 sin(πt) m: it starts on the
+  // folded position (rank loss at q = 0), where the velocity projection itself fails. There the
+  // drive is its limit, 0 by symmetry: q̈(0) = 0 (the natural spline), the centering spring at its
+  // rest length, and m2 = ½ dm1/dq = 0 at the symmetric configuration. It was an EngineError in
+  // Simbody's words.
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_drive_singular_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream p(dir / "p.csv");
+    p << "t,q_m\n";
+    for (int i = 0; i <= 100; ++i) p << fmt::format("{},{:.17g}\n", 0.01 * i, 0.1 * std::sin(M_PI * 0.01 * i));
+  }
+  const auto scene = models::load_scene(RDYN_SOURCE_DIR "/tests/validate/scenes/iso-slider-crank.yaml");
+  const auto motion = profile_motion((dir / "p.csv").string(), false, 1.0, 0.01);
+  const auto full = calc_drive_full(scene, motion);
+  ASSERT_EQ(full.drive.size(), motion.t.size());
+  double peak = 0.0;
+  for (double d : full.drive) peak = std::max(peak, std::abs(d));
+  EXPECT_GT(peak, 10.0);
+  EXPECT_LT(std::abs(full.drive[0]), 1e-7 * peak) << full.drive[0];
+  for (double f : full.forces[0]) EXPECT_TRUE(std::isfinite(f));
+  fs::remove_all(dir);
+}
+
 TEST(Drive, BicycleFullAndReducedAgree) {
   const auto scene = models::load_scene("bicycle");
   const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI * 1.0, 1.0, 0.002);
