@@ -678,7 +678,8 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
 
   // Both strategies, each from its own calibrated scene: curves over the angle and the full model.
   progress.note("optimize: full model, constant strategy");
-  const auto c0 = calc_strategy(w, bounded, x0, e0, opt, "constant").first;
+  auto [c0, scene0] = calc_strategy(w, bounded, x0, e0, opt, "constant");
+  r.constant_scene = std::move(scene0);
   progress.note("optimize: full model, optimised strategy");
   auto [c1, scene1] = calc_strategy(w, bounded, x, best, opt, "optimised");
   r.constant = c0;
