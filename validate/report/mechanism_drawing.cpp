@@ -16,7 +16,8 @@ namespace rdyn::validate {
 namespace {
 
 constexpr double kSame_m = models::kSamePoint_m;  // two attachments closer than this are one drawn point
-constexpr double kLabelGap = 0.015;  // an arrow's label beyond its head, × the drawing's size
+constexpr double kLabelGap = 0.015;     // an arrow's label beyond its head, × the drawing's size
+constexpr double kFontFraction = 0.03;  // labels' font size, × the drawing's size
 
 int find_point(const std::vector<DrawPoint>& pts, const std::string& body, models::Vec2 p) {
   for (size_t i = 0; i < pts.size(); ++i)
@@ -74,7 +75,8 @@ struct Layout {
   double arrow_m_per_N = 0;
 };
 
-Layout calc_layout(const std::vector<std::vector<double>>& P, const std::vector<ForceArrow>& arrows) {
+Layout calc_layout(const std::vector<DrawPoint>& pts, const std::vector<std::vector<double>>& P,
+                   const std::vector<ForceArrow>& arrows) {
   Layout L;
   bool first = true;
   for (const auto& row : P)
@@ -89,6 +91,20 @@ Layout calc_layout(const std::vector<std::vector<double>>& P, const std::vector<
     for (size_t k = 0; k < a.fx_N.size(); ++k) fmax = std::max(fmax, std::hypot(a.fx_N[k], a.fy_N[k]));
   // The largest force of the run is drawn a quarter of the mechanism's size long.
   L.arrow_m_per_N = fmax > 0 ? 0.25 * L.size / fmax : 0.0;
+  // Room for every arrow and its label over the run (placed as svg_body places them; a label's
+  // width estimated at 0.6 em per character of "name 1234.5 N"), so none leaves the drawing.
+  const double font = kFontFraction * L.size, gap = kLabelGap * L.size;
+  for (const auto& a : arrows) {
+    const int i = point_of(pts, a.body, a.point);
+    const double w = 0.6 * font * static_cast<double>(a.name.size() + 9);
+    for (size_t k = 0; k < a.fx_N.size() && k < P.size(); ++k) {
+      const double fx = a.fx_N[k], fy = a.fy_N[k], fn = std::hypot(fx, fy);
+      double x = P[k][2 * i] + L.arrow_m_per_N * fx, y = P[k][2 * i + 1] + L.arrow_m_per_N * fy;
+      if (fn > 0) x += gap * fx / fn, y += gap * fy / fn;
+      L.minx = std::min(L.minx, fx < 0 ? x - w : x), L.maxx = std::max(L.maxx, fx < 0 ? x : x + w);
+      L.miny = std::min(L.miny, fy < 0 ? y - font : y), L.maxy = std::max(L.maxy, fy < 0 ? y : y + font);
+    }
+  }
   return L;
 }
 
@@ -200,13 +216,14 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
     o += fmt::format("<line data-arrow=\"{}\" data-i=\"{}\" data-fx=\"{}\" data-fy=\"{}\" x1=\"{}\" y1=\"{}\" x2=\"{}\" "
                      "y2=\"{}\" marker-end=\"url(#head)\"/>\n",
                      a, i, num(fx), num(fy), num(X(i)), num(-Y(i)), num(x2), num(-y2));
-    // The label just beyond the arrow's head, on the side it points to, so the head does not hide it.
+    // The label just beyond the arrow's head, on the side it points to (left or right, below or
+    // above), so the head does not hide it.
     const double fn = std::hypot(fx, fy), gap = kLabelGap * L.size;
     const double lx = x2 + (fn > 0 ? gap * fx / fn : 0.0), ly = y2 + (fn > 0 ? gap * fy / fn : 0.0);
     o += fmt::format("<text data-arrow-label=\"{}\" data-name=\"{}\" x=\"{}\" y=\"{}\" text-anchor=\"{}\" "
-                     "font-size=\"{}\" stroke=\"none\">{} {:.1f} N</text>\n",
-                     a, html_escape(A.name), num(lx), num(-ly), fx < 0 ? "end" : "start", num(0.03 * L.size),
-                     html_escape(A.name), fn);
+                     "dominant-baseline=\"{}\" font-size=\"{}\" stroke=\"none\">{} {:.1f} N</text>\n",
+                     a, html_escape(A.name), num(lx), num(-ly), fx < 0 ? "end" : "start", fy < 0 ? "hanging" : "auto",
+                     num(kFontFraction * L.size), html_escape(A.name), fn);
   }
   o += "</g>\n";
   return o;
@@ -318,9 +335,9 @@ std::string mechanism_svg(const models::Scene& s, const MechanismFrames& f, size
   if (frame >= f.t_s.size()) throw std::invalid_argument("mechanism drawing: no such frame");
   const auto pts = collect_draw_points(s);
   const auto P = calc_positions(s, pts, f);
-  const Layout L = calc_layout(P, f.arrows);
+  const Layout L = calc_layout(pts, P, f.arrows);
   std::string o = svg_body(s, f, pts, P, L, frame);
-  const double fs = 0.03 * L.size;
+  const double fs = kFontFraction * L.size;
   o += fmt::format("<text class=\"q\" x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>\n", num(L.minx - 0.1 * L.size),
                    num(-L.miny + 0.06 * L.size), num(fs), html_escape(q_text(s, f.q[frame])));
   if (!note.empty())
@@ -334,7 +351,7 @@ std::string animation_section(const models::Scene& s, const MechanismFrames& f, 
   check_frames(s, f);
   const auto pts = collect_draw_points(s);
   const auto P = calc_positions(s, pts, f);
-  const Layout L = calc_layout(P, f.arrows);
+  const Layout L = calc_layout(pts, P, f.arrows);
   nlohmann::json J;
   J["t"] = f.t_s;
   J["p"] = P;
@@ -394,7 +411,7 @@ function show(i) {
       set(e, "data-fx", fx); set(e, "data-fy", fy);
       const l = svg.querySelector('[data-arrow-label="' + a + '"]'), fn = Math.hypot(fx, fy);
       set(l, "x", x2 + (fn > 0 ? F.gap * fx / fn : 0)); set(l, "y", -(y2 + (fn > 0 ? F.gap * fy / fn : 0)));
-      set(l, "text-anchor", fx < 0 ? "end" : "start");
+      set(l, "text-anchor", fx < 0 ? "end" : "start"); set(l, "dominant-baseline", fy < 0 ? "hanging" : "auto");
       l.textContent = F.names[a] + " " + Math.hypot(fx, fy).toFixed(1) + " N";
       continue;
     }
