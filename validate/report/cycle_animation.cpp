@@ -81,7 +81,8 @@ std::string strategies_animation_html(const nlohmann::json& summary) {
   if (!summary.contains("animations")) return "";
   const auto& an = summary.at("animations");
   return "<h2>The two strategies over one steady cycle</h2><p>Each strategy's full model (Simbody) from its steady "
-         "point, over one period at its full-model cadence; the arrows are the optimised constraint force. "
+         "point, over one period at its full-model cadence; the arrows are the scene's requested constraint "
+         "forces. "
          "<code>report.html#t=T</code> shows the frame nearest T in both.</p>\n"
          "<div class=\"strategies\" style=\"display:flex;gap:1em;flex-wrap:wrap\">"
          "<div data-strategy=\"constant\" style=\"flex:1 1 420px;min-width:0\">" +
