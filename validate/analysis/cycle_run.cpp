@@ -26,7 +26,7 @@ CycleStart calc_last_cycle(const models::TimeSeries& run, double fallback_s) {
   size_t r = static_cast<size_t>(std::lower_bound(run.t.begin(), run.t.end(), t0 - 1e-12) - run.t.begin());
   r = std::min(r, n - 2);
   if (crossings.size() < 2) duration = run.t.back() - run.t[r];
-  return {run.t[r], run.q[r], run.qdot[r], duration};
+  return {run.t[r], run.q[r], run.qdot[r], duration, crossings.size() >= 2};
 }
 
 models::TimeSeries simulate_cycle(const models::Scene& scene, const CycleStart& c, int intervals) {

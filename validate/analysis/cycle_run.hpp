@@ -21,13 +21,14 @@ struct CycleStart {
   double q = 0.0;           // the independent coordinate there [rad or m]
   double qdot = 0.0;        // its rate there [rad/s or m/s]
   double duration_s = 0.0;  // one cycle [s], > 0
+  bool revolution = true;   // a whole revolution of the independent coordinate (else a stretch of time)
 };
 
 // The last whole revolution of `run` (crossings of q(0) ± 2πk, analysis/confirm_full.hpp's
 // calc_revolution_times in the direction q moved): it starts at the first output row at or
 // after the second-last crossing (a state of the run, exactly) and lasts as long as the time
 // between the last two crossings. A run with fewer than two crossings (a rocker, a slider, a
-// transient) gives its last `fallback_s` (the whole run when it is shorter). Throws
+// transient) gives its last `fallback_s` (the whole run when it is shorter; revolution false). Throws
 // std::invalid_argument for a run with fewer than two rows or a fallback that is not > 0.
 CycleStart calc_last_cycle(const models::TimeSeries& run, double fallback_s);
 

@@ -19,7 +19,12 @@ nlohmann::json animation_record(const models::Scene& scene, const CycleStart& st
                       {"fy_N", a.fy_N}});
   return {{"title", title},
           {"scene_yaml", models::scene_to_yaml(scene)},
-          {"start", {{"t_s", start.t_s}, {"q", start.q}, {"qdot", start.qdot}, {"duration_s", start.duration_s}}},
+          {"start",
+           {{"t_s", start.t_s},
+            {"q", start.q},
+            {"qdot", start.qdot},
+            {"duration_s", start.duration_s},
+            {"revolution", start.revolution}}},
           {"frames",
            {{"t_s", f.t_s}, {"q", f.q}, {"q_joint", f.q_joint}, {"arrows", arrows}, {"traces", f.traces}}}};
 }
@@ -30,7 +35,7 @@ AnimationRecord read_animation_record(const nlohmann::json& r) {
   a.scene = models::parse_scene(r.at("scene_yaml").get<std::string>(), "summary.json (animation)");
   const auto& st = r.at("start");
   a.start = {st.at("t_s").get<double>(), st.at("q").get<double>(), st.at("qdot").get<double>(),
-             st.at("duration_s").get<double>()};
+             st.at("duration_s").get<double>(), st.value("revolution", true)};
   const auto& f = r.at("frames");
   a.frames.t_s = f.at("t_s").get<std::vector<double>>();
   a.frames.q = f.at("q").get<std::vector<double>>();
@@ -64,16 +69,23 @@ std::string mechanism_drawing_html(const nlohmann::json& summary) {
 
 std::string validate_animation_html(const nlohmann::json& summary) {
   if (summary.contains("animation_error") && summary.at("animation_error").is_string())
-    return "<h2>The mechanism over one steady cycle</h2><p class=warn>Not animated: " +
+    return "<h2>The mechanism in motion</h2><p class=warn>Not animated: " +
            html_escape(summary.at("animation_error").get<std::string>()) + "</p>\n";
   if (!summary.contains("animation")) return "";
   const auto& st = summary.at("animation").at("start");
-  return fmt::format(
-             "<h2>The mechanism over one steady cycle</h2><p>The reference's last whole revolution (a coordinate "
-             "that does not turn: its last period), from t = {:.4g} s for {:.4g} s: the full model (Simbody) "
-             "restarted from the reference's state there, every position placed from the joint coordinates it "
-             "outputs. <code>report.html#t=T</code> shows the frame nearest T.</p>\n",
-             st.at("t_s").get<double>(), st.at("duration_s").get<double>()) +
+  const double t0 = st.at("t_s").get<double>(), d = st.at("duration_s").get<double>();
+  // A coordinate that does not turn (a rocker, a slider) has no cycles to speak of: its last stretch.
+  const std::string head =
+      st.value("revolution", true)
+          ? fmt::format("<h2>The mechanism over one steady cycle</h2><p>The reference's last whole revolution, "
+                        "from t = {:.4g} s for {:.4g} s",
+                        t0, d)
+          : fmt::format("<h2>The mechanism over the end of the run</h2><p>The reference's last {:.4g} s (the "
+                        "scene's time scale), from t = {:.4g} s",
+                        d, t0);
+  return head +
+         ": the full model (Simbody) restarted from the reference's state there, every position placed from the "
+         "joint coordinates it outputs. <code>report.html#t=T</code> shows the frame nearest T.</p>\n" +
          animation_record_html(summary.at("animation"));
 }
 

@@ -38,6 +38,7 @@ TEST(CycleRun, LastWholeRevolutionOfAUniformTurn) {
     EXPECT_NEAR(c.t_s, 3.85, 1e-12) << sign;
     EXPECT_EQ(c.q, ts.q[385]);
     EXPECT_EQ(c.qdot, ts.qdot[385]);
+    EXPECT_TRUE(c.revolution);
   }
 }
 
@@ -48,6 +49,7 @@ TEST(CycleRun, ARockingCoordinateGivesTheRunsLastPeriod) {
   EXPECT_NEAR(c.t_s, 2.5, 1e-12);
   EXPECT_NEAR(c.duration_s, 1.5, 1e-12);
   EXPECT_EQ(c.q, ts.q[250]);
+  EXPECT_FALSE(c.revolution);
   const CycleStart whole = calc_last_cycle(ts, 10.0);
   EXPECT_EQ(whole.t_s, 0.0);
   EXPECT_NEAR(whole.duration_s, 4.0, 1e-12);

@@ -103,5 +103,18 @@ TEST(CycleAnimation, OptimizeSectionHoldsBothStrategies) {
   EXPECT_LT(o, html.find("<h3>optimised</h3>"));
 }
 
+// The validate report's words follow the record: a whole revolution is "one steady cycle"; the
+// last stretch of a coordinate that does not turn says neither "cycle" nor "revolution".
+TEST(CycleAnimation, ValidateSectionSaysCycleOnlyForARevolution) {
+  nlohmann::json summary;
+  summary["animation"] = fourbar_record("t");
+  EXPECT_NE(validate_animation_html(summary).find("<h2>The mechanism over one steady cycle</h2>"), std::string::npos);
+  summary["animation"]["start"]["revolution"] = false;
+  const std::string html = validate_animation_html(summary);
+  EXPECT_NE(html.find("<h2>The mechanism over the end of the run</h2>"), std::string::npos);
+  EXPECT_EQ(html.find("cycle"), std::string::npos);
+  EXPECT_EQ(html.find("revolution"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
