@@ -321,6 +321,7 @@ MujocoModel::MujocoModel(const models::Scene& scene, const std::vector<double>& 
   models::MjcfOptions mo;
   mo.reference_q = initial_q;
   mo.fold_geared_bodies = true;
+  mo.visual_geoms = false;  // nothing to draw in timed runs
   mo.timestep_s = settings.timestep_s;
   mo.integrator = settings.integrator == "rk4" ? "RK4" : "Euler";
   mo.timeconst_s = settings.timeconst_s;

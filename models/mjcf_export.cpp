@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+
+#include "models/pose.hpp"
 
 namespace rdyn::models {
 
@@ -80,6 +83,8 @@ class Writer {
     out_ += fmt::format("  <default>\n    <equality solref=\"{} {}\" solimp=\"{} {} 0.001\"/>\n  </default>\n",
                         num(timeconst), num(o_.dampratio), num(o_.impedance), num(o_.impedance));
     out_ += "  <worldbody>\n";
+    if (o_.visual_geoms)
+      for (const auto& p : calc_body_points(s_, kGround)) out_ += "    " + sphere(p) + "\n";
     children_of(kGround, 2);
     out_ += "  </worldbody>\n";
     equalities();
@@ -178,9 +183,44 @@ class Writer {
       const double Izz = body.inertia_kgm2 + extra_Izz_[b];
       out_ += fmt::format("{}  <inertial pos=\"{}\" mass=\"{}\" diaginertia=\"{} {} {}\"/>\n", pad, vec3(body.com_m),
                           num(body.mass_kg), num(Izz / 2), num(Izz / 2), num(Izz));
+      if (o_.visual_geoms) capsules(body, pad + "  ");
       children_of(body.name, depth + 1);
       out_ += pad + "</body>\n";
     }
+  }
+
+  // Visual geoms (MjcfOptions::visual_geoms): one capsule per side of the body's outline (a bar:
+  // one; a polygon: closed), a sphere for a body with a single point; in the body frame, which
+  // is the scene body's frame (pos/quat above). Radius: geom_radius_, a fixed fraction of the
+  // mechanism's size.
+  void capsules(const Body& body, const std::string& pad) {
+    const auto pts = calc_body_outline(s_, body.name);
+    const size_t n = pts.size();
+    int drawn = 0;
+    for (size_t i = 0; n >= 2 && i < (n == 2 ? 1 : n); ++i) {
+      const Vec2 a = pts[i], b = pts[(i + 1) % n];
+      if (std::hypot(b.x - a.x, b.y - a.y) < kMinCapsule_m) continue;  // MuJoCo refuses a zero-length fromto
+      ++drawn;
+      out_ += fmt::format("{}<geom type=\"capsule\" fromto=\"{} {}\" size=\"{}\" contype=\"0\" conaffinity=\"0\" "
+                          "rgba=\"0.36 0.68 0.89 1\"/>\n",
+                          pad, vec3(a), vec3(b), num(geom_radius()));
+    }
+    if (drawn == 0) out_ += pad + sphere(n >= 1 ? pts[0] : body.com_m) + "\n";
+  }
+  static constexpr double kMinCapsule_m = 1e-9;
+  std::string sphere(Vec2 p) const {
+    return fmt::format("<geom type=\"sphere\" pos=\"{}\" size=\"{}\" contype=\"0\" conaffinity=\"0\" "
+                       "rgba=\"0.5 0.5 0.5 1\"/>",
+                       vec3(p), num(1.5 * geom_radius()));
+  }
+  // 1.5 % of the largest distance of a body or ground point from its frame's origin (at least
+  // 1 mm): thin bars at any scale.
+  double geom_radius() const {
+    double r = 1e-3;
+    for (const auto& b : s_.bodies)
+      for (const auto& p : calc_body_points(s_, b.name)) r = std::max(r, std::hypot(p.x, p.y));
+    for (const auto& p : calc_body_points(s_, kGround)) r = std::max(r, std::hypot(p.x, p.y));
+    return 0.015 * r;
   }
 
   void equalities() {

@@ -1,6 +1,6 @@
 // A scene as MJCF, MuJoCo's XML model format: the same planar mechanism for a peer engine.
 // Pure text generation from the scene (no MuJoCo here): bodies with mass, centre of mass and
-// inertia, hinges (axis z) and slides for the tree joints, loop closures as `connect`
+// inertia, visual capsules along their outlines, hinges (axis z) and slides for the tree joints, loop closures as `connect`
 // equalities, gears as `joint` equalities, gravity. MJCF cannot express rdyn's loads (rate-
 // gated joint torques, resistance laws, motor lines, point-to-point springs): a comment lists
 // them, and engine/mujoco_peer.cpp applies them at every evaluation.
@@ -31,6 +31,12 @@ struct MjcfOptions {
   double timeconst_s = 0.0;
   double dampratio = 1.0;
   double impedance = 0.9999;  // dmin = dmax, in (0, 1)
+  // What MuJoCo's viewer shows: capsules along every body's outline (models::calc_body_outline,
+  // the drawing's bars and polygons; a sphere for a body with one point) and a sphere at every
+  // ground attachment. Visual only: contype = conaffinity = 0 and the inertia is the <inertial>
+  // (inertiafromgeom="false"), so the dynamics are the same without them. The MuJoCo peer
+  // leaves them out (no geometry to update in its timed runs).
+  bool visual_geoms = true;
 };
 
 // The MJCF document. Throws SceneError for a body named "world" (MJCF's ground) and for options

@@ -1,7 +1,9 @@
 #include "models/pose.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace rdyn::models {
 
@@ -60,6 +62,35 @@ Vec2 calc_ground_point(const Scene& s, const Pose& pose, const std::string& body
   const BodyPose& B = pose.bodies[b];
   const double c = std::cos(B.angle_rad), si = std::sin(B.angle_rad);
   return Vec2{B.x_m + c * p.x - si * p.y, B.y_m + si * p.x + c * p.y};
+}
+
+std::vector<Vec2> calc_body_points(const Scene& s, const std::string& body) {
+  std::vector<Vec2> pts;
+  auto add = [&](const std::string& b, Vec2 p) {
+    if (b != body) return;
+    for (const auto& q : pts)
+      if (std::abs(q.x - p.x) < kSamePoint_m && std::abs(q.y - p.y) < kSamePoint_m) return;
+    pts.push_back(p);
+  };
+  if (const Body* b = s.find_body(body))
+    for (const auto& [name, p] : b->points) add(body, p);
+  for (const auto& j : s.joints) add(j.parent, j.parent_point), add(j.child, j.child_point);
+  for (const auto& l : s.loops) add(l.body_a, l.point_a), add(l.body_b, l.point_b);
+  for (const auto& sp : s.springs) add(sp.body_a, sp.point_a), add(sp.body_b, sp.point_b);
+  for (const auto& pf : s.point_forces) add(pf.body_a, pf.point_a), add(pf.body_b, pf.point_b);
+  return pts;
+}
+
+std::vector<Vec2> calc_body_outline(const Scene& s, const std::string& body) {
+  std::vector<Vec2> pts = calc_body_points(s, body);
+  if (pts.empty()) return pts;
+  double cx = 0, cy = 0;
+  for (const auto& p : pts) cx += p.x, cy += p.y;
+  cx /= static_cast<double>(pts.size()), cy /= static_cast<double>(pts.size());
+  std::stable_sort(pts.begin(), pts.end(), [&](const Vec2& a, const Vec2& b) {
+    return std::atan2(a.y - cy, a.x - cx) < std::atan2(b.y - cy, b.x - cx);
+  });
+  return pts;
 }
 
 }  // namespace rdyn::models

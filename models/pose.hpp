@@ -32,4 +32,18 @@ Pose calc_pose(const Scene& scene, const std::vector<double>& q_joint);
 // Point p_B (in body `body`'s frame; ground: ground frame) in the ground frame.
 Vec2 calc_ground_point(const Scene& scene, const Pose& pose, const std::string& body, Vec2 p_B);
 
+// Two attachments of one body closer than this are one point [m].
+inline constexpr double kSamePoint_m = 1e-12;
+
+// The points body `body` carries, in its own frame (ground: the ground frame): its named points
+// (name order), then the attachments of joints (parent point, child point), loops, springs and
+// point forces in scene order, each once (kSamePoint_m). Ground has no named points here.
+std::vector<Vec2> calc_body_points(const Scene& scene, const std::string& body);
+
+// Those points in outline order — by angle about their centroid in the body frame, hence the
+// same in every pose — so that the polygon through them does not cross itself (a bar for two
+// points). What the drawings (validate/report/mechanism_drawing.cpp) and the MJCF export's
+// visual capsules (models/mjcf_export.cpp) draw a body as.
+std::vector<Vec2> calc_body_outline(const Scene& scene, const std::string& body);
+
 }  // namespace rdyn::models

@@ -6,12 +6,21 @@
 #include <expat.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <fstream>
 #include <sstream>
 
+#include "models/pose.hpp"
 #include "models/scene_yaml.hpp"
+
+#ifdef RDYN_HAVE_MUJOCO
+#include <mujoco/mujoco.h>
+#endif
 
 namespace rdyn::models {
 namespace {
@@ -179,6 +188,170 @@ TEST(MjcfExport, BodiesArePlacedSoJointsAndClosedLoopsCoincide) {
     }
   }
 }
+
+// The visual capsules of the four-bar (models/scenes/fourbar.yaml): each body is a bar between
+// its two joint points, written out here from the scene file, so one capsule per body, as long
+// as the bar, ending on those points; visual only (no contact).
+TEST(MjcfExport, FourbarBodiesCarryOneCapsuleAlongEachBar) {
+  const Scene s = load_scene("fourbar");
+  const Parsed p = parse(export_mjcf(s, {}));
+  ASSERT_TRUE(p.ok) << p.error;
+  std::map<std::string, std::vector<std::vector<double>>> fromto;  // body → its capsules' fromto
+  for (const auto& e : p.elements) {
+    if (e.tag != "geom" || e.attr.at("type") != "capsule") continue;
+    EXPECT_EQ(e.attr.at("contype"), "0");
+    EXPECT_EQ(e.attr.at("conaffinity"), "0");
+    EXPECT_EQ(e.attr.count("mass"), 0u);
+    fromto[p.elements[e.parent].attr.at("name")].push_back(numbers(e.attr.at("fromto")));
+  }
+  ASSERT_EQ(fromto.size(), 3u);
+  // Each bar from its frame origin (the joint to its parent) to the far joint, along x.
+  for (const auto& [body, length] : {std::pair<std::string, double>{"crank", 0.08}, {"coupler", 0.28}, {"rocker", 0.20}}) {
+    ASSERT_EQ(fromto[body].size(), 1u) << body;
+    const auto& c = fromto[body][0];
+    ASSERT_EQ(c.size(), 6u);
+    EXPECT_NEAR(std::hypot(c[3] - c[0], c[4] - c[1]), length, 1e-15) << body;
+    EXPECT_EQ(std::min(std::hypot(c[0], c[1]), std::hypot(c[3], c[4])), 0.0) << body << ": one end at the origin";
+    EXPECT_EQ(c[2], 0.0);
+    EXPECT_EQ(c[5], 0.0);
+  }
+  // Ground: a sphere at each pivot (A, D), in the world body.
+  int ground_spheres = 0;
+  for (const auto& e : p.elements)
+    ground_spheres += e.tag == "geom" && e.attr.at("type") == "sphere" && p.elements[e.parent].tag == "worldbody";
+  EXPECT_EQ(ground_spheres, 2);
+  // Without visual geoms: none at all.
+  MjcfOptions bare;
+  bare.visual_geoms = false;
+  EXPECT_EQ(count(parse(export_mjcf(s, bare)), "geom"), 0);
+}
+
+// Every shipped scene: a body with n ≥ 3 distinct points gets n capsules (its closed outline), a
+// bar 1, and together their ends are exactly the points the body carries — its named points and
+// every joint, loop, spring and point-force attachment on it, listed here from the scene.
+TEST(MjcfExport, EveryBodysCapsulesEndOnEveryPointItCarries) {
+  for (const auto& path : shipped_scenes()) {
+    const Scene s = load_scene(path.string());
+    const Parsed p = parse(export_mjcf(s, {}));
+    ASSERT_TRUE(p.ok) << path << ": " << p.error;
+    for (const auto& b : s.bodies) {
+      std::vector<Vec2> carried;
+      auto carry = [&](const std::string& body, Vec2 pt) {
+        if (body != b.name) return;
+        for (const auto& c : carried)
+          if (std::hypot(c.x - pt.x, c.y - pt.y) < 1e-12) return;
+        carried.push_back(pt);
+      };
+      for (const auto& [n, pt] : b.points) carry(b.name, pt);
+      for (const auto& j : s.joints) carry(j.parent, j.parent_point), carry(j.child, j.child_point);
+      for (const auto& l : s.loops) carry(l.body_a, l.point_a), carry(l.body_b, l.point_b);
+      for (const auto& sp : s.springs) carry(sp.body_a, sp.point_a), carry(sp.body_b, sp.point_b);
+      for (const auto& pf : s.point_forces) carry(pf.body_a, pf.point_a), carry(pf.body_b, pf.point_b);
+      std::vector<Vec2> ends;
+      int capsules = 0, spheres = 0;
+      for (const auto& e : p.elements) {
+        if (e.tag != "geom" || p.elements[e.parent].attr.count("name") == 0 ||
+            p.elements[e.parent].attr.at("name") != b.name)
+          continue;
+        EXPECT_EQ(e.attr.at("contype"), "0") << path;
+        if (e.attr.at("type") == "sphere") {
+          ++spheres;
+          continue;
+        }
+        ++capsules;
+        const auto c = numbers(e.attr.at("fromto"));
+        ends.push_back({c[0], c[1]}), ends.push_back({c[3], c[4]});
+      }
+      const size_t n = carried.size();
+      if (n < 2) {
+        EXPECT_EQ(capsules, 0) << path << " " << b.name;
+        EXPECT_EQ(spheres, 1) << path << " " << b.name;
+        continue;
+      }
+      EXPECT_EQ(capsules, n == 2 ? 1 : static_cast<int>(n)) << path << " " << b.name;
+      EXPECT_EQ(spheres, 0) << path << " " << b.name;
+      // Each carried point ends two capsules of a polygon (one of a bar), and every end is a carried point.
+      for (const auto& c : carried) {
+        int at = 0;
+        for (const auto& e : ends) at += e.x == c.x && e.y == c.y;
+        EXPECT_EQ(at, n == 2 ? 1 : 2) << path << " " << b.name << " point " << c.x << ", " << c.y;
+      }
+      EXPECT_EQ(ends.size(), n == 2 ? 2u : 2 * n);
+    }
+  }
+}
+
+#ifdef RDYN_HAVE_MUJOCO
+// MuJoCo's own reading of the export: loaded with and without the visual geoms, the bodies'
+// masses, inertias and their frames are identical (the geoms add no mass: inertiafromgeom is
+// false), no geom takes part in contacts, and at qpos0 (the reference coordinates) MuJoCo's
+// kinematics puts every capsule's ends on the body's points where models::calc_pose puts them.
+struct MjModelPtr {
+  mjModel* m = nullptr;
+  ~MjModelPtr() { if (m) mj_deleteModel(m); }
+};
+
+mjModel* load_mjcf(const std::string& xml, const std::string& name) {
+  const auto path = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".xml");
+  { std::ofstream(path) << xml; }
+  char err[1000] = "";
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof err);
+  std::filesystem::remove(path);
+  EXPECT_NE(m, nullptr) << name << ": " << err;
+  return m;
+}
+
+TEST(MjcfExport, MujocoLoadsTheCapsulesWithoutChangingMassOrInertia) {
+  for (const auto& path : shipped_scenes()) {
+    const Scene s = load_scene(path.string());
+    MjcfOptions with, without;
+    without.visual_geoms = false;
+    MjModelPtr a{load_mjcf(export_mjcf(s, with), "with")}, b{load_mjcf(export_mjcf(s, without), "without")};
+    ASSERT_TRUE(a.m && b.m) << path;
+    ASSERT_EQ(a.m->nbody, b.m->nbody) << path;
+    EXPECT_EQ(b.m->ngeom, 0) << path;
+    EXPECT_GT(a.m->ngeom, 0) << path;
+    for (int i = 0; i < a.m->nbody; ++i) {
+      EXPECT_EQ(a.m->body_mass[i], b.m->body_mass[i]) << path << " body " << i;
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(a.m->body_inertia[3 * i + k], b.m->body_inertia[3 * i + k]) << path << " body " << i;
+        EXPECT_EQ(a.m->body_ipos[3 * i + k], b.m->body_ipos[3 * i + k]) << path << " body " << i;
+        EXPECT_EQ(a.m->body_pos[3 * i + k], b.m->body_pos[3 * i + k]) << path << " body " << i;
+      }
+      for (int k = 0; k < 4; ++k) EXPECT_EQ(a.m->body_iquat[4 * i + k], b.m->body_iquat[4 * i + k]) << path;
+    }
+    for (int g = 0; g < a.m->ngeom; ++g) {
+      EXPECT_EQ(a.m->geom_contype[g], 0);
+      EXPECT_EQ(a.m->geom_conaffinity[g], 0);
+    }
+    // Capsule ends in the world at qpos0 (MuJoCo: centre ± half-length along the geom's z axis)
+    // against the body's points placed by calc_pose at the same coordinates (the joints' guesses).
+    mjData* d = mj_makeData(a.m);
+    mj_forward(a.m, d);
+    std::vector<double> q;
+    for (const auto& j : s.joints) q.push_back(j.guess);
+    const auto pose = calc_pose(s, q);
+    for (int g = 0; g < a.m->ngeom; ++g) {
+      if (a.m->geom_type[g] != mjGEOM_CAPSULE) continue;
+      const std::string body = mj_id2name(a.m, mjOBJ_BODY, a.m->geom_bodyid[g]);
+      const double h = a.m->geom_size[3 * g + 1];
+      for (double sign : {-1.0, 1.0}) {
+        const double x = d->geom_xpos[3 * g] + sign * h * d->geom_xmat[9 * g + 2];
+        const double y = d->geom_xpos[3 * g + 1] + sign * h * d->geom_xmat[9 * g + 5];
+        double nearest = HUGE_VAL;
+        for (const auto& pt : calc_body_points(s, body)) {
+          const Vec2 w = calc_ground_point(s, pose, body, pt);
+          nearest = std::min(nearest, std::hypot(w.x - x, w.y - y));
+        }
+        EXPECT_LT(nearest, 1e-9) << path << " body " << body;
+      }
+    }
+    mj_deleteData(d);
+  }
+}
+#else
+TEST(MjcfExport, MujocoLoadsTheCapsulesWithoutChangingMassOrInertia) { GTEST_SKIP() << "rdyn was built without MuJoCo"; }
+#endif
 
 TEST(MjcfExport, FreeTextAndFileNamesAreEscaped) {
   EXPECT_EQ(xml_escape("a<b>&\"c'd"), "a&lt;b&gt;&amp;&quot;c&apos;d");

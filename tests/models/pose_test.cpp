@@ -73,5 +73,47 @@ TEST(Pose, RefusesWrongSizesNonFiniteValuesAndBrokenTrees) {
   EXPECT_THROW(calc_ground_point(s, calc_pose(s, {0, 0}), "nobody", {}), std::invalid_argument);
 }
 
+// The points a body carries, written out from the arm: a's named point, its joint to ground (its
+// origin) and its joint to b; b's child point and named point; ground's pivot. A point given twice
+// (a named point on a joint's point) is one.
+TEST(Pose, BodyPointsAreTheNamedPointsAndEveryAttachmentOnce) {
+  Scene s = arm();
+  s.bodies[0].points = {{"mid", Vec2{0.25, 0.0}}, {"at_jb", Vec2{0.5, 0.0}}};
+  Loop l;
+  l.name = "L", l.body_a = "b", l.point_a = {0.3, 0.1}, l.body_b = kGround, l.point_b = {3, 4};
+  s.loops = {l};
+  const auto a = calc_body_points(s, "a");
+  ASSERT_EQ(a.size(), 3u);  // at_jb, mid (name order), then ja's child point (0, 0); jb's parent point is at_jb
+  EXPECT_EQ(a[0].x, 0.5);
+  EXPECT_EQ(a[1].x, 0.25);
+  EXPECT_EQ(a[2].x, 0.0);
+  const auto b = calc_body_points(s, "b");
+  ASSERT_EQ(b.size(), 2u);  // tip (also the loop's point), jb's child point
+  EXPECT_EQ(b[0].x, 0.3);
+  EXPECT_EQ(b[1].x, -0.2);
+  const auto g = calc_body_points(s, kGround);
+  ASSERT_EQ(g.size(), 2u);  // ja's parent point, the loop's point on ground
+  EXPECT_EQ(g[0].x, 1.0);
+  EXPECT_EQ(g[1].x, 3.0);
+  EXPECT_TRUE(calc_body_points(s, "nobody").empty());
+}
+
+// The outline goes round the centroid by angle from −π: a square's corners given in any order
+// come back counter-clockwise from the lower left, so the polygon does not cross itself.
+TEST(Pose, BodyOutlineGoesRoundTheCentroid) {
+  Scene s;
+  s.bodies = {Body{"plate", 1, {}, 1, {{"a", Vec2{1, 1}}, {"b", Vec2{-1, -1}}, {"c", Vec2{1, -1}}, {"d", Vec2{-1, 1}}}}};
+  Joint j;
+  j.name = "pin", j.parent = kGround, j.child = "plate", j.child_point = {1, 1};  // on corner a
+  s.joints = {j};
+  const auto o = calc_body_outline(s, "plate");
+  ASSERT_EQ(o.size(), 4u);
+  const double want[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(o[i].x, want[i][0]) << i;
+    EXPECT_EQ(o[i].y, want[i][1]) << i;
+  }
+}
+
 }  // namespace
 }  // namespace rdyn::models

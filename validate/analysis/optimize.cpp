@@ -488,7 +488,8 @@ void finish_strategies(const Workspace& w, const Design& bounded, const std::vec
                        const std::vector<double>& x, const Evaluation& best, const models::Scene& scene,
                        const OptimizeOptions& opt, Progress& progress, OptimizeResult& r) {
   progress.note("optimize: full model, constant strategy");
-  const auto c0 = calc_strategy(w, bounded, x0, e0, opt, "constant").first;
+  auto [c0, scene0] = calc_strategy(w, bounded, x0, e0, opt, "constant");
+  r.constant_scene = std::move(scene0);
   progress.note("optimize: full model, optimised strategy");
   auto [c1, scene1] = calc_strategy(w, bounded, x, best, opt, "optimised");
   r.constant = c0;

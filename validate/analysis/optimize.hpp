@@ -96,6 +96,7 @@ struct OptimizeResult {
   double optimise_wall_s = 0.0, wall_time_s = 0.0;
   bool full_cadence_ok = false, full_better = false;
   models::Scene optimised_scene;  // design loads profiled at the optimum, amplitude, resistance, steady start
+  models::Scene constant_scene;   // the same for the constant strategy (its full run's scene)
 };
 
 // The design resolved from the scene's optimize block and the options (every name checked,

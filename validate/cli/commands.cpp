@@ -28,6 +28,8 @@
 #include "validate/cli/animate_command.hpp"
 #include "engine/inspect.hpp"
 #include "validate/report/report.hpp"
+#include "validate/report/cycle_animation.hpp"
+#include "validate/analysis/cycle_run.hpp"
 #include "validate/harness/summary.hpp"
 #include "validate/analysis/sweep.hpp"
 #include "validate/cli/sweep_axis.hpp"
@@ -97,10 +99,22 @@ bool is_rdyn_sweep(const std::string& head) {
 
 void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
 
-// The validation summary with the assembled mechanism drawn (`inspect --svg`'s drawing), which
-// the report embeds: kept in summary.json so that `rdyn report` re-draws it too.
-nlohmann::json with_drawing(nlohmann::json summary, const models::Scene& scene) {
+// The validation summary with the assembled mechanism drawn (`inspect --svg`'s drawing) and the
+// record of one steady cycle of the reference animated (the last whole revolution re-run with
+// every joint's coordinate, analysis/cycle_run.hpp), which the report embeds: kept in
+// summary.json so that `rdyn report` re-draws them too.
+nlohmann::json with_drawing(nlohmann::json summary, const models::Scene& scene, const ValidationResult& v) {
   summary["mechanism_svg"] = inspect_svg(scene, engine::calc_inspection(engine::FullModel(scene)));
+  try {
+    const CycleStart c = calc_last_cycle(v.reference, v.time_scale.period_s);
+    summary["animation"] = animation_record(
+        scene, c, simulate_cycle(scene, c),
+        fmt::format("{}: full model, t = {:.4g} … {:.4g} s", scene.name, c.t_s, c.t_s + c.duration_s));
+  } catch (const models::NumericalError& e) {  // the report is still written, and says why
+    summary["animation_error"] = e.what();
+  } catch (const std::invalid_argument& e) {  // a reference too short to animate
+    summary["animation_error"] = e.what();
+  }
   return summary;
 }
 
@@ -366,7 +380,7 @@ namespace {
 nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions& opt, const std::string& dir,
                             Progress& progress, bool& pass) {
   const ValidationResult v = run_validation(scene, opt, progress);
-  const nlohmann::json full = with_drawing(summary_json(v), scene);
+  const nlohmann::json full = with_drawing(summary_json(v), scene, v);
   render_report(full, dir);
   pass = v.pass;
   nlohmann::json j = {{"name", v.scene}, {"file", v.scene_file}, {"status", v.pass ? "pass" : "fail"},
@@ -666,6 +680,10 @@ int run_report(const ReportArgs& a) {
   } catch (const nlohmann::json::exception& e) {
     // A hand-edited summary: a key missing or of the wrong type.
     throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
+  } catch (const models::SceneError& e) {  // its animation's scene does not read
+    throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
+  } catch (const std::invalid_argument& e) {  // its animation's frames are not one pose per frame
+    throw ArgumentError(fmt::format("{}: not a summary of `rdyn validate` ({})", a.summary, e.what()));
   }
   out.commit();
   std::fprintf(stderr, "rdyn: re-rendered %s into %s/report.html\n", a.summary.c_str(), a.out.c_str());
@@ -700,7 +718,7 @@ nlohmann::json validate_scene(const models::Scene& scene, const ValidateArgs& a,
   opt.quick = a.quick;
   opt.peers = a.peers;
   const ValidationResult v = run_validation(scene, opt, progress);
-  nlohmann::json summary = with_drawing(summary_json(v), scene);
+  nlohmann::json summary = with_drawing(summary_json(v), scene, v);
   render_report(summary, out.file(""));
   out.commit();
   return summary;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -11,6 +12,11 @@
 #include "validate/analysis/calibrate.hpp"
 #include "validate/analysis/optimize.hpp"
 #include "validate/report/optimize_report.hpp"
+#include "validate/report/cycle_animation.hpp"
+#include "validate/analysis/cycle_run.hpp"
+#include "validate/cli/animate_command.hpp"
+#include "engine/full_model.hpp"
+#include "engine/inspect.hpp"
 #include "validate/io/output_dir.hpp"
 #include "validate/io/progress.hpp"
 
@@ -65,6 +71,17 @@ int run_optimize(const OptimizeArgs& a) {
   if (!failure.empty()) throw models::NumericalError(failure);
   auto summary = optimize_summary(r);
   summary["nonnegative_repair"] = r.nonnegative_repair;  // the lift of a nonnegative shape after the search
+  // The mechanism drawn, and both strategies over one steady cycle of the full model from their
+  // steady points (analysis/cycle_run.hpp), which the report shows side by side.
+  summary["mechanism_svg"] =
+      inspect_svg(r.optimised_scene, engine::calc_inspection(engine::FullModel(r.optimised_scene)));
+  for (const auto& [key, sc, sr] : {std::tuple{"constant", &r.constant_scene, &r.constant},
+                                    std::tuple{"optimised", &r.optimised_scene, &r.optimised}}) {
+    const CycleStart c{0.0, sr->steady_q, sr->steady_qdot, 1.0 / sr->cadence_full_hz};
+    summary["animations"][key] = animation_record(
+        *sc, c, simulate_cycle(*sc, c),
+        fmt::format("{} strategy: peak {} {:.1f} N (full model)", key, r.force_name, sr->peak_full_N));
+  }
   render_optimize_report(summary, dir.file(""));
   // The optimised scene, loadable by every command (read back and checked by the writer).
   write_text_file(dir.file("optimised.yaml"),

@@ -15,4 +15,7 @@ std::string gnuplot_quoted(const std::string& text);
 // A CSV field per RFC 4180: quoted when it holds a comma, a quote, CR or LF (quotes doubled).
 std::string csv_field(const std::string& text);
 
+// Base64 (RFC 4648, with padding): an SVG as a data: URI in an <img>, which runs no script.
+std::string base64(const std::string& bytes);
+
 }  // namespace rdyn::validate

@@ -15,17 +15,15 @@ namespace rdyn::validate {
 
 namespace {
 
-constexpr double kSame_m = 1e-12;  // two attachments closer than this are one drawn point
+constexpr double kSame_m = models::kSamePoint_m;  // two attachments closer than this are one drawn point
+constexpr double kLabelGap = 0.015;     // an arrow's label beyond its head, × the drawing's size
+constexpr double kFontFraction = 0.03;  // labels' font size, × the drawing's size
 
 int find_point(const std::vector<DrawPoint>& pts, const std::string& body, models::Vec2 p) {
   for (size_t i = 0; i < pts.size(); ++i)
     if (pts[i].body == body && std::abs(pts[i].p.x - p.x) < kSame_m && std::abs(pts[i].p.y - p.y) < kSame_m)
       return static_cast<int>(i);
   return -1;
-}
-
-void add_point(std::vector<DrawPoint>& pts, const std::string& body, models::Vec2 p) {
-  if (find_point(pts, body, p) < 0) pts.push_back({body, p});
 }
 
 int point_of(const std::vector<DrawPoint>& pts, const std::string& body, models::Vec2 p) {
@@ -52,18 +50,11 @@ std::vector<std::vector<double>> calc_positions(const models::Scene& s, const st
   return out;
 }
 
-// A body's points in the order of their angle about its centroid (body frame, so fixed): the
-// outline of the polygon through them (a bar for two points).
-std::vector<int> body_outline(const std::vector<DrawPoint>& pts, const std::string& body) {
+// A body's outline (models::calc_body_outline, the order the MJCF export's capsules follow too)
+// as indices into the drawn points.
+std::vector<int> body_outline(const models::Scene& s, const std::vector<DrawPoint>& pts, const std::string& body) {
   std::vector<int> idx;
-  double cx = 0, cy = 0;
-  for (size_t i = 0; i < pts.size(); ++i)
-    if (pts[i].body == body) idx.push_back(static_cast<int>(i)), cx += pts[i].p.x, cy += pts[i].p.y;
-  if (idx.empty()) return idx;
-  cx /= idx.size(), cy /= idx.size();
-  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
-    return std::atan2(pts[a].p.y - cy, pts[a].p.x - cx) < std::atan2(pts[b].p.y - cy, pts[b].p.x - cx);
-  });
+  for (const auto& p : models::calc_body_outline(s, body)) idx.push_back(point_of(pts, body, p));
   return idx;
 }
 
@@ -84,7 +75,8 @@ struct Layout {
   double arrow_m_per_N = 0;
 };
 
-Layout calc_layout(const std::vector<std::vector<double>>& P, const std::vector<ForceArrow>& arrows) {
+Layout calc_layout(const std::vector<DrawPoint>& pts, const std::vector<std::vector<double>>& P,
+                   const std::vector<ForceArrow>& arrows) {
   Layout L;
   bool first = true;
   for (const auto& row : P)
@@ -99,6 +91,20 @@ Layout calc_layout(const std::vector<std::vector<double>>& P, const std::vector<
     for (size_t k = 0; k < a.fx_N.size(); ++k) fmax = std::max(fmax, std::hypot(a.fx_N[k], a.fy_N[k]));
   // The largest force of the run is drawn a quarter of the mechanism's size long.
   L.arrow_m_per_N = fmax > 0 ? 0.25 * L.size / fmax : 0.0;
+  // Room for every arrow and its label over the run (placed as svg_body places them; a label's
+  // width estimated at 0.6 em per character of "name 1234.5 N"), so none leaves the drawing.
+  const double font = kFontFraction * L.size, gap = kLabelGap * L.size;
+  for (const auto& a : arrows) {
+    const int i = point_of(pts, a.body, a.point);
+    const double w = 0.6 * font * static_cast<double>(a.name.size() + 9);
+    for (size_t k = 0; k < a.fx_N.size() && k < P.size(); ++k) {
+      const double fx = a.fx_N[k], fy = a.fy_N[k], fn = std::hypot(fx, fy);
+      double x = P[k][2 * i] + L.arrow_m_per_N * fx, y = P[k][2 * i + 1] + L.arrow_m_per_N * fy;
+      if (fn > 0) x += gap * fx / fn, y += gap * fy / fn;
+      L.minx = std::min(L.minx, fx < 0 ? x - w : x), L.maxx = std::max(L.maxx, fx < 0 ? x : x + w);
+      L.miny = std::min(L.miny, fy < 0 ? y - font : y), L.maxy = std::max(L.maxy, fy < 0 ? y : y + font);
+    }
+  }
   return L;
 }
 
@@ -175,7 +181,7 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
       seg("slide", j.name, point_of(pts, j.parent, j.parent_point), joint_pt(j), "stroke=\"#2c3e50\" stroke-width=\"6\"");
   o += "</g>\n<g class=\"bodies\" stroke=\"#2c3e50\" stroke-width=\"3\" stroke-linejoin=\"round\">\n";
   for (const auto& b : s.bodies) {
-    const auto idx = body_outline(pts, b.name);
+    const auto idx = body_outline(s, pts, b.name);
     std::string list, path;
     for (int i : idx) list += (list.empty() ? "" : " ") + std::to_string(i), path += num(X(i)) + "," + num(-Y(i)) + " ";
     if (idx.size() == 1) {  // a body with one point (a cylinder's barrel): a disc there
@@ -210,9 +216,14 @@ std::string svg_body(const models::Scene& s, const MechanismFrames& f, const std
     o += fmt::format("<line data-arrow=\"{}\" data-i=\"{}\" data-fx=\"{}\" data-fy=\"{}\" x1=\"{}\" y1=\"{}\" x2=\"{}\" "
                      "y2=\"{}\" marker-end=\"url(#head)\"/>\n",
                      a, i, num(fx), num(fy), num(X(i)), num(-Y(i)), num(x2), num(-y2));
-    o += fmt::format("<text data-arrow-label=\"{}\" data-name=\"{}\" x=\"{}\" y=\"{}\" font-size=\"{}\" stroke=\"none\">"
-                     "{} {:.1f} N</text>\n",
-                     a, html_escape(A.name), num(x2), num(-y2), num(0.03 * L.size), html_escape(A.name), std::hypot(fx, fy));
+    // The label just beyond the arrow's head, on the side it points to (left or right, below or
+    // above), so the head does not hide it.
+    const double fn = std::hypot(fx, fy), gap = kLabelGap * L.size;
+    const double lx = x2 + (fn > 0 ? gap * fx / fn : 0.0), ly = y2 + (fn > 0 ? gap * fy / fn : 0.0);
+    o += fmt::format("<text data-arrow-label=\"{}\" data-name=\"{}\" x=\"{}\" y=\"{}\" text-anchor=\"{}\" "
+                     "dominant-baseline=\"{}\" font-size=\"{}\" stroke=\"none\">{} {:.1f} N</text>\n",
+                     a, html_escape(A.name), num(lx), num(-ly), fx < 0 ? "end" : "start", fy < 0 ? "hanging" : "auto",
+                     num(kFontFraction * L.size), html_escape(A.name), fn);
   }
   o += "</g>\n";
   return o;
@@ -245,18 +256,9 @@ void check_frames(const models::Scene& s, const MechanismFrames& f) {
 
 std::vector<DrawPoint> collect_draw_points(const models::Scene& s) {
   std::vector<DrawPoint> pts;
-  std::vector<std::pair<std::string, models::Vec2>> att;  // every attachment, then grouped by body
-  for (const auto& j : s.joints) att.push_back({j.parent, j.parent_point}), att.push_back({j.child, j.child_point});
-  for (const auto& l : s.loops) att.push_back({l.body_a, l.point_a}), att.push_back({l.body_b, l.point_b});
-  for (const auto& sp : s.springs) att.push_back({sp.body_a, sp.point_a}), att.push_back({sp.body_b, sp.point_b});
-  for (const auto& pf : s.point_forces) att.push_back({pf.body_a, pf.point_a}), att.push_back({pf.body_b, pf.point_b});
-  for (const auto& b : s.bodies) {
-    for (const auto& [name, p] : b.points) add_point(pts, b.name, p);
-    for (const auto& [body, p] : att)
-      if (body == b.name) add_point(pts, b.name, p);
-  }
-  for (const auto& [body, p] : att)
-    if (body == models::kGround) add_point(pts, models::kGround, p);
+  for (const auto& b : s.bodies)
+    for (const auto& p : models::calc_body_points(s, b.name)) pts.push_back({b.name, p});
+  for (const auto& p : models::calc_body_points(s, models::kGround)) pts.push_back({models::kGround, p});
   return pts;
 }
 
@@ -333,9 +335,9 @@ std::string mechanism_svg(const models::Scene& s, const MechanismFrames& f, size
   if (frame >= f.t_s.size()) throw std::invalid_argument("mechanism drawing: no such frame");
   const auto pts = collect_draw_points(s);
   const auto P = calc_positions(s, pts, f);
-  const Layout L = calc_layout(P, f.arrows);
+  const Layout L = calc_layout(pts, P, f.arrows);
   std::string o = svg_body(s, f, pts, P, L, frame);
-  const double fs = 0.03 * L.size;
+  const double fs = kFontFraction * L.size;
   o += fmt::format("<text class=\"q\" x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>\n", num(L.minx - 0.1 * L.size),
                    num(-L.miny + 0.06 * L.size), num(fs), html_escape(q_text(s, f.q[frame])));
   if (!note.empty())
@@ -345,11 +347,11 @@ std::string mechanism_svg(const models::Scene& s, const MechanismFrames& f, size
   return o;
 }
 
-std::string animation_html(const models::Scene& s, const MechanismFrames& f, const std::string& title) {
+std::string animation_section(const models::Scene& s, const MechanismFrames& f, const std::string& title) {
   check_frames(s, f);
   const auto pts = collect_draw_points(s);
   const auto P = calc_positions(s, pts, f);
-  const Layout L = calc_layout(P, f.arrows);
+  const Layout L = calc_layout(pts, P, f.arrows);
   nlohmann::json J;
   J["t"] = f.t_s;
   J["p"] = P;
@@ -361,32 +363,33 @@ std::string animation_html(const models::Scene& s, const MechanismFrames& f, con
     for (const auto& a : f.arrows) F[k].push_back(a.fx_N[k]), F[k].push_back(a.fy_N[k]);
   J["f"] = F;
   J["scale"] = L.arrow_m_per_N;
-  std::string names;
-  for (const auto& a : f.arrows) names += (names.empty() ? "" : ",") + nlohmann::json(a.name).dump();
-  // The JSON holds numbers and rdyn's own q labels; '<' is escaped all the same so that no
+  J["gap"] = kLabelGap * L.size;
+  std::vector<std::string> names;
+  for (const auto& a : f.arrows) names.push_back(a.name);
+  J["names"] = names;
+  // The JSON holds numbers, the scene's names and rdyn's q labels; '<' is escaped so that no
   // "</script>" can end the block early.
-  std::string json = J.dump();
   std::string safe;
-  for (char c : json) safe += c == '<' ? std::string("\\u003c") : std::string(1, c);
-  std::string html = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + html_escape(title) +
-                     "</title>\n<style>body{font-family:sans-serif;margin:1em}svg.mechanism{width:100%;max-height:80vh;"
-                     "background:#fff;border:1px solid #ccc}#controls{margin:.5em 0}#controls>*{margin-right:.8em}"
-                     "</style></head>\n<body data-t=\"" + num(f.t_s[0]) + "\" data-frame=\"0\">\n<h1>" +
-                     html_escape(title) + "</h1>\n<div id=\"controls\"><button id=\"play\">play</button>"
-                     "<input id=\"slider\" type=\"range\" min=\"0\" max=\"" + std::to_string(f.t_s.size() - 1) +
-                     "\" step=\"1\" value=\"0\" style=\"width:40%\"><label>speed <select id=\"speed\"><option>0.1"
-                     "</option><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option>"
-                     "</select></label><span id=\"time\">t = " + fmt::format("{:.3f}", f.t_s[0]) +
-                     " s</span><span id=\"q\">" + html_escape(q_text(s, f.q[0])) + "</span></div>\n";
-  html += svg_body(s, f, pts, P, L, 0) + "</svg>\n";
-  html += "<p>Arrows: forces at their joints, " + fmt::format("{:.3g}", L.arrow_m_per_N > 0 ? 1.0 / L.arrow_m_per_N : 0.0) +
-          " N per metre of drawing; dashed purple: traced points' paths; yellow: the independent joint.</p>\n";
-  html += "<script id=\"frames\" type=\"application/json\">" + safe + "</script>\n";
-  html += R"JS(<script>
+  for (char c : J.dump()) safe += c == '<' ? std::string("\\u003c") : std::string(1, c);
+  std::string h = "<div class=\"animation\" data-t=\"" + num(f.t_s[0]) + "\" data-frame=\"0\">\n";
+  if (!title.empty()) h += "<h3>" + html_escape(title) + "</h3>\n";
+  h += "<div class=\"controls\"><button class=\"play\">play</button><input class=\"slider\" type=\"range\" min=\"0\" "
+       "max=\"" + std::to_string(f.t_s.size() - 1) + "\" step=\"1\" value=\"0\"><label>speed <select class=\"speed\">"
+       "<option>0.1</option><option>0.25</option><option>0.5</option><option selected>1</option><option>2</option>"
+       "</select></label><span class=\"time\">t = " + fmt::format("{:.3f}", f.t_s[0]) + " s</span><span class=\"q\">" +
+       html_escape(q_text(s, f.q[0])) + "</span></div>\n";
+  h += svg_body(s, f, pts, P, L, 0) + "</svg>\n";
+  h += "<p class=\"legend\">Arrows: forces at their joints, " +
+       fmt::format("{:.3g}", L.arrow_m_per_N > 0 ? 1.0 / L.arrow_m_per_N : 0.0) +
+       " N per metre of drawing; dashed purple: traced points' paths; yellow: the independent joint.</p>\n";
+  h += "<script class=\"frames\" type=\"application/json\">" + safe + "</script>\n";
+  h += R"JS(<script>
 "use strict";
-// Moves the drawn elements to the positions a frame holds (computed by rdyn; no kinematics here).
-const F = JSON.parse(document.getElementById("frames").textContent);
-const N = F.t.length, names = [)JS" + names + R"JS(];
+// Moves this animation's elements to the positions a frame holds (computed by rdyn; no
+// kinematics here). `#t=T` shows the frame nearest T in every animation of the page.
+(function (root) {
+const F = JSON.parse(root.querySelector("script.frames").textContent);
+const N = F.t.length, svg = root.querySelector("svg.mechanism"), ui = c => root.querySelector(".controls ." + c);
 let k = 0, playing = false, tnow = F.t[0], last = null;
 function nearest(t) {
   if (!(t > F.t[0])) return 0;
@@ -399,16 +402,17 @@ function set(e, a, v) { e.setAttribute(a, String(v)); }
 function show(i) {
   k = i;
   const P = F.p[i];
-  for (const e of document.querySelectorAll("svg.mechanism [data-i]")) {
+  for (const e of svg.querySelectorAll("[data-i]")) {
     const j = +e.dataset.i, x = P[2 * j], y = P[2 * j + 1];
     if (e.hasAttribute("data-arrow")) {
       const a = +e.dataset.arrow, fx = F.f[i][2 * a], fy = F.f[i][2 * a + 1];
       const x2 = x + F.scale * fx, y2 = y + F.scale * fy;
       set(e, "x1", x); set(e, "y1", -y); set(e, "x2", x2); set(e, "y2", -y2);
       set(e, "data-fx", fx); set(e, "data-fy", fy);
-      const l = document.querySelector('[data-arrow-label="' + a + '"]');
-      set(l, "x", x2); set(l, "y", -y2);
-      l.textContent = names[a] + " " + Math.hypot(fx, fy).toFixed(1) + " N";
+      const l = svg.querySelector('[data-arrow-label="' + a + '"]'), fn = Math.hypot(fx, fy);
+      set(l, "x", x2 + (fn > 0 ? F.gap * fx / fn : 0)); set(l, "y", -(y2 + (fn > 0 ? F.gap * fy / fn : 0)));
+      set(l, "text-anchor", fx < 0 ? "end" : "start"); set(l, "dominant-baseline", fy < 0 ? "hanging" : "auto");
+      l.textContent = F.names[a] + " " + Math.hypot(fx, fy).toFixed(1) + " N";
       continue;
     }
     set(e, "data-x", x); set(e, "data-y", y);
@@ -417,48 +421,65 @@ function show(i) {
       const d = e.getAttribute("d"); set(e, "d", "M" + x + "," + (-y) + d.slice(d.indexOf(" ")));
     }
   }
-  for (const e of document.querySelectorAll("svg.mechanism [data-is]"))
+  for (const e of svg.querySelectorAll("[data-is]"))
     set(e, "points", e.dataset.is.split(" ").map(s => { const j = +s; return P[2 * j] + "," + (-P[2 * j + 1]); }).join(" "));
-  for (const e of document.querySelectorAll("svg.mechanism [data-i0]")) {
+  for (const e of svg.querySelectorAll("[data-i0]")) {
     const a = +e.dataset.i0, b = +e.dataset.i1;
     set(e, "x1", P[2 * a]); set(e, "y1", -P[2 * a + 1]); set(e, "x2", P[2 * b]); set(e, "y2", -P[2 * b + 1]);
   }
-  document.body.dataset.t = String(F.t[i]); document.body.dataset.frame = String(i);
-  const svg = document.querySelector("svg.mechanism"); svg.dataset.t = String(F.t[i]); svg.dataset.frame = String(i);
-  document.getElementById("slider").value = String(i);
-  document.getElementById("time").textContent = "t = " + F.t[i].toFixed(3) + " s";
-  document.getElementById("q").textContent = F.q[i];
+  for (const e of [root, svg]) { e.dataset.t = String(F.t[i]); e.dataset.frame = String(i); }
+  if (root.parentElement === document.body && document.querySelectorAll("div.animation").length === 1) {
+    document.body.dataset.t = String(F.t[i]); document.body.dataset.frame = String(i);
+  }
+  ui("slider").value = String(i);
+  ui("time").textContent = "t = " + F.t[i].toFixed(3) + " s";
+  ui("q").textContent = F.q[i];
 }
 function fromHash() {
   const m = /^#t=(.+)$/.exec(location.hash);
   if (!m) return false;
   const t = parseFloat(m[1]);
   if (!Number.isFinite(t)) return false;
-  playing = false; document.getElementById("play").textContent = "play";
+  playing = false; ui("play").textContent = "play";
   tnow = F.t[nearest(t)]; show(nearest(t));
   return true;
 }
 function tick(ms) {
   if (!playing) return;
   if (last !== null) {
-    tnow += (ms - last) / 1000 * parseFloat(document.getElementById("speed").value);
+    tnow += (ms - last) / 1000 * parseFloat(ui("speed").value);
     if (tnow > F.t[N - 1]) tnow = F.t[0];
   }
   last = ms; show(nearest(tnow));
   requestAnimationFrame(tick);
 }
-document.getElementById("play").addEventListener("click", () => {
+ui("play").addEventListener("click", () => {
   playing = !playing; last = null;
-  document.getElementById("play").textContent = playing ? "pause" : "play";
+  ui("play").textContent = playing ? "pause" : "play";
   if (playing) requestAnimationFrame(tick);
 });
-document.getElementById("slider").addEventListener("input", e => { playing = false; tnow = F.t[+e.target.value]; show(+e.target.value); });
+ui("slider").addEventListener("input", e => { playing = false; tnow = F.t[+e.target.value]; show(+e.target.value); });
 window.addEventListener("hashchange", fromHash);
 if (!fromHash()) show(0);
+})(document.currentScript.parentElement);
 </script>
-</body></html>
+</div>
 )JS";
-  return html;
+  return h;
+}
+
+std::string animation_css() {
+  return "svg.mechanism{width:100%;max-height:80vh;background:#fff;border:1px solid #ccc}"
+         ".animation .controls{margin:.5em 0}.animation .controls>*{margin-right:.8em}"
+         ".animation .slider{width:40%}";
+}
+
+std::string animation_html(const models::Scene& s, const MechanismFrames& f, const std::string& title) {
+  check_frames(s, f);
+  return "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + html_escape(title) +
+         "</title>\n<style>body{font-family:sans-serif;margin:1em}" + animation_css() + "</style></head>\n<body data-t=\"" +
+         num(f.t_s[0]) + "\" data-frame=\"0\">\n<h1>" + html_escape(title) + "</h1>\n" + animation_section(s, f, "") +
+         "</body></html>\n";
 }
 
 }  // namespace rdyn::validate

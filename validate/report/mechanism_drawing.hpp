@@ -59,9 +59,18 @@ MechanismFrames frames_from_run(const models::Scene& scene, const models::TimeSe
 std::string mechanism_svg(const models::Scene& scene, const MechanismFrames& frames, size_t frame,
                           const std::string& note);
 
-// The self-contained page (inline SVG, script and frames as JSON; no network): play/pause, a
-// time slider, speed, q shown; `#t=T` shows the frame nearest T (clamped to the run), and every
-// joint element's data-x/data-y are that frame's positions.
+// One animation as a block of HTML that a page may hold several of (the validate report, the
+// optimize report's two strategies): a <div class="animation"> with its controls (play/pause,
+// a time slider, speed), the drawing, the frames as inline JSON and a script scoped to the div
+// (no network). `#t=T` in the page's address shows the frame nearest T (clamped to the run) in
+// every animation of the page; each div and its svg carry data-t and data-frame, and every
+// joint element's data-x/data-y are that frame's positions. `title` (escaped) heads the block
+// when not empty. Needs animation_css() in the page's style.
+std::string animation_section(const models::Scene& scene, const MechanismFrames& frames, const std::string& title);
+std::string animation_css();
+
+// The self-contained page of one animation (`rdyn animate`): the section above under a heading;
+// <body> carries data-t and data-frame too.
 std::string animation_html(const models::Scene& scene, const MechanismFrames& frames, const std::string& title);
 
 }  // namespace rdyn::validate

@@ -1,4 +1,5 @@
 #include "validate/report/optimize_report.hpp"
+#include "validate/report/cycle_animation.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -208,6 +209,7 @@ std::string render_optimize_html(const json& s, const std::map<std::string, std:
                    d(s, "optimise_wall_time_s"), H(s.at("stop_reason")), d(s, "wall_time_s"), H(s.at("objective")),
                    s.at("p").is_number() ? fmt::format(" (p = {:g})", s.at("p").get<double>()) : std::string(),
                    d(s, "reduced_full_agreement"));
+  h += mechanism_drawing_html(s) + strategies_animation_html(s);  // validate/report/cycle_animation.hpp
   h += "<h2>1. Drive loads over the angle</h2>" + svg_or_note(figures, "torques");
   h += "<h2>2. " + H(f) + " force over the angle</h2>" + svg_or_note(figures, "force");
   h += "<h2>3. Shapes</h2><table><tr><th>load</th><th>same as</th><th>shift [deg]</th><th>a0</th><th>a_k</th>"

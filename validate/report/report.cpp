@@ -1,4 +1,5 @@
 #include "validate/report/report.hpp"
+#include "validate/report/cycle_animation.hpp"
 
 #include <fmt/format.h>
 
@@ -61,24 +62,6 @@ std::string quantity_words(const std::string& q) {
   if (q == "qdot") return "speed of the independent coordinate";
   if (q == "mean_qdot") return "mean speed of the independent coordinate";
   return q + " force";
-}
-
-std::string base64(const std::string& in) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
-    out += k[v >> 18], out += k[(v >> 12) & 63], out += k[(v >> 6) & 63], out += k[v & 63];
-  }
-  if (i + 1 == in.size()) {
-    const unsigned v = (unsigned char)in[i] << 16;
-    out += k[v >> 18], out += k[(v >> 12) & 63], out += "==";
-  } else if (i + 2 == in.size()) {
-    const unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8;
-    out += k[v >> 18], out += k[(v >> 12) & 63], out += k[(v >> 6) & 63], out += '=';
-  }
-  return out;
 }
 
 std::string read_text(const std::string& path) {
@@ -761,15 +744,10 @@ void render_report(const json& s, const std::string& dir) {
     html.insert(at == std::string::npos ? 0 : at,
                 "<p class=warn>gnuplot reported errors; see gnuplot.log beside this report.</p>");
   }
-  if (s.contains("mechanism_svg") && s["mechanism_svg"].is_string()) {
-    // As an image from a data URI: a summary.json edited by hand cannot run script in the report.
+  // The mechanism drawn, then one steady cycle animated (validate/report/cycle_animation.hpp).
+  if (const std::string mech = mechanism_drawing_html(s) + validate_animation_html(s); !mech.empty()) {
     const auto at = html.find("<h2>1.");
-    html.insert(at == std::string::npos ? 0 : at,
-                "<h2>The mechanism</h2><p><img alt=\"the mechanism at its assembled configuration\" "
-                "style=\"max-width:100%;max-height:60vh\" src=\"data:image/svg+xml;base64," +
-                    base64(s["mechanism_svg"].get<std::string>()) +
-                    "\"></p><p>The assembled configuration (<code>rdyn inspect SCENE --svg FILE</code>; "
-                    "<code>rdyn animate SCENE</code> plays a run).</p>\n");
+    html.insert(at == std::string::npos ? 0 : at, mech);
   }
   write_text_file(dir + "/report.html", html);
 }

@@ -17,7 +17,12 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
+#include "models/pose.hpp"
+#include "tests/validate/browser.hpp"
 #include "tests/validate/run_rdyn.hpp"
+#include "validate/analysis/cycle_run.hpp"
+#include "validate/analysis/mechanism_run.hpp"
+#include "validate/report/cycle_animation.hpp"
 #include "validate/analysis/calibrate.hpp"
 
 namespace rdyn::validate {
@@ -472,6 +477,53 @@ TEST(OptimizeSlow, LegPressProfileIsTheSummaryRun) {
   EXPECT_GT(std::abs(c1 - c0), 0.1 * c0);
   // The optimised scene's coefficient is the optimum's.
   EXPECT_EQ(s["resistance_coefficient"].get<double>(), c1);
+  fs::remove_all(dir);
+}
+
+// The optimize report shows the mechanism and both strategies over one steady cycle side by side
+// (issue #26): in headless Chromium, report.html#t=T moves both animations, and each one's joints
+// are where that strategy's full model puts them — its cycle re-run in this process from the
+// start summary.json records (the strategy's steady point) — to 1e-9 m.
+TEST(OptimizeSlow, ReportAnimatesBothStrategiesWhereTheirFullModelsPutThem) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_optimize_animation_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string file = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/legpress-cal.yaml";
+  test::RunLimits lim;
+  lim.time_limit_s = 300;
+  const auto run = test::run_rdyn({"optimize", file, "--cadence-hz", "0.6", "--power-w", "40", "--out", "out"}, dir, lim);
+  ASSERT_EQ(run.status, 0) << run.err;
+  const auto summary = nlohmann::json::parse(test::slurp(dir / "out" / "summary.json"));
+  const std::string html = test::slurp(dir / "out" / "report.html");
+  EXPECT_NE(html.find("data:image/svg+xml;base64,"), std::string::npos);  // the mechanism drawing
+  test::Chromium browser(dir);
+  for (const double frac : {0.2, 0.65}) {
+    const double t = frac / 0.6;  // within one period at 0.6 Hz
+    const std::string dom = browser.dump_dom(dir / "out" / "report.html", t);
+    const auto c = dom.find("data-strategy=\"constant\""), o = dom.find("data-strategy=\"optimised\"");
+    ASSERT_NE(c, std::string::npos);
+    ASSERT_NE(o, std::string::npos);
+    for (const auto& [key, part] : {std::pair<std::string, std::string>{"constant", dom.substr(c, o - c)},
+                                    {"optimised", dom.substr(o)}}) {
+      const auto rec = read_animation_record(summary.at("animations").at(key));
+      EXPECT_NEAR(rec.start.duration_s, 1 / 0.6, 0.01 / 0.6) << key;
+      EXPECT_EQ(rec.start.q, summary.at(key).at("steady_q").get<double>()) << key;
+      const auto cycle = simulate_cycle(rec.scene, rec.start);
+      size_t row = 0;
+      for (size_t i = 0; i < cycle.t.size(); ++i)
+        if (std::abs(cycle.t[i] - t) < std::abs(cycle.t[row] - t)) row = i;
+      std::smatch m;
+      ASSERT_TRUE(std::regex_search(part, m, std::regex("<div class=\"animation\" data-t=\"([^\"]+)\""))) << key;
+      EXPECT_NEAR(std::stod(m[1]), cycle.t[row], 1e-12) << key;
+      const auto pose = models::calc_pose(rec.scene, joint_coordinates(rec.scene, cycle, row));
+      const auto joints = test::positions(part, "data-joint");
+      ASSERT_EQ(joints.size(), rec.scene.joints.size()) << key;
+      for (size_t j = 0; j < rec.scene.joints.size(); ++j) {
+        EXPECT_NEAR(joints.at(rec.scene.joints[j].name).x, pose.joints[j].x, 1e-9) << key << " " << rec.scene.joints[j].name;
+        EXPECT_NEAR(joints.at(rec.scene.joints[j].name).y, pose.joints[j].y, 1e-9) << key << " " << rec.scene.joints[j].name;
+      }
+    }
+  }
   fs::remove_all(dir);
 }
 

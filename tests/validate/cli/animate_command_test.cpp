@@ -21,6 +21,7 @@
 
 #include "models/pose.hpp"
 #include "models/scene_yaml.hpp"
+#include "tests/validate/browser.hpp"
 #include "tests/validate/run_rdyn.hpp"
 #include "validate/analysis/mechanism_run.hpp"
 
@@ -31,32 +32,9 @@ namespace fs = std::filesystem;
 using test::run_argv;
 using test::run_rdyn;
 
-struct Xy {
-  double x = 0, y = 0;
-};
-
-// Every element carrying `attr`: its value (plus data-side for loops) → data-x, data-y.
-std::map<std::string, Xy> positions(const std::string& dom, const std::string& attr) {
-  std::map<std::string, Xy> out;
-  const std::regex el("<[a-z]+ " + attr + "=\"([^\"]+)\"[^>]*>");
-  const std::regex x("data-x=\"([^\"]+)\""), y("data-y=\"([^\"]+)\""), side("data-side=\"([^\"]+)\"");
-  for (auto it = std::sregex_iterator(dom.begin(), dom.end(), el); it != std::sregex_iterator(); ++it) {
-    const std::string tag = (*it)[0];
-    std::smatch mx, my, ms;
-    if (!std::regex_search(tag, mx, x) || !std::regex_search(tag, my, y)) continue;
-    std::string key = (*it)[1];
-    if (std::regex_search(tag, ms, side)) key += "." + ms[1].str();
-    out[key] = {std::stod(mx[1]), std::stod(my[1])};
-  }
-  return out;
-}
-
-std::string fmt_t(double t) {
-  std::ostringstream s;
-  s.precision(17);
-  s << t;
-  return s.str();
-}
+using test::fmt_t;
+using test::positions;
+using test::Xy;
 
 class Browser : public ::testing::Test {
  protected:
@@ -66,25 +44,14 @@ class Browser : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
+    browser_ = test::Chromium(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // Chromium as root, headless, no network services, a fresh profile per call.
-  std::vector<std::string> chromium(const std::string& what) {
-    const fs::path profile = dir_ / ("profile" + std::to_string(++profiles_));
-    return {"chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-            "--disable-background-networking", "--disable-component-update", "--disable-sync",
-            "--user-data-dir=" + profile.string(), "--virtual-time-budget=3000", what};
-  }
-  std::string dump_dom(const fs::path& page, double t) {
-    auto argv = chromium("--dump-dom");
-    argv.push_back("file://" + page.string() + "#t=" + fmt_t(t));
-    const auto r = run_argv(argv, dir_);
-    EXPECT_EQ(r.status, 0) << "chromium (Debian package `chromium`) did not run: " << r.err.substr(0, 500);
-    return r.out;
-  }
+  std::vector<std::string> chromium(const std::string& what) { return browser_.argv(what); }
+  std::string dump_dom(const fs::path& page, double t) { return browser_.dump_dom(page, t); }
   fs::path dir_;
-  int profiles_ = 0;
+  test::Chromium browser_{""};  // profiles in dir_ (SetUp)
 };
 
 // The checks of the issue at times `times` of a run of `scene` (`model`, duration, interval).

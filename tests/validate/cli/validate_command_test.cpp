@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <array>
 #include <cstdio>
@@ -91,9 +92,11 @@ TEST(ValidateCommand, SuiteWritesReportsAndFailsOnAThreshold) {
     EXPECT_TRUE(fs::exists(dir / "out" / "a_pass" / f)) << f;
   const std::string html = slurp(dir / "out" / "a_pass" / "report.html");
   EXPECT_EQ(html.find("could not be rendered"), std::string::npos);
-  size_t svgs = 0;
-  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1)) ++svgs;
+  size_t svgs = 0, mechanism = 0;  // the four figures, and the animation of one cycle
+  for (size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 1))
+    ++(html.compare(at, 57, "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"mechanism\"") == 0 ? mechanism : svgs);
   EXPECT_EQ(svgs, 4u);
+  EXPECT_EQ(mechanism, 1u);
   // The verdict table comes before the first figure and names every quantity.
   const size_t verdict = html.find("<h2>Verdict</h2>"), figure = html.find("<svg");
   ASSERT_NE(verdict, std::string::npos);
@@ -206,6 +209,79 @@ TEST(ValidateCommand, ReactionsAllOnTheReducedModelNamesTheOnesItCannotGive) {
       rdyn::test::run_rdyn({"simulate", "listed.yaml", "--model", "reduced", "--out", "listed"}, dir);
   EXPECT_EQ(listed.status, 2) << listed.err;
   EXPECT_NE(listed.err.find("cannot give the reaction of prismatic joint 'rail'"), std::string::npos) << listed.err;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+#include "models/pose.hpp"
+#include "models/scene_yaml.hpp"
+#include "tests/validate/browser.hpp"
+#include "validate/analysis/cycle_run.hpp"
+#include "validate/analysis/mechanism_run.hpp"
+#include "validate/report/cycle_animation.hpp"
+
+namespace {
+
+// The report animates one steady cycle of the full model (issue #26): in headless Chromium,
+// report.html#t=T shows, for two times of that cycle, every joint where the full model puts it —
+// the cycle re-run in this process from the start summary.json records (its state on the
+// reference's last whole revolution) and placed by models::calc_pose — to 1e-9 m, the ground
+// pivots on their ground points and the loop closed. `rdyn report` redraws the same animation
+// from the summary alone.
+TEST(ValidateCommand, ReportAnimatesOneSteadyCycleWhereTheFullModelPutsIt) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_animation_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto r = rdyn::test::run_rdyn({"validate", "slider-crank", "--quick", "--out", "v"}, dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto summary = nlohmann::json::parse(slurp(dir / "v/summary.json"));
+  ASSERT_TRUE(summary.contains("animation"));
+  const auto rec = rdyn::validate::read_animation_record(summary.at("animation"));
+  const auto s = rdyn::models::load_scene("slider-crank", {});
+  // The last whole revolution of the 2 s reference (the motor's steady ~48 rad/s: 0.13 s).
+  EXPECT_GT(rec.start.t_s, 1.5);
+  EXPECT_NEAR(rec.start.duration_s, 0.13, 0.02);
+  EXPECT_LE(rec.start.t_s + rec.start.duration_s, summary.at("duration_s").get<double>() + 1e-9);
+  const auto cycle = rdyn::validate::simulate_cycle(s, rec.start);
+  EXPECT_NEAR(std::abs(cycle.q.back() - cycle.q.front()), 2 * M_PI, 1e-5);
+  rdyn::test::Chromium browser(dir);
+  for (const double t : {rec.start.t_s + 0.23 * rec.start.duration_s, rec.start.t_s + 0.71 * rec.start.duration_s}) {
+    const std::string dom = browser.dump_dom(dir / "v/report.html", t);
+    size_t row = 0;
+    for (size_t i = 0; i < cycle.t.size(); ++i)
+      if (std::abs(cycle.t[i] - t) < std::abs(cycle.t[row] - t)) row = i;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(dom, m, std::regex("<div class=\"animation\" data-t=\"([^\"]+)\"")));
+    EXPECT_NEAR(std::stod(m[1]), cycle.t[row], 1e-12);
+    const auto pose = rdyn::models::calc_pose(s, rdyn::validate::joint_coordinates(s, cycle, row));
+    const auto joints = rdyn::test::positions(dom, "data-joint");
+    ASSERT_EQ(joints.size(), s.joints.size());
+    for (size_t j = 0; j < s.joints.size(); ++j) {
+      EXPECT_NEAR(joints.at(s.joints[j].name).x, pose.joints[j].x, 1e-9) << s.joints[j].name << " at " << t;
+      EXPECT_NEAR(joints.at(s.joints[j].name).y, pose.joints[j].y, 1e-9) << s.joints[j].name << " at " << t;
+    }
+    for (const auto& jt : s.joints)
+      if (jt.parent == rdyn::models::kGround && jt.type == rdyn::models::JointType::Revolute) {
+        EXPECT_NEAR(joints.at(jt.name).x, jt.parent_point.x, 1e-9) << jt.name;
+        EXPECT_NEAR(joints.at(jt.name).y, jt.parent_point.y, 1e-9) << jt.name;
+      }
+    const auto loops = rdyn::test::positions(dom, "data-loop");
+    for (const auto& l : s.loops)
+      EXPECT_LT(std::hypot(loops.at(l.name + ".a").x - loops.at(l.name + ".b").x,
+                           loops.at(l.name + ".a").y - loops.at(l.name + ".b").y),
+                1e-8);
+  }
+  // Re-rendered from the summary alone: the same animation.
+  const auto again = rdyn::test::run_rdyn({"report", "v/summary.json", "--out", "again"}, dir);
+  ASSERT_EQ(again.status, 0) << again.err;
+  const std::string a = slurp(dir / "v/report.html"), b = slurp(dir / "again/report.html");
+  const auto frames = [](const std::string& html) {
+    const auto at = html.find("<script class=\"frames\"");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</script>", at) - at);
+  };
+  EXPECT_FALSE(frames(a).empty());
+  EXPECT_EQ(frames(a), frames(b));
   fs::remove_all(dir);
 }
 

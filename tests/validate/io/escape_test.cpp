@@ -30,5 +30,17 @@ TEST(Escape, CsvFieldsFollowRfc4180) {
   EXPECT_EQ(csv_field("two\nlines"), "\"two\nlines\"");
 }
 
+// RFC 4648 §10's test vectors, and bytes above 0x7f (an SVG's UTF-8 "°").
+TEST(Escape, Base64IsRfc4648) {
+  EXPECT_EQ(base64(""), "");
+  EXPECT_EQ(base64("f"), "Zg==");
+  EXPECT_EQ(base64("fo"), "Zm8=");
+  EXPECT_EQ(base64("foo"), "Zm9v");
+  EXPECT_EQ(base64("foob"), "Zm9vYg==");
+  EXPECT_EQ(base64("fooba"), "Zm9vYmE=");
+  EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+  EXPECT_EQ(base64("\xc2\xb0"), "wrA=");
+}
+
 }  // namespace
 }  // namespace rdyn::validate

@@ -107,10 +107,47 @@ TEST(MechanismDrawing, PageIsSelfContainedAndEscaped) {
   EXPECT_NE(html.find("a &lt;/script&gt;&lt;b&gt;title"), std::string::npos);
   EXPECT_EQ(html.find("http://", html.find("</svg>")), std::string::npos);  // nothing fetched
   EXPECT_EQ(html.find("src="), std::string::npos);
-  EXPECT_NE(html.find("<script id=\"frames\" type=\"application/json\">"), std::string::npos);
+  EXPECT_NE(html.find("<script class=\"frames\" type=\"application/json\">"), std::string::npos);
   MechanismFrames bad = assembled(s, in);
   bad.t_s.push_back(0);  // sizes differ
   EXPECT_THROW(animation_html(s, bad, ""), std::invalid_argument);
+}
+
+// An arrow's label sits just beyond its head, on the side the force points to (the head does not
+// hide its first letters): anchored at its start to the right, at its end to the left, hanging
+// below a head that points down.
+TEST(MechanismDrawing, ArrowLabelsSitBeyondTheHead) {
+  const auto s = models::load_scene("fourbar", {});
+  const auto in = engine::calc_assembly(engine::FullModel(s));
+  MechanismFrames f = assembled(s, in);
+  f.t_s.push_back(1), f.q.push_back(f.q[0]), f.q_joint.push_back(f.q_joint[0]);
+  f.arrows = {ForceArrow{"F", "crank", s.find_body("crank")->points.at("B"), {10.0, -10.0}, {2.0, -2.0}}};
+  for (size_t k = 0; k < 2; ++k) {
+    const std::string svg = mechanism_svg(s, f, k, "");
+    std::smatch line, text;
+    ASSERT_TRUE(std::regex_search(svg, line, std::regex("data-arrow=\"0\"[^>]* x2=\"([^\"]+)\"")));
+    ASSERT_TRUE(std::regex_search(
+        svg, text,
+        std::regex("data-arrow-label=\"0\"[^>]* x=\"([^\"]+)\"[^>]* text-anchor=\"([a-z]+)\" dominant-baseline=\"([a-z]+)\"")));
+    const double tip = std::stod(line[1]), at = std::stod(text[1]);
+    // The drawing has room for the label: its left end (0.6 em a character, the font 3 % of the
+    // drawing's size) inside the viewBox, also for the arrow pointing left out of the mechanism.
+    std::smatch vb, fs;
+    ASSERT_TRUE(std::regex_search(svg, vb, std::regex("viewBox=\"([^ ]+) ([^ ]+) ([^ ]+) ")));
+    ASSERT_TRUE(std::regex_search(svg, fs, std::regex("data-arrow-label=\"0\"[^>]* font-size=\"([^\"]+)\"")));
+    const double width = 0.6 * std::stod(fs[1]) * std::string("F 10.2 N").size();
+    EXPECT_GE(k == 0 ? at : at - width, std::stod(vb[1]));
+    EXPECT_LE(k == 0 ? at + width : at, std::stod(vb[1]) + std::stod(vb[3]));
+    if (k == 0) {
+      EXPECT_GT(at, tip);
+      EXPECT_EQ(text[2], "start");
+      EXPECT_EQ(text[3], "auto");  // pointing up: the label above its baseline
+    } else {
+      EXPECT_LT(at, tip);
+      EXPECT_EQ(text[2], "end");
+      EXPECT_EQ(text[3], "hanging");  // pointing down: the label below the head
+    }
+  }
 }
 
 }  // namespace

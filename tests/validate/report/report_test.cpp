@@ -11,6 +11,9 @@
 #include "tests/validate/run_rdyn.hpp"
 #include "tests/validate/harness/validation_fixture.hpp"
 #include "validate/harness/summary.hpp"
+#include "models/scene_write.hpp"
+#include "models/scene_yaml.hpp"
+#include <functional>
 
 namespace rdyn::validate {
 namespace {
@@ -144,12 +147,30 @@ TEST(Report, CommandReRendersAndRefusesWhatIsNotASummary) {
   auto r = test::run_rdyn({"report", "a/summary.json", "--out", "b"}, dir);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(test::slurp(dir / "a" / "report.html"), test::slurp(dir / "b" / "report.html"));
-  const std::vector<std::pair<std::string, std::string>> bad{
+  std::vector<std::pair<std::string, std::string>> bad{
       {"not_json.json", "{\"scene\": "},
       {"array.json", "[1, 2]"},
       {"runs_not_a_list.json", "{\"scene\": \"x\", \"runs\": 5}"},
       {"missing_keys.json", "{\"scene\": \"x\", \"runs\": []}"},
       {"wrong_types.json", "{\"scene\": 1, \"runs\": [{\"label\": 2}], \"quantities\": [3]}"}};
+  // Animation records edited by hand: a scene that does not read, a frame without a pose per
+  // joint, a frame time that goes back.
+  const nlohmann::json frames = {{"t_s", {0.0, 0.1}}, {"q", {0.0, 0.1}}, {"q_joint", {{0.0, 0.1, 1.5}, {0.1, 0.0, 1.5}}},
+                                 {"arrows", nlohmann::json::array()}, {"traces", nlohmann::json::array()}};
+  const nlohmann::json record = {{"title", "t"},
+                                 {"scene_yaml", models::scene_to_yaml(models::load_scene("fourbar"))},
+                                 {"start", {{"t_s", 0.0}, {"q", 0.0}, {"qdot", 1.0}, {"duration_s", 0.1}}},
+                                 {"frames", frames}};
+  auto with_animation = [&](const std::function<void(nlohmann::json&)>& edit) {
+    auto s = summary_json(test::synthetic_validation());
+    s["animation"] = record;
+    edit(s["animation"]);
+    return s.dump();
+  };
+  bad.push_back({"animation_scene.json", with_animation([](nlohmann::json& a) { a["scene_yaml"] = "bodies: ["; })});
+  bad.push_back({"animation_pose.json", with_animation([](nlohmann::json& a) { a["frames"]["q_joint"][1] = {0.1}; })});
+  bad.push_back({"animation_time.json", with_animation([](nlohmann::json& a) { a["frames"]["t_s"] = {0.1, 0.0}; })});
+  bad.push_back({"animation_null.json", with_animation([](nlohmann::json& a) { a["frames"]["q_joint"][0][0] = nullptr; })});
   for (const auto& [name, text] : bad) {
     std::ofstream(dir / name) << text;
     r = test::run_rdyn({"report", name, "--out", "c"}, dir);
