@@ -569,22 +569,22 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   if (!direct || far_from_guesses(m, s)) {
     State walked = guesses;
     const Walk walk = assemble_by_continuation(m, walked);
+    // Through a singular configuration along the guesses' branch, as the extraction and the
+    // dynamics continue (follow_branch: the chord of the last move there, the smooth
+    // continuation, not the branch that crosses); where that fails, the start's branch is not
+    // determined by the guesses: refused unless a loop names it.
+    const State direct_state = s;
     if (walk == Walk::Reached) {
       s = walked;
+    } else if (walk == Walk::SingularBetween && continue_through_singularity(model, *this, guesses)) {
+      // s holds the start on the guesses' branch
     } else if (!direct) {
       s = guesses;  // report the direct attempt's gap
       assemble(m, s, true);
     } else if (walk == Walk::SingularBetween) {
-      // Through the singular configuration along the guesses' branch, as the extraction and the
-      // dynamics continue (follow_branch: the chord of the last move there, the smooth
-      // continuation, not the branch that crosses); where that fails, the start's branch is not
-      // determined by the guesses: refused unless a loop names it.
-      const State direct_state = s;
-      if (!continue_through_singularity(model, *this, guesses)) {
-        s = direct_state;
-        wrap_to_guesses(m, s);
-        refuse_branch_across_singularity(m, s, walked);
-      }
+      s = direct_state;
+      wrap_to_guesses(m, s);
+      refuse_branch_across_singularity(m, s, walked);
     }
   }
   wrap_to_guesses(m, s);

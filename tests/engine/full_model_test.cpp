@@ -152,7 +152,7 @@ TEST(FullModelAssembly, FarGuessesNearAFlatConfigurationWalkToTheStart) {
   // Starts across a flat configuration from the guesses' 90° (−30°, 180.1°, −179.99°, 270°): the
   // walk continues through it along the guesses' branch (follow_branch); the direct assembly
   // landed folded there (crank1 at 180°) with only a far-from-guess warning.
-  for (double deg : {0.5, 0.1, 0.01, 0.003, 179.9, 45.0, 270.0, -30.0, 180.1, -179.99}) {
+  for (double deg : {0.5, 0.1, 0.01, 0.003, 179.9, 45.0, 270.0, -30.0, 180.1, -179.99, -0.1, -0.01, 359.99}) {
     const auto scene =
         models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", fmt::format("{}", deg)}});
     const Inspection a = calc_assembly(FullModel(scene));
@@ -165,11 +165,22 @@ TEST(FullModelAssembly, FarGuessesNearAFlatConfigurationWalkToTheStart) {
     EXPECT_NEAR(std::remainder(angle("crank1") - angle("crank0"), 2 * kPi), 0, 1e-9) << deg << "°";
     EXPECT_NEAR(std::remainder(angle("coupler0"), 2 * kPi), 0, 1e-9) << deg << "°";
     for (const auto& j : a.joints)  // the independent coordinate is the initial q as given
-      if (j.name != "crank0") EXPECT_LE(std::abs(j.q - j.guess), kPi + 1e-12) << j.name << " at " << deg << "°";
+      if (j.name != "crank0") {
+        EXPECT_LE(std::abs(j.q - j.guess), kPi + 1e-12) << j.name << " at " << deg << "°";
+      }
   }
-  const auto across = models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", "-0.1"}});
-  const std::string m = refusal(across);
-  EXPECT_TRUE(has(m, "guesses describe the configuration at this q")) << m;
+  // Starts on a flat configuration itself, by any label of it: the singular-start refusal.
+  for (const char* deg : {"0", "360", "-180", "540"}) {
+    const auto flat = models::load_scene(RDYN_SCENES "/chains/chain-1.yaml", {{"initial.q_deg", deg}});
+    try {
+      FullModel model(flat);
+      FullWorkspace ws(model);
+      ADD_FAILURE() << deg << "° accepted";
+    } catch (const models::SceneError& e) {
+      EXPECT_EQ(e.field(), "initial") << deg;
+      EXPECT_TRUE(has(e.what(), "starts at a singular configuration")) << e.what();
+    }
+  }
 }
 
 // A point force whose points coincide where the mechanism assembles has no direction: refused

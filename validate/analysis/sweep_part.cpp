@@ -164,9 +164,14 @@ SweepPart parse_sweep_part(const std::string& text, const std::string& file) {
   if (records.empty()) throw models::SceneError(file, 2, "header", "no column header");
   if (cut) throw models::SceneError(file, records.back().line, "row", "the file is cut short (no final line break)");
   const Record& head = records.front();
-  // case, the axes, status and its seven columns: at least one axis.
+  // case, the axes (at least one), status and the result columns (six of a calibrating sweep,
+  // seven of a drive sweep, the last `error`): status is the last field of that name.
   const size_t n = head.fields.size();
-  if (n < 9 || head.fields[0] != "case" || head.fields[n - 7] != "status")
+  size_t status_at = 0;
+  for (size_t k = 0; k < n; ++k)
+    if (head.fields[k] == "status") status_at = k;
+  if (head.fields.empty() || head.fields[0] != "case" || status_at < 2 || n - status_at < 7 || n - status_at > 8 ||
+      head.fields[n - 1] != "error")
     throw models::SceneError(file, head.line, "header", "expected case,<axes>,status,… as written by rdyn sweep");
   p.header = head.text;
   long previous = p.range.first - 1;
@@ -181,7 +186,7 @@ SweepPart parse_sweep_part(const std::string& text, const std::string& file) {
     if (c < p.range.first || c >= p.range.end)
       fail("case", fmt::format("case {} is outside this part's cases {}-{}", c, p.range.first, p.range.end));
     if (c <= previous) fail("case", fmt::format("case {} after case {}: rows out of order or doubled", c, previous));
-    const std::string& status = r.fields[n - 7];
+    const std::string& status = r.fields[status_at];
     if (status != "ok" && status != "error") fail("status", "expected ok or error, got '" + status + "'");
     if (status == "error") ++p.failed;
     previous = c;

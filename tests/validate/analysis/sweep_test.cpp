@@ -1,5 +1,6 @@
 // Sweeps: the cartesian product of the axes, sharded into blocks whose CSVs concatenate.
 #include "validate/analysis/sweep.hpp"
+#include "validate/analysis/sweep_part.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -240,6 +241,19 @@ TEST(Sweep, DriveSweepFollowsItsClosedForm) {
   const SweepPlan plan = plan_sweep(o);
   EXPECT_EQ(run_sweep_case(plan, 4), rows[5]);
   EXPECT_THROW(run_sweep_case(plan, 6), models::SceneError);
+  // Its shards merge into the whole sweep (its header has one result column more than a
+  // calibrating sweep's: --merge and --resume refused every drive part).
+  const SweepResult whole = run_sweep(o);
+  std::vector<SweepPart> parts;
+  for (int i = 0; i < 3; ++i) {
+    SweepOptions shard = o;
+    shard.shard = i;
+    shard.shards = 3;
+    parts.push_back(parse_sweep_part(run_sweep(shard).csv, "part" + std::to_string(i) + ".csv"));
+  }
+  const MergedSweep merged = merge_sweep_parts(parts);
+  EXPECT_EQ(merged.cases, 6);
+  EXPECT_EQ(merged.csv.substr(merged.csv.find('\n')), whole.csv.substr(whole.csv.find('\n')));
   // A drive sweep calibrates nothing: with a calibration option it is refused before work.
   SweepOptions both = o;
   both.cadence_hz = 1.0;
