@@ -19,6 +19,11 @@
 
 namespace rdyn::validate {
 
+// The --set K=V overrides parsed (SceneError naming the malformed one), and the scene loaded
+// with them: what every subcommand does first (commands.cpp, validate_command.cpp).
+std::vector<models::Override> overrides_of(const std::vector<std::string>& sets);
+models::Scene load(const std::string& scene, const std::vector<std::string>& sets);
+
 struct SimulateArgs {
   std::string scene;
   std::string model = "full";  // full | reduced

@@ -10,6 +10,7 @@
 
 #include "validate/io/escape.hpp"
 #include "validate/report/drive_figure.hpp"
+#include "validate/report/report_tables.hpp"
 #include "validate/io/output_dir.hpp"
 #include "validate/io/run_program.hpp"
 
@@ -19,35 +20,7 @@ namespace {
 
 using json = nlohmann::json;
 
-// A number of the summary; NaN for null or a missing key ("not measured").
-double d(const json& j, const char* key) {
-  if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return NAN;
-  return j[key].get<double>();
-}
-std::string str(const json& j, const char* key) {
-  return j.is_object() && j.contains(key) && j[key].is_string() ? j[key].get<std::string>()
-                                                                : std::string();
-}
-double error_of(const json& run, const std::string& q) {
-  if (!run.is_object() || !run.contains("errors") || !run.at("errors").contains(q)) return NAN;
-  return d(run.at("errors")[q], "max_rel");
-}
-
-// Scene-given text in HTML.
-std::string H(const std::string& s) { return html_escape(s); }
-
-// A number in `spec`, or "n/a" when the summary has none (never "nan" in an output).
-std::string num(double x, const char* spec = "{:g}") {
-  return std::isfinite(x) ? fmt::format(fmt::runtime(spec), x) : "n/a";
-}
-
-std::string pct(double x) { return std::isfinite(x) ? fmt::format("{:.3g} %", 100 * x) : "n/a"; }
-std::string secs(double s) {
-  if (!std::isfinite(s)) return "n/a";
-  if (s >= 1) return fmt::format("{:.3g} s", s);
-  if (s >= 1e-3) return fmt::format("{:.3g} ms", s * 1e3);
-  return fmt::format("{:.3g} µs", s * 1e6);
-}
+using namespace report_format;
 
 // A cost for the run as simulated, and per simulated second only when at least a second was
 // simulated (summary "per_second_measured").
@@ -565,20 +538,7 @@ std::string headline(const json& s) {
 
 std::string render_html(const json& s, const std::map<std::string, std::string>& figures) {
   std::string h;
-  h += "<!DOCTYPE html><html lang=en><head><meta charset='utf-8'><title>rdyn validation: " +
-       H(str(s, "scene")) + "</title>";
-  h += "<style>body{font-family:sans-serif;max-width:1000px;margin:2em auto;padding:0 "
-       "1em;line-height:1.45;color:#222}"
-       "h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ccc}"
-       "table{border-collapse:collapse;font-size:.85em;margin:.5em 0}td,th{border:1px solid "
-       "#ccc;padding:2px 6px;"
-       "text-align:right}th{background:#f3f3f3}td.l{text-align:left}.lead{font-size:1.02em;"
-       "background:#f6f9ff;"
-       "padding:.8em;border-left:4px solid "
-       "#1f77b4}.warn{color:#a00}.pass{color:#070;font-weight:bold}.fail{color:#a00;"
-       "font-weight:bold}svg{max-width:100%;height:auto}code{background:#f3f3f3;padding:0 "
-       "3px}summary{cursor:pointer;"
-       "font-weight:bold}</style></head><body>";
+  h += html_head(str(s, "scene"));
   const bool pass = str(s, "status") == "pass";
   h += "<h1>rdyn validation: " + H(str(s, "scene")) +
        " — <span class=" + (pass ? "pass>pass" : "fail>FAIL") + "</span></h1>";
@@ -638,58 +598,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   h += " Below that floor an error measures the reference, not the table.</p>";
   if (s.contains("calibration")) h += calibration_section(s);
   if (s.contains("drive_cycle")) h += drive_cycle_section(s.at("drive_cycle"), figures);
-  if (!s.at("thresholds").empty()) {
-    h += "<h2>Acceptance thresholds</h2>";
-    if (s.value("thresholds_are_defaults", false))
-      h += "<p>The scene declares no thresholds: it is judged against the defaults (docs/scene-format.md, "
-           "\"Validation settings\").</p>";
-    h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
-         "th><th>run</th>"
-         "<th></th></tr>";
-    for (const auto& t : s.at("thresholds")) {
-      const bool p = t.value("pass", false);
-      h += fmt::format(
-          "<tr><td class=l>{}</td><td>{}°</td><td>{}</td><td>{}</td><td class=l>{}</td><td "
-          "class={}>{}</td>"
-          "</tr>",
-          H(str(t, "quantity")), num(d(t, "grid_deg")), pct(d(t, "max_error")), pct(d(t, "error")),
-          H(str(t, "run")), p ? "pass" : "fail", p ? "pass" : "FAIL");
-    }
-    h += "</table>";
-  }
-  h += fmt::format(
-      "<details><summary>All {} runs</summary><p>Median wall time of repeated runs (repeated until "
-      "a minimum "
-      "wall time) for the run as simulated; errors are maxima over the compared window relative to "
-      "the "
-      "reference's peak (RMS in <code>runs.csv</code>). ★: on the Pareto front of its model.</p>"
-      "<table><tr><th>run</th><th>wall time</th><th>repeats</th><th>steps</th><th>energy "
-      "residual</th>",
-      s.at("runs").size());
-  for (const auto& q : s.at("quantities")) h += "<th>" + H(q.get<std::string>()) + "</th>";
-  h += "</tr>";
-  for (const auto& r : s.at("runs")) {
-    if (!str(r, "failure").empty()) {
-      h += fmt::format("<tr><td class=l>{}</td><td class=l colspan={}>stopped: {}</td></tr>",
-                       H(str(r, "label")), 4 + s.at("quantities").size(), H(str(r, "failure")));
-      continue;
-    }
-    h += fmt::format("<tr><td class=l>{}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>",
-                     r.value("pareto", false) ? "★ " : "", H(str(r, "label")), secs(d(r, "wall_s")),
-                     r.value("repeats", 0), r.value("steps", 0L),
-                     num(d(r, "energy_balance_residual_rel"), "{:.1e}"));
-    for (const auto& q : s.at("quantities"))
-      h += "<td>" + num(error_of(r, q.get<std::string>()), "{:.2e}") + "</td>";
-    h += "</tr>";
-  }
-  h += "</table></details><h2>Extraction "
-       "cost</h2><table><tr><th>grid</th><th>points</th><th>kinetostatic calls</th>"
-       "<th>time</th></tr>";
-  for (const auto& e : s.at("extractions"))
-    h += fmt::format("<tr><td>{}°</td><td>{}</td><td>{}</td><td>{} ms</td></tr>",
-                     num(d(e, "grid_deg")), e.value("points", 0), e.value("kinetostatic_calls", 0L),
-                     num(d(e, "ms"), "{:.3g}"));
-  h += "</table>";
+  h += thresholds_table(s) + runs_table(s) + extraction_table(s);
   h += "<h2>Files</h2><p><code>summary.json</code> (every number above and the data of every "
        "figure; the report is "
        "rendered from it alone), <code>runs.csv</code>, and for each figure its data "

@@ -1,0 +1,81 @@
+// `rdyn drive` (validate/cli/drive_command.cpp): its outputs, statistics from rows at most 1°
+// apart whatever --dt-out, and the command's contract.
+#include "validate/cli/drive_command.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/validate/run_rdyn.hpp"
+
+namespace rdyn::validate {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rdyn_drive_cli_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto run = [&](std::vector<std::string> args) { return test::run_rdyn(args, dir); };
+  // Statistics come from rows at most 1° apart whatever --dt-out: 0.5 s rows of a 1 rev/s run.
+  auto r = run({"drive", RDYN_SCENES "/hard/parallelogram.yaml", "--cadence-hz", "1", "--duration", "2", "--dt-out",
+                "0.5", "--model", "reduced", "--out", "coarse"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto c = nlohmann::json::parse(test::slurp(dir / "coarse" / "run.json"));
+  const double kp = 9.81 * 0.18;
+  EXPECT_NEAR(c["drive_peak"].get<double>(), kp, 1e-4 * kp);
+  EXPECT_NEAR(c["drive_rms"].get<double>(), kp / std::sqrt(2.0), 1e-4 * kp);
+  const std::string coarse = test::slurp(dir / "coarse" / "timeseries.csv");
+  EXPECT_EQ(std::count(coarse.begin(), coarse.end(), '\n'), 6);  // header + 0, 0.5, 1, 1.5, 2
+  r = run({"drive", "fourbar", "--cadence-hz", "2", "--out", "out"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(test::slurp(dir / "out" / "run.json"));
+  EXPECT_EQ(j["drive_unit"], "N·m");
+  EXPECT_DOUBLE_EQ(j["duration_s"].get<double>(), 0.5);  // one revolution by default
+  EXPECT_TRUE(j["constraint_force_peaks_N"].contains("rocker_axial"));
+  const std::string csv = test::slurp(dir / "out" / "timeseries.csv");
+  EXPECT_EQ(csv.rfind("t,q,qdot,qddot,drive_Nm,drive_W,F_rocker_axial\n", 0), 0u);
+  EXPECT_FALSE(j.contains("motor_check"));
+  // --motor: run.json says whether the line covers the drive, and by how much (the margin's
+  // closed form is the test above); the message says it in words.
+  r = run({"drive", RDYN_SCENES "/hard/parallelogram.yaml", "--cadence-hz", "1", "--motor", "1,20", "--out", "weak"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto weak = nlohmann::json::parse(test::slurp(dir / "weak" / "run.json"))["motor_check"];
+  EXPECT_FALSE(weak["covers"].get<bool>());
+  EXPECT_NEAR(weak["min_margin"].get<double>(), 1 - 2 * M_PI / 20 - kp, 1e-3 * kp);
+  EXPECT_NE(r.err.find("does NOT cover the drive"), std::string::npos) << r.err;
+  // Bad input is exit 2 before any output: neither or both motions, a zero or infinite rate,
+  // a constant rate for a slider, a missing profile.
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"drive", "fourbar", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "1", "--profile", "p.csv", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "0", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "inf", "--out", "o2"},
+           {"drive", "slider-crank-slider", "--cadence-hz", "1", "--out", "o2"},
+           {"drive", "fourbar", "--profile", "missing.csv", "--out", "o2"},
+           {"drive", "fourbar", "--profile", "/dev/zero", "--out", "o2"},  // never ends: refused unread
+           {"drive", "fourbar", "--cadence-hz", "1", "--duration", "0.5", "--dt-out", "1", "--out", "o2"},
+           {"drive", "fourbar", "--cadence-hz", "1000", "--duration", "10", "--out", "o2"},  // hours of moves
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5", "--out", "o2"},       // one number
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5,-20", "--out", "o2"},   // two signs
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "0x5,20", "--out", "o2"},  // not decimal
+           {"drive", "fourbar", "--cadence-hz", "1", "--motor", "5,0", "--out", "o2"}}) {
+    r = run(args);
+    EXPECT_EQ(r.status, 2) << args[2] << " " << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o2")) << args[2];
+  }
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

@@ -1,0 +1,62 @@
+// The report's tables and formatting (validate/report/report_tables.cpp): numbers the summary does
+// not hold are "n/a", never "nan"; scene-given text is escaped; verdicts are classed.
+#include "validate/report/report_tables.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+namespace rdyn::validate {
+namespace {
+
+using nlohmann::json;
+using namespace report_format;
+
+TEST(ReportTables, MissingNumbersAreNotAvailableAndUnitsScale) {
+  EXPECT_EQ(num(NAN), "n/a");
+  EXPECT_EQ(pct(INFINITY), "n/a");
+  EXPECT_EQ(secs(NAN), "n/a");
+  EXPECT_EQ(pct(0.0123), "1.23 %");
+  EXPECT_EQ(secs(2.5), "2.5 s");
+  EXPECT_EQ(secs(2.5e-3), "2.5 ms");
+  EXPECT_EQ(secs(2.5e-6), "2.5 µs");
+  const json j = {{"a", 1.5}, {"b", nullptr}, {"t", "x"}};
+  EXPECT_EQ(d(j, "a"), 1.5);
+  EXPECT_TRUE(std::isnan(d(j, "b")));
+  EXPECT_TRUE(std::isnan(d(j, "missing")));
+  EXPECT_EQ(str(j, "t"), "x");
+  EXPECT_EQ(str(j, "a"), "");
+  const json run = {{"errors", {{"q", {{"max_rel", 2e-6}}}}}};
+  EXPECT_EQ(error_of(run, "q"), 2e-6);
+  EXPECT_TRUE(std::isnan(error_of(run, "qdot")));
+}
+
+TEST(ReportTables, ScenesTextIsEscapedAndVerdictsAreClassed) {
+  const json s = {
+      {"thresholds",
+       {{{"quantity", "F_<b>"}, {"grid_deg", 10}, {"max_error", 0.01}, {"error", 0.02}, {"run", "r&1"}, {"pass", false}},
+        {{"quantity", "q"}, {"grid_deg", 5}, {"max_error", 0.01}, {"error", 0.001}, {"run", "r2"}, {"pass", true}}}},
+      {"quantities", {"q"}},
+      {"runs",
+       {{{"label", "<script>x</script>"}, {"wall_s", 0.002}, {"repeats", 3}, {"steps", 40},
+         {"energy_balance_residual_rel", 1e-9}, {"errors", {{"q", {{"max_rel", 3e-5}}}}}, {"pareto", true}},
+        {{"label", "stopped"}, {"failure", "budget <exceeded>"}}}},
+      {"extractions", {{{"grid_deg", 10}, {"points", 36}, {"kinetostatic_calls", 40}, {"ms", 3.3}}}}};
+  const std::string t = thresholds_table(s);
+  EXPECT_NE(t.find("F_&lt;b&gt;"), std::string::npos) << t;
+  EXPECT_NE(t.find("r&amp;1"), std::string::npos) << t;
+  EXPECT_NE(t.find("class=fail>FAIL"), std::string::npos) << t;
+  EXPECT_NE(t.find("class=pass>pass"), std::string::npos) << t;
+  EXPECT_EQ(thresholds_table(json{{"thresholds", json::array()}}), "");
+  const std::string r = runs_table(s);
+  EXPECT_EQ(r.find("<script>"), std::string::npos) << r;
+  EXPECT_NE(r.find("★ &lt;script&gt;"), std::string::npos) << r;
+  EXPECT_NE(r.find("stopped: budget &lt;exceeded&gt;"), std::string::npos) << r;
+  EXPECT_NE(r.find("3.00e-05"), std::string::npos) << r;
+  EXPECT_NE(extraction_table(s).find("<td>36</td><td>40</td><td>3.3 ms</td>"), std::string::npos);
+  EXPECT_NE(html_head("a<b").find("<title>rdyn validation: a&lt;b</title>"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rdyn::validate

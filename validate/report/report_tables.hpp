@@ -1,0 +1,37 @@
+// Pieces of the validation report's HTML drawn from summary.json (validate/report/report.cpp): the
+// page head, the acceptance-threshold, run and extraction tables, and the formatting every piece
+// shares (numbers never "nan": "n/a"; scene text escaped).
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace rdyn::validate {
+
+namespace report_format {
+using json = nlohmann::json;
+// A number of the summary; NaN for null or a missing key ("not measured").
+double d(const json& j, const char* key);
+// A text of the summary; empty for null or a missing key.
+std::string str(const json& j, const char* key);
+// A run's largest error of quantity q relative to its peak; NaN when it has none.
+double error_of(const json& run, const std::string& q);
+// Scene-given text in HTML.
+std::string H(const std::string& s);
+// A number in `spec`, or "n/a" when the summary has none.
+std::string num(double x, const char* spec = "{:g}");
+std::string pct(double x);
+std::string secs(double s);
+}  // namespace report_format
+
+// <!DOCTYPE html> … <body>: the title naming the scene and the page's style.
+std::string html_head(const std::string& scene);
+// The thresholds with their verdicts ("" when the summary has none).
+std::string thresholds_table(const nlohmann::json& summary);
+// Every run with its cost and errors, the Pareto front starred, stopped runs with their reason.
+std::string runs_table(const nlohmann::json& summary);
+// The extractions' grids, points, kinetostatic calls and times.
+std::string extraction_table(const nlohmann::json& summary);
+
+}  // namespace rdyn::validate
