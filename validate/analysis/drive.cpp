@@ -186,11 +186,11 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
       // Simbody's projection text says nothing a user can act on: the motion asks for a
       // configuration the mechanism does not have.
       throw engine::EngineError(fmt::format(
-          "{}: the prescribed motion reaches {} = {:.9g} {} at t = {:.6g} s, where the mechanism cannot be assembled "
+          "{}: the prescribed motion reaches {} = {:.9g}{} at t = {:.6g} s, where the mechanism cannot be assembled "
           "(past a dead point or the end of its range, or a loop that cannot close there); keep the motion inside "
           "the range `rdyn inspect` reports",
           scene.source_file, scene.independent, revolute ? motion.q[i] * 180 / M_PI : motion.q[i],
-          revolute ? "°" : "m", motion.t[i]));
+          revolute ? "°" : " m", motion.t[i]));
     }
     // At a singular configuration the velocity projection itself may fail (a profile starting on
     // an isosceles slider-crank's folded position): nothing is asked of the model there but the
