@@ -17,6 +17,7 @@
 #include "engine/inspect.hpp"
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
+#include "engine_refusal.hpp"
 #include "test_scenes.hpp"
 
 namespace rdyn::engine {
@@ -24,18 +25,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The message of the EngineError that building a workspace of `scene` throws ("" if none).
-std::string refusal(const models::Scene& scene) {
-  try {
-    FullModel model(scene);
-    FullWorkspace ws(model);
-  } catch (const EngineError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using test::has;
+using test::refusal;
 
 // The bicycle's right knee with three requests: along the shank (the shipped one), across it
 // (+90°) and at +45°.

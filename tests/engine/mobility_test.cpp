@@ -18,23 +18,14 @@
 #include "engine/inspect.hpp"
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
+#include "engine_refusal.hpp"
 #include "test_scenes.hpp"
 
 namespace rdyn::engine {
 namespace {
 
-// The message of the EngineError that building a workspace of `scene` throws ("" if none).
-std::string refusal(const models::Scene& scene) {
-  try {
-    FullModel model(scene);
-    FullWorkspace ws(model);
-  } catch (const EngineError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using test::has;
+using test::refusal;
 
 // Parallelogram A-B-C-D (as test_scenes.hpp) with a third link E→E' parallel to the crank,
 // from ground E (0.15, 0) to the coupler's midpoint: on the parallelogram branch it moves with
