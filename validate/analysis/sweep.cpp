@@ -168,13 +168,17 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   const long chunks = static_cast<long>(order.chunks.size()) - 1;
 
   std::vector<std::string> rows(n);
-  std::atomic<long> next{0}, done{0}, failed{0}, tables{0};
+  std::atomic<long> next{0}, done{0}, failed{0}, tables{0}, walks{0};
   auto work = [&] {
     Progress quiet(false);
     // The last table this thread extracted, by table_key: cases that differ only in load
     // values, resistance coefficients, cadence or power share it (calibrate's extraction and
     // fit are 3/4 of a case; run_order puts the cases of one mechanism next to each other).
     std::optional<std::pair<std::string, CalibrationTable>> last;
+    // The last table's neighbour record (issue #28 item 3): a next table of the same topology
+    // whose neighbour stayed far from rank loss skips the dead-point walk when its own sweep
+    // does too. Cleared by a failed extraction, so the case after a failure walks.
+    std::optional<TableNeighbour> neighbour;
     for (long c; (c = next.fetch_add(1)) < chunks;) {
       for (long k = order.chunks[c]; k < order.chunks[c + 1]; ++k) {
         const long index = order.cases[k];
@@ -194,7 +198,11 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
           if (!last || last->first != key) {
             last.reset();  // a failed extraction leaves none
             ++tables;
-            last.emplace(key, extract_calibration_table(scene, copt));
+            auto previous = std::move(neighbour);
+            neighbour.reset();
+            last.emplace(key, extract_calibration_table(scene, copt, previous));
+            neighbour = neighbour_of(scene, last->second);
+            if (last->second.walked) ++walks;
           }
           const auto r = calibrate(scene, last->second, copt, quiet);
           // No constraint force requested: an empty field, never NaN.
@@ -221,6 +229,7 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   r.failed = failed.load();
   r.threads = threads;
   r.tables = tables.load();
+  r.walks = walks.load();
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
