@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -307,42 +308,59 @@ BENCHMARK(BM_CalibrationWithoutFullCheck)->Unit(benchmark::kMillisecond);
 // table) in one thread, as the sweep runs it: the scene (load_scene with the override, the
 // bicycle-leg generator), the Simbody system build, the dead-point walk (assembly and
 // calc_independent_domain), the 10° extraction, the table fit and the reduced calibration.
+// Arg 0: the walk with the singular-point scan (before the edges-only walk); Arg 1: the cold
+// route (edges-only walk before every extraction); Arg 2: what the sweep runs now, continuation
+// in the parameters — extract_calibration_table with the previous case's neighbour record (the
+// walk only where a case's own sweep or its neighbour's comes near rank loss) — whose build,
+// walk, extraction and fit are one stage, "table"; `walks` counts the cases that walked.
 void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
   auto now = [] {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
   };
-  const std::vector<std::string> names{"scene", "build", "walk", "extraction", "fit", "reduced", "case"};
+  const bool continued = st.range(0) == 2;
+  const std::vector<std::string> names =
+      continued ? std::vector<std::string>{"scene", "table", "reduced", "case"}
+                : std::vector<std::string>{"scene", "build", "walk", "extraction", "fit", "reduced", "case"};
   std::vector<std::vector<double>> ms(names.size());
   constexpr int kCases = 20;
-  for (auto _ : st)
+  long walks = 0;
+  for (auto _ : st) {
+    std::optional<validate::TableNeighbour> neighbour;
     for (int k = 0; k < kCases; ++k) {
       const double h = 1.6 + 0.3 * k / (kCases - 1);
-      double t[7];
-      t[0] = now();
+      std::vector<double> t{now()};
       const auto scene = models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", std::to_string(h)}});
       validate::CalibrationOptions o = validate::calibration_options_of(scene, 0.0, 0.0, "");
       o.full_max_s = 0.0;
-      t[1] = now();
-      const engine::FullModel model(scene);
-      t[2] = now();
-      { const engine::FullWorkspace assembled(model); }
-      benchmark::DoNotOptimize(st.range(0) == 0 ? engine::calc_independent_domain(model).periodic
-                                                : engine::calc_independent_domain_edges(model).periodic);
-      t[3] = now();
-      auto e = validate::extract_from_full(model, o.grid_deg, reduced::Method::Kinetostatic);
-      t[4] = now();
+      t.push_back(now());
       validate::CalibrationTable table;
-      table.table = reduced::build_table(e.samples, reduced::parse_interpolation(o.interpolation));
-      table.samples = std::move(e.samples);
-      t[5] = now();
+      if (continued) {
+        table = validate::extract_calibration_table(scene, o, neighbour);
+        neighbour = validate::neighbour_of(scene, table);
+        walks += table.walked ? 1 : 0;
+        t.push_back(now());
+      } else {
+        const engine::FullModel model(scene);
+        t.push_back(now());
+        { const engine::FullWorkspace assembled(model); }
+        benchmark::DoNotOptimize(st.range(0) == 0 ? engine::calc_independent_domain(model).periodic
+                                                  : engine::calc_independent_domain_edges(model).periodic);
+        t.push_back(now());
+        auto e = validate::extract_from_full(model, o.grid_deg, reduced::Method::Kinetostatic);
+        t.push_back(now());
+        table.table = reduced::build_table(e.samples, reduced::parse_interpolation(o.interpolation));
+        table.samples = std::move(e.samples);
+        t.push_back(now());
+      }
       validate::Progress quiet(false);
       benchmark::DoNotOptimize(validate::calibrate(scene, table, o, quiet).load_value);
-      t[6] = now();
+      t.push_back(now());
       for (size_t i = 0; i + 1 < names.size(); ++i) ms[i].push_back(t[i + 1] - t[i]);
-      ms.back().push_back(t[6] - t[0]);
+      ms.back().push_back(t.back() - t.front());
     }
+  }
   for (size_t i = 0; i < names.size(); ++i) {
     auto v = ms[i];
     std::sort(v.begin(), v.end());
@@ -350,8 +368,9 @@ void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
     st.counters[names[i] + "_ms_min"] = v.front();
     st.counters[names[i] + "_ms_max"] = v.back();
   }
+  if (continued) st.counters["walks"] = static_cast<double>(walks) / static_cast<double>(st.iterations());
 }
-BENCHMARK(BM_SweepCaseStagesOverHeight)->Arg(0)->Arg(1)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SweepCaseStagesOverHeight)->Arg(0)->Arg(1)->Arg(2)->Iterations(3)->Unit(benchmark::kMillisecond);
 
 // Building the fused table with `fourier` interpolation (trigonometric interpolant resampled
 // at ≤ 0.25° into the cubic table) from synthetic samples with the bicycle's 21 columns; the

@@ -604,7 +604,40 @@ CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const mo
   return r;
 }
 
+namespace {
+
+CalibrationTable table_of(Extraction e, const CalibrationOptions& opt, bool walked) {
+  CalibrationTable t;
+  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
+  t.samples = std::move(e.samples);
+  t.walked = walked;
+  return t;
+}
+
+}  // namespace
+
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
+  return extract_calibration_table(scene, opt, std::nullopt);
+}
+
+std::string topology_key(const models::Scene& scene) {
+  std::string key = fmt::format("{}:{}|", scene.independent.size(), scene.independent);
+  auto str = [&](const std::string& s) { key += fmt::format("{}:{},", s.size(), s); };
+  for (const auto& j : scene.joints) str(j.name), str(j.parent), str(j.child), key += std::to_string(static_cast<int>(j.type));
+  key += "|";
+  for (const auto& l : scene.loops) str(l.name), str(l.body_a), str(l.body_b);
+  key += "|";
+  for (const auto& g : scene.gears) str(g.driver), str(g.driven);
+  return key;
+}
+
+std::optional<TableNeighbour> neighbour_of(const models::Scene& scene, const CalibrationTable& table) {
+  if (!table.samples.periodic) return std::nullopt;
+  return TableNeighbour{topology_key(scene), table.samples.min_conditioning};
+}
+
+CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt,
+                                           const std::optional<TableNeighbour>& neighbour) {
   // Dead points are looked for twice, because each route alone misses some: the domain walk
   // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts)
   // and the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over
@@ -612,13 +645,31 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
   // extraction (2.9 ms on the bicycle); sweeps pay it once per table. One system serves both.
   check_calibration_input(scene, opt);
   const engine::FullModel model(scene);
-  check_full_turn(scene, model);
-  auto e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+  const bool continued = neighbour && neighbour->min_conditioning >= kWalkSkipConditioning &&
+                         neighbour->topology == topology_key(scene);
+  if (!continued) {
+    check_full_turn(scene, model);
+    auto e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+    if (e.range || !e.samples.periodic) fail_dead_points(scene);
+    return table_of(std::move(e), opt, true);
+  }
+  // Continuation from a neighbour far from dead points: the extraction first, the walk only
+  // where this case's own sweep gives a reason (a failure, a dead point, a grid sample nearer
+  // rank loss than kWalkSkipConditioning or than kWalkSkipDrop of the neighbour's). Its errors
+  // come after the walk's, as in the cold route.
+  Extraction e;
+  try {
+    e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+  } catch (...) {
+    check_full_turn(scene, model);
+    throw;
+  }
+  const double c = e.samples.min_conditioning;
+  const bool walk = e.range || !e.samples.periodic || !(c >= kWalkSkipConditioning) ||
+                    !(c >= kWalkSkipDrop * neighbour->min_conditioning);
+  if (walk) check_full_turn(scene, model);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
-  CalibrationTable t;
-  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
-  t.samples = std::move(e.samples);
-  return t;
+  return table_of(std::move(e), opt, walk);
 }
 
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {

@@ -10,11 +10,13 @@
 // GSL Brent on the load value (each value a steady-cycle search) inside a secant on ln c.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "models/scene.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/extract.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/samples.hpp"
 #include "reduced/table.hpp"
@@ -130,8 +132,47 @@ CalibrationResult calibrate_reduced(const reduced::ReducedModel& m, const models
 struct CalibrationTable {
   reduced::Samples samples;
   reduced::Table table;
+  bool walked = true;  // the dead-point walk ran (false: its neighbour's continuation stood in for it)
 };
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt);
+
+// A sweep's previous table on its thread (issue #28 item 3, continuation in the parameters):
+// what the next case needs to know to skip the dead-point walk.
+struct TableNeighbour {
+  std::string topology;           // topology_key of its scene
+  double min_conditioning = 0.0;  // the smallest loop conditioning over its grid samples
+};
+
+// The joints, loops, gears and independent joint by name and kind, without any number: two
+// scenes of a sweep over sizes, masses or positions share it; one whose axis adds a leg does not.
+std::string topology_key(const models::Scene& scene);
+
+// The neighbour a table leaves for the next case of a sweep (a periodic table only; none
+// otherwise, so the next case walks).
+std::optional<TableNeighbour> neighbour_of(const models::Scene& scene, const CalibrationTable& table);
+
+// When a case may skip the dead-point walk: its neighbour's and its own smallest grid
+// conditioning at least kWalkSkipConditioning, and its own at least kWalkSkipDrop of the
+// neighbour's. A dead point is rank loss of the loop Jacobian (conditioning 0), and the
+// conditioning rises like the square root of the distance from it, so a blocked range hiding
+// between two grid points pulls the grid samples beside it down. The floor is the extraction's
+// own (reduced::kScanBelowConditioning: below it rank loss may lie between grid points, and it
+// scans); the drop catches a dead point approaching as the parameter changes. A heuristic, not a
+// proof: measured, the narrow blocked four-bar whose 20° sweep closes over its blocked range
+// shows 0.016–0.020 after free-turning neighbours at 0.065–0.26; the bicycle 0.060 at every
+// rider height of 1.5–2.0 m (tests/validate/analysis/calibrate_test.cpp).
+inline constexpr double kWalkSkipConditioning = reduced::kScanBelowConditioning;
+inline constexpr double kWalkSkipDrop = 0.5;
+
+// extract_calibration_table for a sweep's next case. With a neighbour of the same topology whose
+// grid stayed at or above kWalkSkipConditioning, the extraction runs first and the walk only
+// when it fails, meets a dead point, or its own grid comes below kWalkSkipConditioning or below
+// kWalkSkipDrop of the neighbour's: the
+// extraction's sweep traverses the same turn in the same 10° moves. A case that skips the walk
+// gets the same table (the walk changes nothing in it); one that fails gets the same error as
+// the cold route (the walk, run before the error is passed on, refuses dead points first).
+CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt,
+                                           const std::optional<TableNeighbour>& neighbour);
 
 // calibrate() on a table already extracted for a scene of the same hash (sweeps whose axes vary
 // only load values reuse one; reduced::TableError when the hashes differ).

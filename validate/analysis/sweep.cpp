@@ -108,6 +108,11 @@ struct TableCache {
   std::optional<std::pair<std::string, CalibrationTable>> calibration;
   std::optional<std::pair<std::string, reduced::Samples>> drive;  // a drive sweep's
   long extracted = 0;
+  // The last table's neighbour record (issue #28 item 3): a next table of the same topology
+  // whose neighbour stayed far from rank loss skips the dead-point walk when its own sweep does
+  // too. Cleared by a failed extraction, so the case after a failure walks.
+  std::optional<TableNeighbour> neighbour;
+  long walks = 0;  // tables whose dead-point walk ran
 };
 
 // A calibrated case's fields after its status.
@@ -116,7 +121,11 @@ std::string calibrated_fields(const SweepPlan& plan, const models::Scene& scene,
   if (!cache.calibration || cache.calibration->first != key) {
     cache.calibration.reset();  // a failed extraction leaves none
     ++cache.extracted;
-    cache.calibration.emplace(key, extract_calibration_table(scene, plan.calibration));
+    auto previous = std::move(cache.neighbour);
+    cache.neighbour.reset();
+    cache.calibration.emplace(key, extract_calibration_table(scene, plan.calibration, previous));
+    cache.neighbour = neighbour_of(scene, cache.calibration->second);
+    if (cache.calibration->second.walked) ++cache.walks;
   }
   Progress quiet(false);
   const auto r = calibrate(scene, cache.calibration->second, plan.calibration, quiet);
@@ -270,7 +279,7 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   const long chunks = static_cast<long>(order.chunks.size()) - 1;
 
   std::vector<std::string> rows(n);
-  std::atomic<long> next{0}, done{0}, failed{0}, tables{0};
+  std::atomic<long> next{0}, done{0}, failed{0}, tables{0}, walks{0};
   auto work = [&] {
     TableCache cache;
     for (long c; (c = next.fetch_add(1)) < chunks;) {
@@ -284,6 +293,7 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
       }
     }
     tables += cache.extracted;
+    walks += cache.walks;
   };
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(work);
@@ -295,6 +305,7 @@ SweepResult run_sweep(const SweepPlan& plan, StderrProgress* progress) {
   r.failed = failed.load();
   r.threads = threads;
   r.tables = tables.load();
+  r.walks = walks.load();
   r.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

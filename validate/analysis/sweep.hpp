@@ -62,6 +62,7 @@ struct SweepResult {
   long failed = 0;         // rows with status "error"
   int threads = 0;         // worker threads used
   long tables = 0;         // reduced tables extracted (a thread reuses its last one)
+  long walks = 0;          // of those, the ones whose dead-point walk ran (the others continued from a neighbour)
   double elapsed_s = 0.0;  // wall time of the cases
 };
 

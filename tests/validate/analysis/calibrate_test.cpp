@@ -11,10 +11,13 @@
 #include <type_traits>
 #include <fstream>
 
+#include <fmt/format.h>
+
 #include "engine/forward_dynamics.hpp"
 #include "engine/full_model.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/table.hpp"
+#include "validate/analysis/build_reduced.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -442,6 +445,99 @@ TEST(Calibrate, ANarrowBlockedRangeIsRefused) {
   coarse.grid_deg = 20;
   const std::string g = refusal_of(from_below, coarse);
   EXPECT_EQ(g.rfind("independent: ", 0), 0u) << g;
+}
+
+// Continuation in the parameters (issue #28 item 3): the next table of a sweep, given its
+// neighbour's record, skips the dead-point walk and is the cold table value for value (the walk
+// changes nothing in it), so the calibration on it is the cold one to the last bit. A neighbour
+// of another topology, or nearer rank loss than kWalkSkipConditioning, gives no such licence.
+TEST(Calibrate, AContinuedTableIsTheColdTable) {
+  auto at_height = [](double h) {
+    return models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", fmt::format("{:.17g}", h)}});
+  };
+  const auto a = at_height(1.70), b = at_height(1.72);
+  CalibrationOptions opt = calibration_options_of(b, 0.0, 0.0, "");
+  opt.full_max_s = 0;
+  const auto first = extract_calibration_table(a, opt);
+  const auto neighbour = neighbour_of(a, first);
+  ASSERT_TRUE(neighbour);
+  EXPECT_GE(neighbour->min_conditioning, kWalkSkipConditioning);
+  EXPECT_EQ(neighbour->topology, topology_key(b));
+  const auto cold = extract_calibration_table(b, opt);
+  const auto warm = extract_calibration_table(b, opt, neighbour);
+  EXPECT_TRUE(cold.walked);
+  EXPECT_FALSE(warm.walked);
+  EXPECT_EQ(warm.samples.q, cold.samples.q);
+  EXPECT_EQ(warm.samples.names, cold.samples.names);
+  EXPECT_EQ(warm.samples.columns, cold.samples.columns);
+  EXPECT_EQ(warm.samples.roots, cold.samples.roots);
+  EXPECT_EQ(warm.samples.min_conditioning, cold.samples.min_conditioning);
+  Progress quiet(false);
+  const auto rc = calibrate(b, cold, opt, quiet), rw = calibrate(b, warm, opt, quiet);
+  EXPECT_EQ(rw.load_value, rc.load_value);
+  EXPECT_EQ(rw.mean_cadence_hz_reduced, rc.mean_cadence_hz_reduced);
+  EXPECT_EQ(rw.peak_force_N, rc.peak_force_N);
+  EXPECT_EQ(rw.speed_fluctuation, rc.speed_fluctuation);
+  auto other = *neighbour;
+  other.topology = topology_key(models::load_scene("fourbar"));
+  EXPECT_TRUE(extract_calibration_table(b, opt, other).walked);
+  other = *neighbour;
+  other.min_conditioning = 0.9 * kWalkSkipConditioning;
+  EXPECT_TRUE(extract_calibration_table(b, opt, other).walked);
+  other.min_conditioning = 2.5 * warm.samples.min_conditioning;  // this case's grid fell sharply: walk
+  EXPECT_TRUE(extract_calibration_table(b, opt, other).walked);
+  // A range table (a crank-rocker) leaves no neighbour record.
+  CalibrationTable range;
+  range.samples.periodic = false;
+  EXPECT_FALSE(neighbour_of(b, range));
+}
+
+// A case near a dead point is handled as cold even after the best neighbour (its own topology,
+// conditioning 1): ANarrowBlockedRangeIsRefused's four-bar, whose 20° sweep from −158° steps over
+// the blocked range twice and closes its turn, shows grid conditioning below
+// kWalkSkipConditioning, so the walk runs and refuses it with the cold route's message; its 10°
+// sweep from 32° meets the dead point and is refused the same way.
+TEST(Calibrate, ACaseNearADeadPointWalksWhateverItsNeighbour) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  auto scene = models::parse_scene(yaml, "fourbar-blocked.yaml",
+                                   {{"bodies.crank.points.B.0", "0.18004"},
+                                    {"ground_points.D.0", "0.299714"},
+                                    {"ground_points.D.1", "0.013089"},
+                                    {"initial.q_deg", "32"}});
+  auto refusal = [](const models::Scene& s, const CalibrationOptions& o, const std::optional<TableNeighbour>& n) {
+    try {
+      extract_calibration_table(s, o, n);
+    } catch (const models::SceneError& e) {
+      return e.field() + ": " + e.message();
+    }
+    return std::string("accepted");
+  };
+  const std::optional<TableNeighbour> best = TableNeighbour{topology_key(scene), 1.0};
+  CalibrationOptions opt = calibration_options_of(scene, 1.0, 0.0, "drive");
+  const std::string cold = refusal(scene, opt, std::nullopt);
+  EXPECT_EQ(cold.rfind("independent: ", 0), 0u) << cold;
+  EXPECT_EQ(refusal(scene, opt, best), cold);
+  scene.initial.q = -158 * M_PI / 180;
+  opt.grid_deg = 20;
+  const auto closed = extract_from_full(scene, 20, reduced::Method::Kinetostatic);
+  ASSERT_TRUE(closed.samples.periodic);  // the extraction alone would take it
+  EXPECT_FALSE(closed.range);
+  EXPECT_LT(closed.samples.min_conditioning, 0.5 * kWalkSkipConditioning) << closed.samples.min_conditioning;
+  // A free-turning neighbour (crank 0.15 m, as in the sweep test) stays far above the floor.
+  auto free = models::parse_scene(yaml, "fourbar-free.yaml",
+                                  {{"bodies.crank.points.B.0", "0.15"},
+                                   {"ground_points.D.0", "0.299714"},
+                                   {"ground_points.D.1", "0.013089"},
+                                   {"initial.q_deg", "-158"}});
+  EXPECT_GE(extract_from_full(free, 20, reduced::Method::Kinetostatic).samples.min_conditioning,
+            2 * kWalkSkipConditioning);
+  const std::string g = refusal(scene, opt, std::nullopt);
+  EXPECT_EQ(g.rfind("independent: ", 0), 0u) << g;
+  EXPECT_EQ(refusal(scene, opt, best), g);
 }
 
 // With only resistances of constant magnitude and position-only drives every speed is a steady

@@ -393,5 +393,76 @@ TEST(Sweep, ThreadsTakeWholeMechanismsAndWriteTheSameFile) {
   EXPECT_EQ(two.csv, one.csv);
 }
 
+// Continuation in the parameters (issue #28 item 3): over the rider's height one thread walks
+// for its first table only (each next one continues from its neighbour, far from dead points),
+// and every row is calibrate() of its own scene run cold, to the last digit the CSV prints.
+TEST(Sweep, ContinuedCasesAreTheColdCases) {
+  SweepOptions o;
+  o.scene = "bicycle";
+  o.axes = {parse_sweep_axis("bicycle_leg.subject.height_m=1.6:1.9:4")};
+  o.threads = 1;
+  const SweepResult r = run_sweep(o);
+  EXPECT_EQ(r.failed, 0) << r.csv;
+  EXPECT_EQ(r.tables, 4);
+  EXPECT_EQ(r.walks, 1);
+  std::istringstream lines(r.csv);
+  std::string line;
+  std::getline(lines, line);  // metadata
+  std::getline(lines, line);  // header
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_TRUE(std::getline(lines, line));
+    const auto scene =
+        models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", fmt::format("{:.17g}", o.axes[0].values[k])}});
+    CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+    opt.full_max_s = 0.0;
+    Progress quiet(false);
+    const auto cold = calibrate(scene, opt, quiet);
+    EXPECT_EQ(line.substr(line.find(",ok,")),
+              fmt::format(",ok,{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},", cold.load_value,
+                          cold.mean_cadence_hz_reduced, cold.mean_power_w, cold.peak_force_N, cold.speed_fluctuation))
+        << k;
+  }
+  // Two threads: each walks for its first table; the file is the one thread's, byte for byte.
+  o.threads = 2;
+  const SweepResult two = run_sweep(o);
+  EXPECT_EQ(two.csv, r.csv);
+}
+
+// A case near a dead point after a neighbour that turned freely is refused as cold: the
+// four-bar of Calibrate.ANarrowBlockedRangeIsRefused (20° grid from −158°, where only the walk
+// finds the blocked range) after a shorter crank, in one thread.
+TEST(Sweep, ACaseNearADeadPointIsRefusedAfterAFreeNeighbour) {
+  namespace fs = std::filesystem;
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_blocked_" + std::to_string(::getpid()) + ".yaml");
+  const RemoveOnExit remove_scene{scene};
+  std::ofstream(scene) << yaml;
+  SweepOptions o;
+  o.scene = scene.string();
+  o.cadence_hz = 1.0;
+  o.load = "drive";
+  o.grid_deg = 20;
+  o.threads = 1;
+  o.sets = {"ground_points.D.0=0.299714", "ground_points.D.1=0.013089", "initial.q_deg=-158"};
+  o.axes = {parse_sweep_axis("bodies.crank.points.B.0=0.15:0.18004:2")};
+  auto last_row = [](const std::string& csv) {
+    const std::string body = csv.substr(0, csv.size() - 1);
+    return body.substr(body.rfind('\n') + 1);
+  };
+  const SweepResult r = run_sweep(o);
+  EXPECT_EQ(r.tables, 2);
+  const std::string blocked = last_row(r.csv);
+  EXPECT_EQ(blocked.find("1,0.18004,error,"), 0u) << r.csv;
+  EXPECT_NE(blocked.find("dead points"), std::string::npos) << r.csv;
+  // The same case alone (no neighbour): the same row but its case number.
+  o.axes = {parse_sweep_axis("bodies.crank.points.B.0=0.18004:0.18004:1")};
+  const std::string alone = last_row(run_sweep(o).csv);
+  EXPECT_EQ(blocked.substr(1), alone.substr(1)) << alone;
+}
+
 }  // namespace
 }  // namespace rdyn::validate
