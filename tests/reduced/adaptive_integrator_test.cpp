@@ -13,28 +13,14 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "analytic_source.hpp"
+#include "free_crank.hpp"
 #include "reduced/extract.hpp"
 
 namespace rdyn::reduced {
 namespace {
 
-// The analytic slider-crank (no loads): it turns freely from q̇ = 10 rad/s.
-ReducedModel free_crank() {
-  test::AnalyticSource src;
-  ExtractOptions opt;
-  opt.step_rad = 10 * M_PI / 180;
-  const auto scene = test::analytic_scene();
-  return make_reduced_model(extract_samples(src, scene, opt), scene, Interpolation::CubicSpline);
-}
-
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::free_crank;
+using test::message_of;
 
 // AdaptiveIntegrator drives GSL's steppers itself (the start derivative and the end point come
 // from the previous step instead of two more right-hand sides): on a model without gates its
