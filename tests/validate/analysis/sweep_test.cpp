@@ -112,6 +112,19 @@ struct RemoveOnExit {
   }
 };
 
+// The shipped four-bar driven by a 0.5 N·m crank torque named "drive" (and `edit` applied to its
+// text), as the text of a scene file.
+template <typename Edit>
+std::string driven_fourbar_yaml(Edit edit) {
+  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  edit(yaml);
+  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  return yaml;
+}
+
 // A failing case is a row with status "error" and its message, and it is counted: the
 // four-bar driven by a crank torque, with the ground pivot D moved so far in the second case
 // that the loop cannot close.
@@ -283,12 +296,9 @@ TEST(Sweep, ACaseAloneIsItsRowInTheSweep) {
 // table of the other branch.
 TEST(Sweep, ABranchCheckIsNeverSkippedByAReusedTable) {
   namespace fs = std::filesystem;
-  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  yaml.replace(yaml.find("point_b: C}"), 11, "point_b: C, branch: {joint: rocker, sign: positive}}");
-  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const std::string yaml = driven_fourbar_yaml([](std::string& y) {
+    y.replace(y.find("point_b: C}"), 11, "point_b: C, branch: {joint: rocker, sign: positive}}");
+  });
   const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_branch_" + std::to_string(::getpid()) + ".yaml");
   const RemoveOnExit remove_scene{scene};
   std::ofstream(scene) << yaml;
@@ -433,11 +443,7 @@ TEST(Sweep, ContinuedCasesAreTheColdCases) {
 // finds the blocked range) after a shorter crank, in one thread.
 TEST(Sweep, ACaseNearADeadPointIsRefusedAfterAFreeNeighbour) {
   namespace fs = std::filesystem;
-  std::ifstream in(std::string(RDYN_SCENES) + "/fourbar.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  yaml.replace(yaml.find("loads:\n"), 7, "loads:\n  - {type: joint_torque, name: drive, joint: crank, torque_Nm: 0.5}\n");
+  const std::string yaml = driven_fourbar_yaml([](std::string&) {});
   const fs::path scene = fs::temp_directory_path() / ("rdyn_sweep_blocked_" + std::to_string(::getpid()) + ".yaml");
   const RemoveOnExit remove_scene{scene};
   std::ofstream(scene) << yaml;
