@@ -462,11 +462,21 @@ void calc_first_screen(ValidationResult& v) {
                        "reference)",
                        v.matched_target, v.headline_quantity));
   const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
-  v.verdicts = calc_verdicts(v.quantities, rec, v.thresholds, v.matched_target);
+  v.verdicts = calc_verdicts(v.quantities, rec, v.matched_target);
   v.baselines.clear();
   v.budget.reset();
+  v.recommended_full = -1;
+  v.recommended_speedup.reset();
   if (!rec) return;
-  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.matched_full);
+  // One setting on the first screen: its errors, and its speed against the cheapest full run at
+  // least as accurate on the quantities it was chosen on (so within the target on them too: a
+  // threshold failing on another grid does not make this comparison less true; the status says it).
+  v.recommended_full = pick_matched_full(*rec, v.runs, {"qdot", v.headline_quantity});
+  const RunRecord& against = v.recommended_full >= 0 ? v.runs[v.recommended_full] : v.reference_run;
+  if (v.reference_change.samples >= kMinComparedSamples && rec->wall_s > 0 &&
+      std::isfinite(against.wall_s))
+    v.recommended_speedup = against.wall_s / rec->wall_s;
+  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.recommended_full);
   const SignalError* ref = v.reference_change.find(v.headline_quantity);
   v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
 }

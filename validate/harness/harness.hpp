@@ -69,6 +69,11 @@ struct ValidationResult {
   std::optional<double> speedup_at_matched_error;
   int matched_full = -1, matched_reduced = -1;  // indices into runs
   int recommended = -1;                         // cheapest reduced run within the target (index)
+  // The cheapest full run at equal or better error than the recommended run on the speed and
+  // the headline quantity (index, −1: none, the reference stands in), and the recommended run's
+  // speedup over it: the first screen's one speedup.
+  int recommended_full = -1;
+  std::optional<double> recommended_speedup;
   std::vector<Verdict> verdicts;
   std::vector<Baseline> baselines;              // the recommended run against full-model runs
   std::optional<ErrorBudget> budget;            // of the recommended run, headline quantity

@@ -249,15 +249,17 @@ nlohmann::json summary_json(const ValidationResult& v) {
       v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
   j["showcase_reduced"] =
       v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
+  // The first screen's one comparison: the recommended run against the cheapest full run at
+  // equal or better error (null: none was, the reference stands in; see baselines).
+  j["recommended_full"] =
+      v.recommended_full >= 0 ? run_json(v.runs[v.recommended_full]) : nlohmann::json(nullptr);
+  j["recommended_speedup"] = v.recommended_speedup ? num(*v.recommended_speedup) : nullptr;
   nlohmann::json verdicts = nlohmann::json::array();
   for (const auto& d : v.verdicts)
     verdicts.push_back({{"quantity", d.quantity},
                         {"error", num(d.error)},
-                        {"limit", num(d.limit)},
-                        {"judged_on", d.judged_on},
-                        {"judged_error", num(d.judged_error)},
-                        {"pass", d.pass},
-                        {"decides", d.decides}});
+                        {"target", num(d.target)},
+                        {"within_target", d.within_target}});
   j["verdicts"] = verdicts;
   nlohmann::json baselines = nlohmann::json::array();
   for (const auto& b : v.baselines)

@@ -6,31 +6,30 @@
 namespace rdyn::validate {
 
 std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities, const RunRecord* rec,
-                                   const std::vector<ThresholdResult>& thresholds, double target) {
+                                   double target) {
   std::vector<Verdict> out;
   for (const auto& q : quantities) {
     Verdict v;
     v.quantity = q;
     v.error = rec ? rec->error_of(q) : INFINITY;
-    const ThresholdResult* th = nullptr;
-    for (const auto& t : thresholds)
-      if (t.threshold.quantity == q && (!th || t.threshold.max_error < th->threshold.max_error))
-        th = &t;
-    if (th) {
-      v.limit = th->threshold.max_error;
-      v.judged_on = th->run;
-      v.judged_error = th->error;
-      v.pass = th->pass;
-      v.decides = true;
-    } else {
-      v.limit = target;
-      v.judged_on = rec ? rec->label() : "no reduced run within the target";
-      v.judged_error = v.error;
-      v.pass = v.error <= target;
-    }
+    v.target = target;
+    v.within_target = v.error <= target;
     out.push_back(v);
   }
   return out;
+}
+
+int pick_matched_full(const RunRecord& rec, const std::vector<RunRecord>& runs,
+                      const std::vector<std::string>& quantities) {
+  int best = -1;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const auto& r = runs[i];
+    if (r.model != "full" || !r.failure.empty() || !std::isfinite(r.wall_s)) continue;
+    bool ok = true;
+    for (const auto& q : quantities) ok &= r.error_of(q) <= rec.error_of(q);
+    if (ok && (best < 0 || r.wall_s < runs[best].wall_s)) best = static_cast<int>(i);
+  }
+  return best;
 }
 
 std::vector<Baseline> calc_baselines(const RunRecord& rec, const RunRecord& reference,
@@ -41,7 +40,7 @@ std::vector<Baseline> calc_baselines(const RunRecord& rec, const RunRecord& refe
       out.push_back({what, f.label(), f.wall_s, f.wall_s / rec.wall_s});
   };
   add("reference", reference);
-  if (matched_full >= 0) add("matched-error full run", runs[matched_full]);
+  if (matched_full >= 0) add("full run at equal or better error", runs[matched_full]);
   const RunRecord* cheapest = nullptr;
   for (const auto& r : runs)
     if (r.model == "full" && r.failure.empty() && (!cheapest || r.wall_s < cheapest->wall_s))

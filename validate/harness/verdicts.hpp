@@ -10,32 +10,36 @@
 
 namespace rdyn::validate {
 
+// One row of the first screen: a quantity's error at the recommended reduced setting against
+// the validation's target. Every row is read on that one run (issue #23: the table once mixed
+// the recommended run's errors with a 10° run's, so its two error columns disagreed); the
+// scene's thresholds, each on the grid it declares, are judged separately (thresholds.hpp) and
+// decide the status.
 struct Verdict {
   std::string quantity;
-  double error = 0.0;     // at the recommended setting (+∞ without one)
-  double limit = 0.0;     // the scene's threshold for the quantity, else the matched-error target
-  std::string judged_on;  // the run the pass/fail is decided on
-  double judged_error = 0.0;
-  bool pass = false;
-  bool decides = false;  // a scene threshold: its failure fails the validation
+  double error = 0.0;   // at the recommended setting (+∞ without one)
+  double target = 0.0;  // the validation's matched-error target
+  bool within_target = false;
 };
 
-// Thresholds decide for their quantity (the tightest when several); other quantities are
-// compared with `target` at the recommended setting for information (decides = false), so the
-// table never contradicts the validation's status.
 std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities,
-                                   const RunRecord* recommended,
-                                   const std::vector<ThresholdResult>& thresholds, double target);
+                                   const RunRecord* recommended, double target);
+
+// The full run the recommended setting is compared with: the cheapest completed full run whose
+// error on every one of `quantities` is at most the recommended run's (equal or better error, so
+// the speedup never flatters the reduced model); −1 when none is (the reference then stands in).
+int pick_matched_full(const RunRecord& recommended, const std::vector<RunRecord>& runs,
+                      const std::vector<std::string>& quantities);
 
 struct Baseline {
-  std::string what;   // "reference", "matched-error full run", "cheapest full run"
+  std::string what;   // "reference", "full run at equal or better error", "cheapest full run"
   std::string label;  // the full run
   double wall_s = 0.0;
   double speedup = 0.0;  // baseline wall / recommended wall
 };
 
-// Baselines: the reference, the matched-error full run (index, −1: none) and the cheapest
-// completed full run of the ladder.
+// Baselines: the reference, the full run at equal or better error (pick_matched_full's index,
+// −1: none) and the cheapest completed full run of the ladder.
 std::vector<Baseline> calc_baselines(const RunRecord& recommended, const RunRecord& reference,
                                      const std::vector<RunRecord>& runs, int matched_full);
 

@@ -10,6 +10,7 @@
 
 #include "validate/io/escape.hpp"
 #include "validate/report/drive_figure.hpp"
+#include "validate/report/first_screen.hpp"
 #include "validate/report/report_tables.hpp"
 #include "validate/io/output_dir.hpp"
 #include "validate/io/run_program.hpp"
@@ -21,21 +22,6 @@ namespace {
 using json = nlohmann::json;
 
 using namespace report_format;
-
-// A cost for the run as simulated, and per simulated second only when at least a second was
-// simulated (summary "per_second_measured").
-std::string cost(const json& s, double wall_s) {
-  std::string c = fmt::format("{} for the {} s run", secs(wall_s), num(d(s, "duration_s")));
-  if (s.value("per_second_measured", false))
-    c += fmt::format(" ({} per simulated second)", secs(wall_s / d(s, "duration_s")));
-  return c;
-}
-
-std::string quantity_words(const std::string& q) {
-  if (q == "qdot") return "speed of the independent coordinate";
-  if (q == "mean_qdot") return "mean speed of the independent coordinate";
-  return q + " force";
-}
 
 std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -327,79 +313,6 @@ std::string svg_or_note(const std::map<std::string, std::string>& figures,
   return it->second.substr(at);
 }
 
-// What the errors were taken over, in words: the steady revolutions, or the whole run when
-// the reference has no steady cycles (a transient, a rocking mechanism).
-std::string compared_over(const json& s) {
-  const auto& w = s.at("steady_window");
-  if (w.value("whole_run", false)) return "over the whole run";
-  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
-                     num(d(w, "t_start_s"), "{:.3g}"));
-}
-
-// The cost of the accurate rows the errors are read from: an untimed second run of the
-// recommended setting (one extra single step of its method per output row).
-std::string row_cost(const json& s) {
-  const json& rec = s.at("recommended_reduced");
-  const double timed = d(rec, "wall_s"), rows = d(rec, "compared_run_wall_s");
-  if (!(timed > 0) || !(rows > 0)) return "";
-  return fmt::format(
-      "The accurate rows come from an untimed second run of that setting (one extra single step "
-      "per output row): {} against {} for the timed run, {}× (one run, noisy).",
-      secs(rows), secs(timed), num(rows / timed, "{:.2g}"));
-}
-
-// The first screen: one row per quantity.
-std::string verdict_table(const json& s) {
-  const json& rec = s.at("recommended_reduced");
-  std::string h = "<h2>Verdict</h2>";
-  if (rec.is_object())
-    h += "<p>Recommended reduced setting: <b>" + H(str(rec, "label")) + "</b>, " +
-         H(cost(s, d(rec, "wall_s"))) + ".</p>";
-  else
-    h += fmt::format(
-        "<p class=warn>No reduced run reached the target of {} on the speed and on {}.</p>",
-        pct(d(s, "matched_error_target")), H(str(s, "headline_quantity")));
-  h += "<table><tr><th>quantity</th><th>max error " + H(compared_over(s)) +
-       " at the recommended setting</th><th>limit</th><th>judged on</th><th>error there</th><th></th></tr>";
-  for (const auto& v : s.at("verdicts")) {
-    const bool pass = v.value("pass", false), decides = v.value("decides", false);
-    // Only the scene's thresholds pass or fail; the target is shown for information.
-    const std::string mark = decides
-                                 ? (pass ? "<td class=pass>pass</td>" : "<td class=fail>FAIL</td>")
-                                 : (pass ? "<td>within target</td>" : "<td>above target</td>");
-    h += fmt::format(
-        "<tr><td class=l>{}</td><td>{}</td><td>{}{}</td><td class=l>{}</td><td>{}</td>{}</tr>",
-        H(str(v, "quantity")), pct(d(v, "error")), pct(d(v, "limit")), decides ? "" : " (target)",
-        H(str(v, "judged_on")), pct(d(v, "judged_error")), mark);
-  }
-  h += "</table>";
-  if (!s.at("baselines").empty()) {
-    h += "<table><tr><th>baseline (full model)</th><th>run</th><th>its cost</th><th>recommended "
-         "setting is</th></tr>";
-    for (const auto& b : s.at("baselines"))
-      h += fmt::format(
-          "<tr><td class=l>{}</td><td class=l>{}</td><td class=l>{}</td><td>{}× faster</td></tr>",
-          H(str(b, "what")), H(str(b, "label")), H(cost(s, d(b, "wall_s"))),
-          num(d(b, "speedup"), "{:.3g}"));
-    h += "</table>";
-  }
-  if (s.contains("error_budget")) {
-    const auto& b = s.at("error_budget");
-    h += fmt::format(
-        "<p><b>Error budget</b> of {} at the recommended setting ({} of its peak, on output rows "
-        "computed as accurately as the integrator's steps): reference {} (its change when its "
-        "tolerance is halved), table {} ({}: grid and interpolation, integrated at the tightest "
-        "tolerance), integration {} (what the setting's integrator adds). Output interpolation {}: "
-        "what quintic-Hermite rows between steps, as the timed run writes them, differ from "
-        "those rows (not in the total). Contributions are maxima, so they bound rather than "
-        "sum. {}</p>",
-        H(str(b, "quantity")), pct(d(b, "total")), pct(d(b, "reference")), pct(d(b, "table")),
-        H(str(b, "table_run").empty() ? "no tight run at that grid" : str(b, "table_run")),
-        pct(d(b, "integration")), pct(d(b, "output_interpolation")), row_cost(s));
-  }
-  return h;
-}
-
 // Published values the scene compares with (validation.compare), beside rdyn's calibration.
 std::string calibration_section(const json& s) {
   const auto& c = s.at("calibration");
@@ -448,94 +361,6 @@ std::string calibration_section(const json& s) {
 
 }  // namespace
 
-// A joint output (reaction, shaking, joint motion) among the judged quantities: the headline
-// gives their largest error, not a sentence each.
-bool is_joint_output(const json& s, const json& q) {
-  for (const auto& j : s.value("joint_output_quantities", json::array()))
-    if (j == q) return true;
-  return false;
-}
-
-std::string headline(const json& s) {
-  std::string out;
-  const std::string Q = str(s, "headline_quantity");
-  const std::string qw = quantity_words(Q);
-  const json& mf = s.at("matched_full");
-  const json& mr = s.at("matched_reduced");
-  if (s.at("speedup_at_matched_error").is_number() && mf.is_object() && mr.is_object()) {
-    out += fmt::format(
-        "On this machine ({}), the reduced model of '{}' ({}) takes {} against {} for Simbody "
-        "forward dynamics ({}), at "
-        "equal or better error of the {} ({} vs {} of its peak): {}× faster. ",
-        str(s, "machine"), str(s, "scene"), str(mr, "label"), cost(s, d(mr, "wall_s")),
-        secs(d(mf, "wall_s")), str(mf, "label"), qw, pct(error_of(mr, Q)), pct(error_of(mf, Q)),
-        num(d(s, "speedup_at_matched_error"), "{:.3g}"));
-    for (const auto& e : s.at("extractions"))
-      if (std::abs(d(e, "grid_deg") - d(mr, "grid_deg")) < 1e-9) {
-        out += fmt::format("Its {}° table costs {} ms to extract once", num(d(e, "grid_deg")),
-                           num(d(e, "ms"), "{:.3g}"));
-        if (s.value("per_second_measured", false))
-          out += fmt::format(" (as long as {} s of simulated motion with that full run)",
-                             num(d(e, "ms") * 1e-3 / d(mf, "wall_s_per_simulated_s"), "{:.3g}"));
-        out += ". ";
-      }
-  } else {
-    out += fmt::format(
-        "No run of the full-model tolerance ladder of '{}' reached the target of {} of the peak of "
-        "the {}, "
-        "or no reduced run matched it: no matched-error speedup is claimed. ",
-        str(s, "scene"), pct(d(s, "matched_error_target")), qw);
-  }
-  const json& sc = s.at("showcase_reduced");
-  if (sc.is_object()) {
-    out += fmt::format("At the 10° grid ({}), the errors are {} for the speed", str(sc, "label"),
-                       pct(error_of(sc, "qdot")));
-    std::string worst_joint;
-    double worst = -1;
-    for (const auto& q : s.at("quantities")) {
-      if (q == "qdot" || q == "mean_qdot") continue;
-      if (is_joint_output(s, q)) {
-        const double e = error_of(sc, q);
-        if (!(e <= worst)) worst = e, worst_joint = q.get<std::string>();
-        continue;
-      }
-      out += fmt::format(" and {} for {}", pct(error_of(sc, q)), q.get<std::string>());
-    }
-    if (!worst_joint.empty())
-      out += fmt::format(", and at most {} for the {} joint outputs ({})", pct(worst),
-                         s.value("joint_output_quantities", json::array()).size(), worst_joint);
-    out += ". ";
-  }
-  const auto& ref = s.at("reference");
-  out += fmt::format(
-      "Reference: the full model (Simbody, {}) at tolerance {}; halving that tolerance changed",
-      str(ref, "integrator") == "rkmerson" ? "Runge–Kutta–Merson" : str(ref, "integrator"),
-      num(d(ref, "tolerance"), "{:.0e}"));
-  const auto& ch = ref.at("change_when_tolerance_halved").at("errors");
-  bool first = true;
-  double joint_change = -1;
-  for (const auto& q : s.at("quantities")) {
-    const std::string name = q.get<std::string>();
-    if (name == "mean_qdot" || !ch.contains(name)) continue;
-    if (is_joint_output(s, q)) {
-      joint_change = std::max(joint_change, d(ch[name], "max_rel"));
-      continue;
-    }
-    out += fmt::format("{} {} by {}", first ? "" : " and", name == "qdot" ? "the speed" : name,
-                       pct(d(ch[name], "max_rel")));
-    first = false;
-  }
-  if (joint_change >= 0) out += fmt::format(" and the joint outputs by at most {}", pct(joint_change));
-  out += " of their peaks. ";
-  const auto& w = s.at("steady_window");
-  // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
-  const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
-  out += !w.value("whole_run", false) ? "Errors are maxima " + compared_over(s) + " (after the start-up transient)."
-         : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
-                                      : "The run has no steady cycles: errors are maxima over the whole run.";
-  return out;
-}
-
 std::string render_html(const json& s, const std::map<std::string, std::string>& figures) {
   std::string h;
   h += html_head(str(s, "scene"));
@@ -548,7 +373,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
       h += "<li class=warn>" + H(f.get<std::string>()) + "</li>";
     h += "</ul>";
   }
-  h += verdict_table(s);
+  h += first_screen_html(s);
   h += "<p class=lead>" + H(headline(s)) + "</p>";
   if (!str(s, "note").empty())
     h += "<p><b>What this scene tests:</b> " + H(str(s, "note")) + "</p>";
@@ -577,7 +402,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   h += std::string(s.at("steady_window").value("whole_run", false)
                        ? "<h2>2. Full and reduced model toward the end of the run</h2>"
                        : "<h2>2. Full and reduced model over the last periods</h2>") +
-       svg_or_note(figures, "timeseries");
+       svg_or_note(figures, "timeseries") + showcase_note(s);
   if (s.contains("figures") && s.at("figures").contains("joint_outputs")) {
     h += "<h3>Joint reactions and shaking load</h3><p>The requested reactions (the joint's force on its child, "
          "the loop's force of body_a on body_b, ground frame) and the mechanism's load on the ground, over the "
@@ -586,7 +411,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
     for (const auto& r : s.value("reactions_not_given", json::array()))
       h += "<p class=warn>Reaction " + H(str(r, "reaction")) + ": full model only (" + H(str(r, "why")) + ").</p>";
   }
-  h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto") + baselines_note(s);
+  h += "<h2>3. Accuracy against computing time</h2>" + svg_or_note(figures, "pareto") + matched_target_note(s) + baselines_note(s);
   h += "<h2>4. Convergence with the grid</h2>" + svg_or_note(figures, "convergence");
   h += "<p>Observed orders (fitted above 10× the reference's own change, " +
        pct(d(s.at("convergence"), "floor")) + "):";

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "validate/report/first_screen.hpp"  // headline, printed by the CLI
+
 namespace rdyn::validate {
 
 // Writes summary.json, the figure data and scripts, renders the figures with gnuplot (no
@@ -19,7 +21,5 @@ void render_report(const nlohmann::json& summary, const std::string& dir);
 std::string render_html(const nlohmann::json& summary,
                         const std::map<std::string, std::string>& figures);
 
-// One-paragraph plain-words headline (also printed by the CLI).
-std::string headline(const nlohmann::json& summary);
 
 }  // namespace rdyn::validate

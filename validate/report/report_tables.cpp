@@ -40,6 +40,33 @@ std::string secs(double s) {
   return fmt::format("{:.3g} µs", s * 1e6);
 }
 
+std::string cost(const json& s, double wall_s) {
+  std::string c = fmt::format("{} for the {} s run", secs(wall_s), num(d(s, "duration_s")));
+  if (s.value("per_second_measured", false))
+    c += fmt::format(" ({} per simulated second)", secs(wall_s / d(s, "duration_s")));
+  return c;
+}
+
+std::string quantity_words(const std::string& q) {
+  if (q == "qdot") return "speed of the independent coordinate";
+  if (q == "mean_qdot") return "mean speed of the independent coordinate";
+  return q + " force";
+}
+
+// The whole run when the reference has no steady cycles (a transient, a rocking mechanism).
+std::string compared_over(const json& s) {
+  const auto& w = s.at("steady_window");
+  if (w.value("whole_run", false)) return "over the whole run";
+  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
+                     num(d(w, "t_start_s"), "{:.3g}"));
+}
+
+bool is_joint_output(const json& s, const json& q) {
+  for (const auto& j : s.value("joint_output_quantities", json::array()))
+    if (j == q) return true;
+  return false;
+}
+
 }  // namespace report_format
 
 using namespace report_format;

@@ -23,6 +23,15 @@ std::string H(const std::string& s);
 std::string num(double x, const char* spec = "{:g}");
 std::string pct(double x);
 std::string secs(double s);
+// A cost for the run as simulated, and per simulated second only when at least a second was
+// simulated (summary "per_second_measured").
+std::string cost(const json& s, double wall_s);
+// A compared quantity in words ("speed of the independent coordinate", "knee force").
+std::string quantity_words(const std::string& q);
+// What the errors were taken over: the steady revolutions, or the whole run.
+std::string compared_over(const json& s);
+// Whether q is one of the summary's joint outputs (reactions, shaking, joint motion).
+bool is_joint_output(const json& s, const json& q);
 }  // namespace report_format
 
 // <!DOCTYPE html> … <body>: the title naming the scene and the page's style.

@@ -101,7 +101,14 @@ TEST(Harness, AnalysisAndFirstScreenFromRecords) {
   EXPECT_DOUBLE_EQ(v.convergence_floor, 2e-8);
   calc_first_screen(v);
   ASSERT_EQ(v.verdicts.size(), 3u);
-  EXPECT_TRUE(v.verdicts[1].decides);  // F has a threshold
+  EXPECT_DOUBLE_EQ(v.verdicts[1].error, 4e-4);  // F at the recommended run, not a threshold's run
+  // The first screen's one speedup: the recommended run (3 ms; 2e-4, 4e-4) against the cheapest
+  // full run at least as accurate on both: the 1 s run (the 0.3 s run's 5e-4, 6e-4 are worse).
+  EXPECT_EQ(v.recommended_full, 0);
+  ASSERT_TRUE(v.recommended_speedup);
+  EXPECT_DOUBLE_EQ(*v.recommended_speedup, 1.0 / 0.003);
+  EXPECT_EQ(v.baselines[1].label, v.runs[0].label());
+  EXPECT_DOUBLE_EQ(v.baselines[1].speedup, *v.recommended_speedup);
   ASSERT_TRUE(v.budget);
   EXPECT_DOUBLE_EQ(v.budget->reference, 2e-9);
   EXPECT_EQ(v.baselines.front().what, "reference");

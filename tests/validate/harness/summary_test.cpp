@@ -35,7 +35,9 @@ TEST(Summary, HoldsTheVerdictsBaselinesAndFigureData) {
   EXPECT_EQ(s["recommended_reduced"]["label"], v.runs[2].label());
   ASSERT_EQ(s["verdicts"].size(), 3u);
   EXPECT_EQ(s["verdicts"][1]["quantity"], "F");
-  EXPECT_EQ(s["verdicts"][1]["pass"], true);
+  EXPECT_EQ(s["verdicts"][1]["within_target"], true);
+  EXPECT_EQ(s["recommended_full"]["label"], v.runs[0].label());
+  EXPECT_DOUBLE_EQ(s["recommended_speedup"].get<double>(), 1.0 / 0.003);
   EXPECT_DOUBLE_EQ(s["baselines"][0]["speedup"].get<double>(), 1000.0);  // reference 3 s / 3 ms
   EXPECT_TRUE(s["runs"][4]["wall_s"].is_null());                         // the stopped run
   EXPECT_EQ(s["runs"][4]["failure"], "diverged at t = 0.5 s");

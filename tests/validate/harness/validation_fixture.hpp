@@ -57,10 +57,7 @@ inline validate::ValidationResult synthetic_validation() {
   v.matched_full = m.full, v.matched_reduced = m.reduced, v.speedup_at_matched_error = m.speedup;
   v.recommended = validate::pick_recommended(v.runs, {"qdot", "F"}, v.matched_target);
   v.thresholds = {{{"F", 10.0, "", 1e-3}, 4e-4, true, v.runs[2].label()}};
-  v.verdicts =
-      validate::calc_verdicts(v.quantities, &v.runs[v.recommended], v.thresholds, v.matched_target);
-  v.baselines =
-      validate::calc_baselines(v.runs[v.recommended], v.reference_run, v.runs, v.matched_full);
+  validate::calc_first_screen(v);
   v.convergence = validate::calc_convergence(v.runs, "F", 1e-8, 1e-8);
   v.reference = sine_series(1.0);
   v.showcase = sine_series(1.001);

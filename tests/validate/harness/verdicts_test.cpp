@@ -11,28 +11,41 @@ namespace {
 
 using test::record;
 
-TEST(Verdicts, ThresholdsDecideTheirQuantityTheTargetTheOthers) {
+// Every row is read on the one recommended run (issue #23: a 10° run's errors once stood in the
+// same table); the scene's thresholds are not mixed in.
+TEST(Verdicts, EveryRowIsTheRecommendedRunAgainstTheTarget) {
   const RunRecord rec = record("reduced", 1e-3, {{"qdot", 2e-4}, {"F", 3e-3}, {"mean_qdot", 1e-6}});
-  ThresholdResult loose{{"F", 30.0, "", 0.1}, 0.05, true, "coarse run"};
-  ThresholdResult tight{{"F", 10.0, "", 0.01}, 0.02, false, "10° run"};
-  const auto v = calc_verdicts({"qdot", "F", "mean_qdot"}, &rec, {loose, tight}, 1e-3);
+  const auto v = calc_verdicts({"qdot", "F", "mean_qdot"}, &rec, 1e-3);
   ASSERT_EQ(v.size(), 3u);
   EXPECT_EQ(v[0].quantity, "qdot");
   EXPECT_DOUBLE_EQ(v[0].error, 2e-4);
-  EXPECT_DOUBLE_EQ(v[0].limit, 1e-3);
-  EXPECT_TRUE(v[0].pass);
-  EXPECT_FALSE(v[0].decides);  // no threshold: for information
-  // F: the tightest threshold decides, on its own run.
+  EXPECT_DOUBLE_EQ(v[0].target, 1e-3);
+  EXPECT_TRUE(v[0].within_target);
   EXPECT_DOUBLE_EQ(v[1].error, 3e-3);
-  EXPECT_DOUBLE_EQ(v[1].limit, 0.01);
-  EXPECT_EQ(v[1].judged_on, "10° run");
-  EXPECT_DOUBLE_EQ(v[1].judged_error, 0.02);
-  EXPECT_FALSE(v[1].pass);
-  EXPECT_TRUE(v[1].decides);
-  // Without a recommended setting nothing passes on the target.
-  const auto none = calc_verdicts({"qdot"}, nullptr, {}, 1e-3);
-  EXPECT_FALSE(none[0].pass);
+  EXPECT_FALSE(v[1].within_target);
+  EXPECT_TRUE(v[2].within_target);
+  // Without a recommended setting nothing is within the target.
+  const auto none = calc_verdicts({"qdot"}, nullptr, 1e-3);
+  EXPECT_FALSE(none[0].within_target);
   EXPECT_TRUE(std::isinf(none[0].error));
+}
+
+// The full run the recommended setting is compared with is at least as accurate on every
+// quantity it was chosen on: a cheaper run better on one and worse on the other is not it, and
+// a stopped run never is.
+TEST(Verdicts, MatchedFullRunIsTheCheapestAtEqualOrBetterError) {
+  const RunRecord rec = record("reduced", 1e-3, {{"qdot", 2e-4}, {"F", 4e-4}});
+  std::vector<RunRecord> runs{record("full", 2.0, {{"qdot", 1e-6}, {"F", 1e-6}}),
+                              record("full", 0.9, {{"qdot", 2e-4}, {"F", 3e-4}}),   // equal on qdot: it
+                              record("full", 0.5, {{"qdot", 1e-5}, {"F", 5e-4}}),   // worse on F
+                              record("full", 0.1, {{"qdot", 1e-7}, {"F", 1e-7}}), rec};
+  runs[3].failure = "stopped";
+  EXPECT_EQ(pick_matched_full(rec, runs, {"qdot", "F"}), 1);
+  // On the speed alone the cheaper run qualifies.
+  EXPECT_EQ(pick_matched_full(rec, runs, {"qdot"}), 2);
+  // None as accurate: −1 (the reference stands in).
+  const RunRecord exact = record("reduced", 1e-3, {{"qdot", 0.0}, {"F", 0.0}});
+  EXPECT_EQ(pick_matched_full(exact, runs, {"qdot", "F"}), -1);
 }
 
 TEST(Verdicts, BaselinesAreCostRatios) {
@@ -46,7 +59,7 @@ TEST(Verdicts, BaselinesAreCostRatios) {
   ASSERT_EQ(b.size(), 3u);
   EXPECT_EQ(b[0].what, "reference");
   EXPECT_DOUBLE_EQ(b[0].speedup, 400);
-  EXPECT_EQ(b[1].what, "matched-error full run");
+  EXPECT_EQ(b[1].what, "full run at equal or better error");
   EXPECT_DOUBLE_EQ(b[1].speedup, 200);
   EXPECT_EQ(b[2].what, "cheapest full run");
   EXPECT_DOUBLE_EQ(b[2].speedup, 50);
