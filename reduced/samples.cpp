@@ -2,6 +2,7 @@
 
 #include "models/scene_hash.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cerrno>
 #include <cstdio>
@@ -126,6 +127,10 @@ void write_samples_csv(const std::string& path, const Samples& s) {
 
 namespace {
 
+// Largest magnitude of any number in a table: products of two such values and a speed squared
+// stay far from overflow (1e100·1e100·1e6 < 1.8e308).
+constexpr double kMaxTableMagnitude = 1e100;
+
 // Reads a table's text line by line (without their \n or \r\n), failing with the file and line.
 struct TableReader {
   const std::string& text;
@@ -152,6 +157,11 @@ struct TableReader {
     const double v = std::strtod(cell.c_str(), &end);
     if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
       fail(ln, fmt::format("{}: not a finite number: '{}'", what, cell.substr(0, 40)));
+    // The reduced model multiplies table values with each other and with q̇²: a value near the
+    // double's limit (m1 = 1e308) overflowed there into NaN, reported without file or line.
+    if (std::abs(v) > kMaxTableMagnitude)
+      fail(ln, fmt::format("{}: {} is beyond ±{:g}, no mechanism's reduced parameter", what, cell.substr(0, 40),
+                           kMaxTableMagnitude));
     return v;
   }
 };
@@ -167,10 +177,15 @@ void read_metadata(TableReader& r, Samples& s) {
   std::istringstream meta(r.line.substr(std::char_traits<char>::length(kHeader)));
   bool have_q0 = false, have_step = false, have_periodic = false;
   double grid = NAN;
+  std::vector<std::string> seen;
   for (std::string kv; meta >> kv;) {
     const auto eq = kv.find('=');
     if (eq == std::string::npos) r.fail(1, "malformed metadata '" + kv.substr(0, 40) + "' (key=value)");
     const std::string k = kv.substr(0, eq), v = kv.substr(eq + 1);
+    // A key given twice would let the last silently win (a hand edit appending periodic=0).
+    if (std::find(seen.begin(), seen.end(), k) != seen.end())
+      r.fail(1, "metadata field '" + k.substr(0, 40) + "' is given twice");
+    seen.push_back(k);
     if (k == "scene") {
       if (v.size() != 16 || v.find_first_not_of("0123456789abcdef") != std::string::npos)
         r.fail(1, "field 'scene': the scene hash must be 16 lowercase hexadecimal digits");

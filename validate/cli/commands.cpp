@@ -19,6 +19,7 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/table_check.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/analysis/calibrated_scene.hpp"
 #include "validate/cli/cli_limits.hpp"
@@ -166,11 +167,6 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
         throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
       samples = reduced::read_samples_csv(a.table);
       run["table"] = a.table;
-      if (!samples.content_checked)
-        std::fprintf(stderr,
-                     "rdyn: warning: %s has no content checksum (written before rdyn recorded one): an edit of its "
-                     "values cannot be detected; extract it again to have it checked\n",
-                     a.table.c_str());
     } else {
       auto e = extract_from_full(rscene, a.grid_deg, reduced::parse_method(a.method));
       samples = std::move(e.samples);
@@ -184,6 +180,16 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
     }
     const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
                                                    a.energy_consistent);
+    // A table read from a file (here or by the Python module) without a content checksum: its
+    // values and annotations against a fresh extraction (validate/analysis/table_check.hpp), once
+    // the table fits the scene's columns and hash.
+    if (!samples.file.empty() && !samples.content_checked) {
+      std::fprintf(stderr,
+                   "rdyn: warning: %s has no content checksum (written before rdyn recorded one): checking it "
+                   "against a fresh extraction of its scene; extract it again to skip this\n",
+                   samples.file.c_str());
+      check_table_against_scene(samples, rscene);
+    }
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
     reduced::check_energy_balance(
