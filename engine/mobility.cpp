@@ -145,13 +145,24 @@ void check_one_dof(const FullModel::Impl& m, const State& s) {
   if (one_dof(mob)) return;
   const bool rev = m.scene.joints[m.independent].type == JointType::Revolute;
   const double step = rev ? 0.01 : 1e-3;
+  bool beside = false;
   for (double dq : {step, -step}) {
     if (const auto near = nearby_configuration(m, s, dq)) {
       const Mobility other = calc_mobility(m, *near);
       // One degree of freedom beside the start but not at it: the start itself is singular.
       if (one_dof(other)) throw_singular_start(m, s);
       if (other.rank > mob.rank) mob = other;
+      beside = true;
     }
+  }
+  // No configuration beside the start could be projected from it (Newton from an exactly flat
+  // 10- or 40-loop parallelogram chain fails both ways): where the loop rows are dependent at the
+  // extraction's singular threshold, the start is singular and its rank says nothing of the
+  // mechanism's count (it reported "cannot move", or 3 degrees of freedom and a redundant loop).
+  // An independent coordinate the loops lock has independent rows and keeps its own message.
+  if (!beside) {
+    const Mobility loose = calc_mobility(m, s, kSingularConditioning);
+    if (loose.rank < loose.rows) throw_singular_start(m, s);
   }
   const int dof = mob.mobilities - mob.rank;
   std::string names;
