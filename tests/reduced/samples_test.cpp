@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -103,6 +104,17 @@ TEST(Samples, TheContentChecksumRefusesEditsButNotLineEndings) {
   for (char c : text) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
   EXPECT_TRUE(parse_samples_csv(crlf, "t.csv").content_checked);
   EXPECT_TRUE(parse_samples_csv(text.substr(0, text.size() - 1), "t.csv").content_checked);  // no last newline
+  // An editor's byte-order mark and CR-only line ends change no value: read, checked, the same.
+  const auto bom = parse_samples_csv("\xEF\xBB\xBF" + text, "t.csv");
+  EXPECT_TRUE(bom.content_checked);
+  EXPECT_EQ(bom.columns, s.columns);
+  std::string cr = text;
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  const auto mac = parse_samples_csv(cr, "t.csv");
+  EXPECT_TRUE(mac.content_checked);
+  EXPECT_EQ(mac.columns, s.columns);
+  // An edit behind a byte-order mark is still refused.
+  EXPECT_NE(refused("\xEF\xBB\xBF" + edited), std::string::npos);
   std::string unchecked = text;
   unchecked.erase(unchecked.find(" content="), 25);
   EXPECT_FALSE(parse_samples_csv(unchecked, "t.csv").content_checked);
