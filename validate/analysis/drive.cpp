@@ -1,5 +1,7 @@
 #include "validate/analysis/drive.hpp"
 
+#include "reduced/sweep_refine.hpp"
+
 #include "reduced/joint_outputs.hpp"
 
 #include <gsl/gsl_errno.h>
@@ -216,6 +218,22 @@ DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& 
         if (joint_outputs) side_cols.push_back(engine::calc_joint_output_row(model, ws));
       }
       auto limit = [](double m1, double m2, double p2, double p1) { return (2 * (m2 + p2) - 0.5 * (m1 + p1)) / 3; };
+      // A value with a pole there (f ≈ a/(q − q_s): an isosceles slider-crank's rod force where
+      // it folds) has no limit: the symmetric one above is its principal value, finite and wrong,
+      // and the row is refused as the reduced model refuses its band (reduced::check_force_poles).
+      auto refuse_pole = [&](const std::string& what, double m1, double m2, double p2, double p1) {
+        if (!reduced::is_simple_pole(m1, m2, p2, p1)) return;
+        throw models::NumericalError(fmt::format(
+            "the full model's {} grows without bound at t = {:.6g} s ({} = {:.9g}{}): the prescribed motion passes a "
+            "singular configuration where the loop Jacobian loses rank, and there it has a pole (≈ a/(q − q_s)), so "
+            "no finite value exists; prescribe a motion that stops short of it, or leave that output out",
+            what, motion.t[i], scene.independent, revolute ? motion.q[i] * 180 / M_PI : motion.q[i],
+            revolute ? "°" : " m"));
+      };
+      refuse_pole("drive", side[0].driving_force, side[1].driving_force, side[2].driving_force, side[3].driving_force);
+      for (size_t c = 0; c < names.size(); ++c)
+        refuse_pole("constraint force '" + names[c] + "'", side[0].constraint_forces[c], side[1].constraint_forces[c],
+                    side[2].constraint_forces[c], side[3].constraint_forces[c]);
       k = side[0];
       if (joint_outputs) cols.assign(side_cols[0].size(), 0.0);
       for (size_t c = 0; c < cols.size(); ++c)

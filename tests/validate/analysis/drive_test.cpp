@@ -147,6 +147,32 @@ TEST(Drive, AProfileStartingOnTheSingularConfigurationTakesItsLimitThere) {
   fs::remove_all(dir);
 }
 
+// Through the same folded position accelerating (q̈ = 0.1 m/s² there), the rod force has its pole
+// (me1 ≈ 0.026/x kg times q̈): the symmetric limit is a finite principal value with no branch
+// behind it, so the row is refused (exit 1 in the CLI), as the reduced model refuses its band.
+TEST(Drive, AForceWithAPoleAtASingularRowIsRefusedThere) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_drive_pole_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  {
+    std::ofstream p(dir / "p.csv");
+    p << "t,q_m\n";
+    for (int i = 0; i <= 100; ++i) {
+      const double t = 0.01 * i - 0.5;  // q = 0 exactly on the row at t = 0.5 s
+      p << fmt::format("{},{:.17g}\n", 0.01 * i, 0.1 * t + 0.05 * t * t);
+    }
+  }
+  const auto scene = models::load_scene(RDYN_SOURCE_DIR "/tests/validate/scenes/iso-slider-crank.yaml");
+  const auto motion = profile_motion((dir / "p.csv").string(), false, 1.0, 0.01);
+  try {
+    calc_drive_full(scene, motion);
+    ADD_FAILURE() << "the principal value at the pole was given as the rod force";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("constraint force 'rod_axial' grows without bound at t = 0.5 s"), std::string::npos) << m;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Drive, BicycleFullAndReducedAgree) {
   const auto scene = models::load_scene("bicycle");
   const auto motion = constant_rate_motion(scene.initial.q, 2 * M_PI * 1.0, 1.0, 0.002);
