@@ -114,14 +114,26 @@ PrescribedMotion calc_motion_at(const DriveArgs& a, const models::Scene& scene, 
   PrescribedMotion m;
   if (a.cadence_hz) {
     const double duration = a.duration.value_or(1.0 / std::abs(*a.cadence_hz));  // one revolution
-    if (dt > duration * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, duration));
+    // Without --duration the run is one revolution, so its length is the cadence's: name it.
+    const char* whose = a.duration ? "--duration" : "--cadence-hz";
+    const std::string run = a.duration ? fmt::format("the {:g} s run", duration)
+                                       : fmt::format("one revolution at {:g} rev/s ({:g} s)", *a.cadence_hz, duration);
+    if (dt > duration * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than {}", dt, run));
     if (duration / step > cli_limits::kMaxOutputRows)
-      refuse(scene, "--dt-out", fmt::format("{:g} s over {:g} s makes too many rows", dt, duration));
+      refuse(scene, whose,
+             fmt::format("{} at --dt-out {:g} s makes {:.3g} rows, more than {:g}: {} or --dt-out", run, dt,
+                         duration / step, cli_limits::kMaxOutputRows,
+                         a.duration ? "shorten --duration" : "raise the cadence"));
     m = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, step);
     m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
   } else {
     m = profile_motion(a.profile, revolute, a.duration, step, cli_limits::kMaxOutputRows);
-    if (dt > m.t.back() * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than the {:g} s run", dt, m.t.back()));
+    // The profile's own span is what is short (a profile whose times are 1e-300 s apart).
+    if (dt > m.t.back() * (1 + 1e-12))
+      throw models::SceneError(a.profile, 0, "t",
+                               fmt::format("the profile lasts {:g} s, shorter than --dt-out {:g} s: give times in "
+                                           "seconds over the motion, or a shorter --dt-out",
+                                           m.t.back(), dt));
     m.how = "profile " + a.profile + " (natural cubic spline, from its first time)";
   }
   return m;
