@@ -30,11 +30,6 @@ models::Scene reduced_outputs_scene(const models::Scene& scene) {
   return reduced::split_reduced_reactions(scene).scene;
 }
 
-// The scene a reduced model is extracted from: with the internal constraint lines its joint
-// outputs need (reduced/joint_outputs.hpp), when the scene asks for reactions or shaking.
-models::Scene extraction_scene(const models::Scene& scene) {
-  return reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(reduced_outputs_scene(scene)) : scene;
-}
 
 // A reduced run of that model as the user gets it: the joint outputs the scene asks for, from
 // the table, and the internal lines removed again (what `rdyn simulate --model reduced` writes).
@@ -94,6 +89,10 @@ std::string machine_description() {
 }
 
 }  // namespace
+
+models::Scene extraction_scene(const models::Scene& scene) {
+  return reduced::wants_joint_outputs(scene) ? reduced::with_reaction_requests(reduced_outputs_scene(scene)) : scene;
+}
 
 void finish_run(RunRecord& r, const std::vector<double>& walls, const models::TimeSeries& ts,
                 const ValidationResult& v) {
@@ -539,6 +538,12 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
     v.calibration_options = calibration_options_of(scene, 0.0, 0.0, "");
     progress.note(scene.name + ": calibrating the drive load");
     run_stage(v, "calibration", [&] { v.calibration = calibrate(scene, v.calibration_options, progress); });
+    // Both models at the calibrated operating point (the report's calibration figure).
+    if (v.calibration)
+      run_stage(v, "calibrated operating point", [&] {
+        v.calibrated_run =
+            calc_calibrated_run(scene, v.calibration_options, *v.calibration, v.samples10, v.output_interval_s);
+      });
   }
   // 5b. The drive over one revolution at that cadence from both models (the report's figure).
   run_stage(v, "drive cycle", [&] { calc_drive_cycle(scene, v); });

@@ -16,6 +16,7 @@
 #include "validate/harness/compare.hpp"
 #include "validate/harness/convergence.hpp"
 #include "validate/io/progress.hpp"
+#include "validate/harness/calibrated_run.hpp"
 #include "validate/harness/run_record.hpp"
 #include "validate/harness/time_scale.hpp"
 #include "validate/harness/verdicts.hpp"
@@ -89,6 +90,9 @@ struct ValidationResult {
   // The drive over one revolution at the scene's cadence (validation.calibrate) from both
   // models (calc_drive_cycle): scenes with a cadence whose coordinate turns fully.
   std::optional<DriveCycleComparison> drive_cycle;
+  // Both models at the calibrated operating point over two revolutions (validate/harness/
+  // calibrated_run.hpp): the calibration section's figure.
+  std::optional<CalibratedRun> calibrated_run;
   std::vector<ThresholdResult> thresholds;
   bool default_thresholds = false;  // the scene declares none: judged on thresholds_of's defaults
   bool pass = true;
@@ -101,6 +105,10 @@ struct ValidationResult {
   }
   std::string failure_summary() const;
 };
+
+// The scene a reduced model is extracted from: with the internal constraint lines its joint
+// outputs need (reduced/joint_outputs.hpp), when the scene asks for reactions or shaking.
+models::Scene extraction_scene(const models::Scene& scene);
 
 // Runs everything (engine + reduced) for one scene. Throws on scene/engine errors. The
 // stages, in order: run_reference, plan_ladders (validate/harness/ladder_plan.hpp), the full and reduced

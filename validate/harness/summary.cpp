@@ -125,6 +125,32 @@ nlohmann::json drive_cycle_json(const DriveCycleComparison& c) {
           {"curve", table_json({"q_deg", "t", "drive_full_Nm", "drive_reduced_Nm"}, cols)}};
 }
 
+// Both models at the calibrated operating point (validate/report/calibrated_figure.hpp draws
+// it): their differences and the curves on the output rows.
+nlohmann::json calibrated_run_json(const CalibratedRun& c) {
+  const bool force = !c.force_name.empty();
+  std::vector<std::string> names = {"t", "qdot_full", "qdot_reduced"};
+  if (force) names.insert(names.end(), {"force_full_N", "force_reduced_N"});
+  std::vector<std::vector<double>> cols(names.size());
+  const size_t n = std::min(c.full.t.size(), c.reduced.t.size());
+  for (size_t i = 0; i < n; ++i) {
+    cols[0].push_back(c.full.t[i]);
+    cols[1].push_back(c.full.qdot[i]);
+    cols[2].push_back(c.reduced.qdot[i]);
+    if (force) {
+      cols[3].push_back(c.full.forces[0][i]);
+      cols[4].push_back(c.reduced.forces[0][i]);
+    }
+  }
+  return {{"cadence_hz", num(c.cadence_hz)},
+          {"force_name", c.force_name},
+          {"qdot_error", num(c.qdot_error)},
+          {"force_error", force ? num(c.force_error) : nlohmann::json(nullptr)},
+          {"mean_cadence_full_hz", num(c.mean_cadence_full_hz)},
+          {"mean_cadence_reduced_hz", num(c.mean_cadence_reduced_hz)},
+          {"curve", table_json(names, cols)}};
+}
+
 // The calibration result under neutral names (kCompareQuantities), with what the scene
 // compares it to.
 nlohmann::json calibration_json(const ValidationResult& v) {
@@ -305,6 +331,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
   j["peers"] = peers;
   if (v.calibration) j["calibration"] = calibration_json(v);
   if (v.drive_cycle) j["drive_cycle"] = drive_cycle_json(*v.drive_cycle);
+  if (v.calibrated_run) j["calibrated_run"] = calibrated_run_json(*v.calibrated_run);
   nlohmann::json th = nlohmann::json::array();
   for (const auto& t : v.thresholds)
     th.push_back({{"quantity", t.threshold.quantity},

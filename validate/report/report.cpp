@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "validate/io/escape.hpp"
+#include "validate/report/calibrated_figure.hpp"
 #include "validate/report/drive_figure.hpp"
 #include "validate/report/first_screen.hpp"
 #include "validate/report/report_tables.hpp"
@@ -422,6 +423,7 @@ std::string render_html(const json& s, const std::map<std::string, std::string>&
   }
   h += " Below that floor an error measures the reference, not the table.</p>";
   if (s.contains("calibration")) h += calibration_section(s);
+  if (s.contains("calibrated_run")) h += calibrated_run_section(s.at("calibrated_run"), figures);
   if (s.contains("drive_cycle")) h += drive_cycle_section(s.at("drive_cycle"), figures);
   h += thresholds_table(s) + runs_table(s) + extraction_table(s);
   h += "<h2>Files</h2><p><code>summary.json</code> (every number above and the data of every "
@@ -460,6 +462,11 @@ void render_report(const json& s, const std::string& dir) {
     write_text_file(dir + "/drive.csv", drive_cycle_csv(s.at("drive_cycle")));
     write_text_file(dir + "/drive.gp", drive_cycle_gp(s.at("drive_cycle")));
     names.push_back("drive");
+  }
+  if (s.contains("calibrated_run")) {  // validate/report/calibrated_figure.hpp
+    write_text_file(dir + "/calibrated.csv", calibrated_run_csv(s.at("calibrated_run")));
+    write_text_file(dir + "/calibrated.gp", calibrated_run_gp(s.at("calibrated_run")));
+    names.push_back("calibrated");
   }
   write_pareto(s, dir);
   write_convergence(s, dir);
