@@ -578,6 +578,12 @@ void check_validation(const Checker& c, const Scene& s) {
     if (!(v.calibrate_power_W >= 0.0 && v.calibrate_power_W <= limits::kMaxPower_W))
       c.fail("validation.calibrate.power_W", fmt::format("must be in (0, {:g}] W (got {:g})",
                                                          limits::kMaxPower_W, v.calibrate_power_W));
+    c.in_range("validation.calibrate.grid_deg", v.calibrate_grid_deg, limits::kMinGrid_deg, limits::kMaxGrid_deg,
+               "degrees");
+    const double steps = 360.0 / v.calibrate_grid_deg;
+    if (std::abs(steps - std::round(steps)) > 1e-9 * steps)
+      c.fail("validation.calibrate.grid_deg",
+             fmt::format("{:g}° does not divide 360° into whole steps", v.calibrate_grid_deg));
   }
 }
 

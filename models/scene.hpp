@@ -300,6 +300,10 @@ struct Validation {
   double calibrate_cadence_Hz = 0.0;
   double calibrate_power_W = 0.0;
   std::string calibrate_load;  // a joint_torque or motor name; empty: every joint torque together
+  // Grid of the calibration's table [deg] (validate; `rdyn calibrate --grid-deg` overrides): a
+  // mechanism whose 10° table is too coarse at its operating point (a gear above ~18:1 turns its
+  // geared joint 180° per 10° step) is validated there on a finer one.
+  double calibrate_grid_deg = 10.0;
   std::string note;  // why the scene is hard / what it shows (reports quote it)
   std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };

@@ -187,11 +187,12 @@ namespace {
 // calibrated to reach it.
 void read_calibrate(const Fields& f, const Context& ctx, Scene& s) {
   if (!f.has("calibrate")) return;
-  Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load"});
+  Fields c(f.raw("calibrate"), "validation.calibrate", ctx, {"cadence_Hz", "power_W", "load", "grid_deg"});
   s.validation.calibrate_cadence_Hz = c.num("cadence_Hz");
   // power_W absent: mean-speed mode (the resistances stay as given).
   s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
   s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
+  s.validation.calibrate_grid_deg = c.num_or("grid_deg", 10.0);  // range: check_scene
   if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
   if (c.has("load") && s.validation.calibrate_load.empty())
     c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");

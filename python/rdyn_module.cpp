@@ -231,6 +231,7 @@ PYBIND11_MODULE(_rdyn, m) {
     if (power_w) a.power_w = *power_w, a.power_given = true;
     a.load = load;
     a.grid_deg = grid_deg;
+    a.grid_given = true;
     a.interpolation = interpolation;
     const rv::CalibrationOptions opt = rv::check_calibrate_args(scene, a);
     py::gil_scoped_release free;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "models/scene_hash.hpp"
+#include "models/scene_write.hpp"
 #include "scene_yaml_checks.hpp"
 
 namespace rdyn::models {
@@ -28,6 +29,20 @@ TEST(SceneYamlStudy, CalibrateBlockNamesItsLoadAndMayOmitThePower) {
   EXPECT_EQ(s.validation.calibrate_cadence_Hz, 3.0);
   EXPECT_EQ(s.validation.calibrate_power_W, 0.0);
   EXPECT_EQ(s.validation.calibrate_load, "motor");
+  EXPECT_EQ(s.validation.calibrate_grid_deg, 10.0);  // the default
+}
+
+// validation.calibrate.grid_deg: the calibration table's grid (a geared mechanism needs a finer
+// one), checked like a threshold's grid and written back only when not the default.
+TEST(SceneYamlStudy, CalibrateGridIsReadCheckedAndWritten) {
+  const Scene five = load_scene("bicycle", {parse_override("validation.calibrate.grid_deg=5")});
+  EXPECT_EQ(five.validation.calibrate_grid_deg, 5.0);
+  EXPECT_NE(scene_to_yaml(five).find("    grid_deg: 5\n"), std::string::npos);
+  EXPECT_EQ(scene_to_yaml(load_scene("bicycle")).find("grid_deg: 10\n    "), std::string::npos);
+  const std::string yaml = read_scene_text("bicycle");
+  EXPECT_NE(error_of(yaml, {{"validation.calibrate.grid_deg", "7"}}).find("7° does not divide 360°"), std::string::npos);
+  EXPECT_NE(error_of(yaml, {{"validation.calibrate.grid_deg", "0"}}).find("validation.calibrate.grid_deg"),
+            std::string::npos);
 }
 
 TEST(SceneYamlStudy, JointOutputsAllOrNames) {

@@ -154,6 +154,7 @@ CalibrationOptions calibration_options_of(const models::Scene& scene, double cad
   o.power_w = power_w > 0 ? power_w : v.calibrate_power_W;
   o.load = !load.empty() ? load : v.calibrate_load;
   o.load_field = !load.empty() ? "--load" : "validation.calibrate.load";
+  o.grid_deg = v.calibrate_grid_deg;
   return o;
 }
 

@@ -314,7 +314,7 @@ CalibrationOptions check_calibrate_args(const models::Scene& scene, const Calibr
   CalibrationOptions opt = calibration_options_of(scene, a.cadence_given ? a.cadence_hz : 0.0,
                                                   a.power_given ? a.power_w : 0.0, a.load);
   if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
-  opt.grid_deg = a.grid_deg;
+  if (a.grid_given) opt.grid_deg = a.grid_deg;
   opt.interpolation = a.interpolation;
   return opt;
 }

@@ -85,6 +85,7 @@ struct CalibrateArgs {
   std::string write_scene;  // optional output YAML
   bool force = false;
   double grid_deg = 10.0;
+  bool grid_given = false;  // else the scene's validation.calibrate.grid_deg (default 10)
   std::string interpolation = "fourier";
 };
 int run_calibrate(const CalibrateArgs& args);

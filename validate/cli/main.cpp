@@ -111,6 +111,8 @@ void add_calibrate_command(CLI::App& app, CalibrateArgs& cal) {
   calibrate->add_flag("--force", cal.force, kForceHelpFile);
   add_scene_overrides(*calibrate, cal.sets);
   add_reduced_table_options(*calibrate, cal.grid_deg, cal.interpolation);
+  // Given: it overrides the scene's validation.calibrate.grid_deg.
+  calibrate->get_option("--grid-deg")->each([&cal](const std::string&) { cal.grid_given = true; });
 }
 
 void add_validate_command(CLI::App& app, ValidateArgs& val) {

@@ -41,6 +41,14 @@ TEST(Calibrate, BicycleKeepsItsTorqueWithoutANamedLoad) {
   EXPECT_EQ(r.load_unit, "N·m");
 }
 
+// The calibration's grid: the scene's validation.calibrate.grid_deg (validate calibrates on it),
+// 10° when the scene gives none.
+TEST(Calibrate, OptionsTakeTheScenesCalibrationGrid) {
+  EXPECT_EQ(calibration_options_of(models::load_scene("bicycle"), 0.0, 0.0, "").grid_deg, 10.0);
+  const auto fine = models::load_scene("bicycle", {models::parse_override("validation.calibrate.grid_deg=2")});
+  EXPECT_EQ(calibration_options_of(fine, 0.0, 0.0, "").grid_deg, 2.0);
+}
+
 TEST(Calibrate, BicycleHoldsTheCadenceAndBalancesEnergy) {
   const auto scene = models::load_scene("bicycle");
   CalibrationOptions opt;
