@@ -276,10 +276,12 @@ PYBIND11_MODULE(_rdyn, m) {
   m.def("plan_sweep", [](const std::string& scene, const std::vector<std::string>& sets,
                          const std::vector<std::string>& vary, std::optional<double> cadence_hz,
                          std::optional<double> power_w, const std::string& load, double grid_deg,
-                         std::optional<double> drive_cadence_hz, std::optional<int> threads) {
+                         std::optional<double> drive_cadence_hz, const std::vector<std::string>& peaks,
+                         std::optional<int> threads) {
     rv::SweepArgs a;  // checked as `rdyn sweep` checks its options (ArgumentError names them)
     a.inputs = {scene}, a.sets = sets, a.vary = vary, a.cadence_hz = cadence_hz, a.power_w = power_w;
     a.load = load, a.grid_deg = grid_deg, a.drive_cadence_hz = drive_cadence_hz, a.threads = threads;
+    a.peaks = peaks;
     return rv::plan_sweep(rv::check_sweep_args(a));
   });
   m.def("sweep_case", [](const rv::SweepPlan& plan, long index) {

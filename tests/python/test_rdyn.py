@@ -326,6 +326,21 @@ def test_calibrating_sweep_on_a_thread_pool_is_the_cli_sweep(rdyn_cli, tmp_path)
     assert rows[0]["drive_torque_Nm"] > rows[1]["drive_torque_Nm"] > 0  # a longer crank needs less torque
 
 
+def test_sweep_peaks_on_a_thread_pool_are_the_cli_sweep(rdyn_cli, tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+    scene = rdyn.load_scene("bicycle")
+    rdyn_cli("sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:2", "--peak", "F_knee",
+             "--out", str(tmp_path / "p.csv"))
+    with ThreadPoolExecutor(2) as pool:
+        rows = rdyn.sweep(scene, {"bicycle_leg.crank_length_m": "0.16:0.18:2"}, map=pool.map, peaks=["F_knee"])
+    assert rows == read_sweep_csv(tmp_path / "p.csv")
+    for r in rows:  # the sampled cycle's peak against the refined one (sweep_peaks_test.cpp)
+        assert r["peak_F_knee"] == pytest.approx(r["peak_knee_force_N"], rel=1e-4)
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.sweep(scene, {"bicycle_leg.crank_length_m": (0.16, 0.18, 2)}, peaks=["R_knee_x"])
+    assert e.value.field == "--peak"
+
+
 def test_sweep_errors_have_their_fields():
     scene = rdyn.load_scene("bicycle")
     with pytest.raises(rdyn.SceneError) as e:
