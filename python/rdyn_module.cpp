@@ -334,7 +334,15 @@ PYBIND11_MODULE(_rdyn, m) {
       .def_property_readonly("steps", [](const Runtime& r) { return r.ws.get_steps(); })
       .def_property_readonly("forces", [](const Runtime& r) { return to_array(r.ws.get_forces()); })
       .def_property_readonly("drive_torques", [](const Runtime& r) { return to_array(r.ws.get_drive_torques()); })
-      .def_property_readonly("force_names", [](const Runtime& r) { return r.model.reduced.force_names; })
+      .def_property_readonly("force_names", [](const Runtime& r) { return r.model.force_names; })
+      // The scene's joint outputs at the current state (reactions, shaking, joint motion), named
+      // as `rdyn simulate --model reduced` names its columns; empty when the scene asks for none.
+      .def_property_readonly("joint_outputs", [](const Runtime& r) { return to_array(r.ws.get_joint_outputs()); })
+      .def_property_readonly("joint_output_names",
+                             [](const Runtime& r) {
+                               return r.model.joint_outputs ? r.model.joint_outputs->names
+                                                            : std::vector<std::string>();
+                             })
       .def_property_readonly("drive_names", [](const Runtime& r) { return r.model.drive_names; })
       // The C++ cost of n steps at dt, timed inside C++ (no Python between steps) [s per step]:
       // the baseline a Python control loop's overhead is measured against.

@@ -315,5 +315,14 @@ class Runtime:
     work = property(lambda self: self._rt.work, doc="work of the non-conservative loads [J]")
     forces = property(lambda self: self._rt.forces, doc="constraint forces [N] (force_names order)")
     force_names = property(lambda self: self._rt.force_names)
+    joint_outputs = property(lambda self: self._rt.joint_outputs,
+                             doc="the scene's joint outputs at the current state: reactions [N], shaking "
+                                 "load, joint motion (joint_output_names order; empty when it asks for none)")
+    joint_output_names = property(lambda self: self._rt.joint_output_names,
+                                  doc="their names, as rdyn simulate --model reduced names its columns")
+
+    def joint_output_dict(self):
+        """The joint outputs at the current state as {name: value}."""
+        return dict(zip(self._rt.joint_output_names, self._rt.joint_outputs.tolist()))
     drive_names = property(lambda self: self._rt.drive_names)
     drive_torques = property(lambda self: self._rt.drive_torques)

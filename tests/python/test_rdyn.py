@@ -136,6 +136,25 @@ def test_runtime_matches_fixed_step_simulate():
     np.testing.assert_allclose(qs, run["q"][1:], rtol=0, atol=1e-12)
 
 
+def test_runtime_joint_outputs_are_the_reduced_runs_rows():
+    # A scene that asks for reactions and the shaking load: the runtime takes the table extract
+    # gives it, and reset to a row's state gives that row's joint outputs (runtime_test.cpp
+    # checks them against closed forms).
+    scene = rdyn.load_scene("slider-crank", {"outputs.reactions": "all", "outputs.shaking": "true"})
+    table = rdyn.extract(scene, grid_deg=10)
+    run = rdyn.simulate(scene, model="reduced", duration=0.05, table=table, interpolation="fourier")
+    rt = rdyn.Runtime(table, scene)
+    assert rt.force_names == ["rod_axial"]
+    assert rt.joint_output_names[:2] == ["R_crank_x", "R_crank_y"] and rt.joint_output_names[-1] == "shaking_M"
+    for i in (0, len(run["t"]) // 2, len(run["t"]) - 1):
+        rt.reset(run["q"][i], run["qdot"][i])
+        values = rt.joint_output_dict()
+        assert list(values) == rt.joint_output_names
+        for name, v in values.items():
+            assert v == pytest.approx(run[name][i], rel=1e-9, abs=1e-9 * np.max(np.abs(run[name]))), name
+    assert runtime_for("fourbar", 30).joint_output_names == []
+
+
 def test_runtime_errors_leave_the_state():
     rt = runtime_for("fourbar", 30)
     q0, qdot0 = rt.q, rt.qdot
