@@ -37,6 +37,25 @@ struct TimeSeries {
   RunStats stats;
 };
 
+// The columns of timeseries.csv in order (validate/report/timeseries_csv.hpp writes them):
+// t, q, qdot, qddot, energy, work, F_<name> per constraint force, then the joint outputs.
+inline std::vector<std::string> timeseries_column_names(const std::vector<std::string>& force_names,
+                                                        const std::vector<std::string>& column_names) {
+  std::vector<std::string> n{"t", "q", "qdot", "qddot", "energy", "work"};
+  for (const auto& f : force_names) n.push_back("F_" + f);
+  n.insert(n.end(), column_names.begin(), column_names.end());
+  return n;
+}
+inline std::vector<std::string> timeseries_column_names(const TimeSeries& ts) {
+  return timeseries_column_names(ts.force_names, ts.column_names);
+}
+// Column k of that list (k < its size).
+inline const std::vector<double>& timeseries_column(const TimeSeries& ts, size_t k) {
+  const std::vector<double>* fixed[] = {&ts.t, &ts.q, &ts.qdot, &ts.qddot, &ts.energy, &ts.work};
+  if (k < 6) return *fixed[k];
+  return k - 6 < ts.forces.size() ? ts.forces[k - 6] : ts.columns[k - 6 - ts.forces.size()];
+}
+
 // The output grid of a run: rows at t = i·interval for i = 0…n−1 and a last row at t =
 // duration, also when the interval does not divide it (1 s at 0.3 s: 0, 0.3, 0.6, 0.9, 1), so
 // the final state is always written. calc_output_rows is n + 1 without the t = 0 row, i.e. the

@@ -277,10 +277,12 @@ PYBIND11_MODULE(_rdyn, m) {
   m.def("plan_sweep", [](const std::string& scene, const std::vector<std::string>& sets,
                          const std::vector<std::string>& vary, std::optional<double> cadence_hz,
                          std::optional<double> power_w, const std::string& load, double grid_deg,
-                         std::optional<double> drive_cadence_hz, std::optional<int> threads) {
+                         std::optional<double> drive_cadence_hz, const std::vector<std::string>& peaks,
+                         std::optional<int> threads) {
     rv::SweepArgs a;  // checked as `rdyn sweep` checks its options (ArgumentError names them)
     a.inputs = {scene}, a.sets = sets, a.vary = vary, a.cadence_hz = cadence_hz, a.power_w = power_w;
     a.load = load, a.grid_deg = grid_deg, a.drive_cadence_hz = drive_cadence_hz, a.threads = threads;
+    a.peaks = peaks;
     return rv::plan_sweep(rv::check_sweep_args(a));
   });
   m.def("sweep_case", [](const rv::SweepPlan& plan, long index) {
@@ -333,7 +335,15 @@ PYBIND11_MODULE(_rdyn, m) {
       .def_property_readonly("steps", [](const Runtime& r) { return r.ws.get_steps(); })
       .def_property_readonly("forces", [](const Runtime& r) { return to_array(r.ws.get_forces()); })
       .def_property_readonly("drive_torques", [](const Runtime& r) { return to_array(r.ws.get_drive_torques()); })
-      .def_property_readonly("force_names", [](const Runtime& r) { return r.model.reduced.force_names; })
+      .def_property_readonly("force_names", [](const Runtime& r) { return r.model.force_names; })
+      // The scene's joint outputs at the current state (reactions, shaking, joint motion), named
+      // as `rdyn simulate --model reduced` names its columns; empty when the scene asks for none.
+      .def_property_readonly("joint_outputs", [](const Runtime& r) { return to_array(r.ws.get_joint_outputs()); })
+      .def_property_readonly("joint_output_names",
+                             [](const Runtime& r) {
+                               return r.model.joint_outputs ? r.model.joint_outputs->names
+                                                            : std::vector<std::string>();
+                             })
       .def_property_readonly("drive_names", [](const Runtime& r) { return r.model.drive_names; })
       // The C++ cost of n steps at dt, timed inside C++ (no Python between steps) [s per step]:
       // the baseline a Python control loop's overhead is measured against.

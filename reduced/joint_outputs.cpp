@@ -61,9 +61,7 @@ void check_prismatic_balance(const models::Scene& s, const models::Joint& jt) {
       refuse("is the only body that can balance loop '" + l.name + "'");
 }
 
-struct Kin {  // one body at one sample: angle, rates, origin and its acceleration (ground)
-  double th = 0, w = 0, al = 0, x = 0, y = 0, ax = 0, ay = 0;
-};
+using Kin = BodyMotion;
 
 // Rigid transfer: the point at offset d (ground frame) from a frame with acceleration a, ω, α.
 void transfer(const Kin& k, double dx, double dy, double& ax, double& ay) {
@@ -92,8 +90,7 @@ void add_joint_position_columns(const models::Scene& scene, const std::vector<do
   }
 }
 
-models::Scene with_reaction_requests(const models::Scene& scene) {
-  models::Scene out = scene;
+std::vector<std::string> reaction_line_joints(const models::Scene& scene) {
   std::vector<std::string> joints;  // revolute joints whose reaction lines are needed
   auto need = [&](const std::string& j) {
     if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
@@ -119,7 +116,12 @@ models::Scene with_reaction_requests(const models::Scene& scene) {
     for (const auto& l : scene.loops)
       if (l.name == name) need_loop(l);
   }
-  for (const auto& j : joints) {
+  return joints;
+}
+
+models::Scene with_reaction_requests(const models::Scene& scene) {
+  models::Scene out = scene;
+  for (const auto& j : reaction_line_joints(scene)) {
     for (char axis : {'x', 'y'}) {
       const std::string name = internal_request_name(j, axis);
       for (const auto& c : scene.outputs.constraint_forces)
@@ -149,137 +151,91 @@ ReducedReactions split_reduced_reactions(const models::Scene& scene) {
 
 namespace {
 
-// One output row's motion of every joint and body, and the columns it reads.
-struct RowKinematics {
-  const models::Scene& s;
-  const Table& T;
-  std::vector<int> cp, ck, cr;  // p_, k_, r_ columns per joint
-  std::vector<int> order;       // joints with parents before children (a tree rooted at ground)
-  double gx = 0.0, gy = 0.0;
-  std::vector<double> qj, uj, aj;
-  std::vector<Kin> body;
-  std::vector<double> cax, cay, cx, cy;  // centre of mass: acceleration, position
-
-  RowKinematics(const models::Scene& scene, const Table& table) : s(scene), T(table) {
-    const size_t nj = s.joints.size(), nb = s.bodies.size();
-    auto col = [&](const std::string& name) {
-      const int c = T.column(name);
-      if (c < 0)
-        throw TableError("the reduced table has no column '" + name +
-                         "': extract it from a scene that asks for outputs.joints, reactions or shaking");
-      return c;
-    };
-    for (size_t j = 0; j < nj; ++j) {
-      cp.push_back(col("p_" + s.joints[j].name));
-      ck.push_back(col("k_" + s.joints[j].name));
-      cr.push_back(col("r_" + s.joints[j].name));
-    }
-    std::vector<char> done(nj, 0);
-    for (size_t pass = 0; pass <= nj && order.size() < nj; ++pass)
-      for (size_t j = 0; j < nj; ++j) {
-        if (done[j]) continue;
-        const auto& jt = s.joints[j];
-        const int pb = s.body_index(jt.parent);
-        bool ready = jt.parent == models::kGround;
-        for (int o : order) ready |= s.body_index(s.joints[o].child) == pb;
-        if (ready) order.push_back(static_cast<int>(j)), done[j] = 1;
-      }
-    gx = s.gravity.enabled ? s.gravity.g_m_s2.x : 0.0, gy = s.gravity.enabled ? s.gravity.g_m_s2.y : 0.0;
-    qj.assign(nj, 0.0), uj = aj = qj;
-    body.assign(nb, Kin{});
-    cax.assign(nb, 0.0), cay = cx = cy = cax;
+// Planar tree kinematics: the child's frame from its parent's and its joint's motion.
+void place_child(const JointOutputModel& m, JointOutputWorkspace& ws, int j) {
+  const auto& jt = m.scene.joints[j];
+  const Kin P = m.parent[j] < 0 ? Kin{} : ws.body[m.parent[j]];
+  const double cP = std::cos(P.th), sP = std::sin(P.th);
+  double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
+  Kin C = P;
+  if (jt.type == models::JointType::Revolute) {
+    C.th = P.th + jt.offset_rad + ws.qj[j];
+    C.w = P.w + ws.uj[j];
+    C.al = P.al + ws.aj[j];
+  } else {  // slides along the axis (parent frame) by q_j
+    px += jt.axis.x * ws.qj[j];
+    py += jt.axis.y * ws.qj[j];
+    const double ux = cP * jt.axis.x - sP * jt.axis.y, uy = sP * jt.axis.x + cP * jt.axis.y;
+    // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
+    arx = ux * ws.aj[j] - 2 * P.w * uy * ws.uj[j];
+    ary = uy * ws.aj[j] + 2 * P.w * ux * ws.uj[j];
   }
+  const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
+  double Jax, Jay;
+  transfer(P, dx, dy, Jax, Jay);
+  Jax += arx, Jay += ary;
+  const double cC = std::cos(C.th), sC = std::sin(C.th);
+  const double ex = -(cC * jt.child_point.x - sC * jt.child_point.y);  // joint point → child origin
+  const double ey = -(sC * jt.child_point.x + cC * jt.child_point.y);
+  C.x = P.x + dx + ex;
+  C.y = P.y + dy + ey;
+  Kin Jk = C;
+  Jk.ax = Jax, Jk.ay = Jay;
+  transfer(Jk, ex, ey, C.ax, C.ay);
+  const int b = m.child[j];
+  ws.body[b] = C;
+  const auto& bd = m.scene.bodies[b];
+  const double fx = cC * bd.com_m.x - sC * bd.com_m.y, fy = sC * bd.com_m.x + cC * bd.com_m.y;
+  ws.cx[b] = C.x + fx, ws.cy[b] = C.y + fy;
+  transfer(C, fx, fy, ws.cax[b], ws.cay[b]);
+}
 
-  void calc(double q, double qd, double qdd) {
-    // Joint motion: q_j = p_j + k_j q; q̇_j = r_j q̇; q̈_j = r_j q̈ + (dr_j/dq) q̇².
-    for (size_t j = 0; j < s.joints.size(); ++j) {
-      const double rj = T.eval(cr[j], q);
-      qj[j] = T.eval(cp[j], q) + T.eval(ck[j], q) * q;
-      uj[j] = rj * qd;
-      aj[j] = rj * qdd + T.eval_deriv(cr[j], q) * qd * qd;
-    }
-    for (int j : order) place_child(j);
+// Joint motion at (q, q̇, q̈), then every body's by planar tree kinematics, into ws.
+void calc_kinematics(const JointOutputModel& m, const Table& T, JointOutputWorkspace& ws, double q, double qd,
+                     double qdd) {
+  // Joint motion: q_j = p_j + k_j q; q̇_j = r_j q̇; q̈_j = r_j q̈ + (dr_j/dq) q̇².
+  for (size_t j = 0; j < m.c_p.size(); ++j) {
+    const double rj = T.eval(m.c_r[j], q);
+    ws.qj[j] = T.eval(m.c_p[j], q) + T.eval(m.c_k[j], q) * q;
+    ws.uj[j] = rj * qd;
+    ws.aj[j] = rj * qdd + T.eval_deriv(m.c_r[j], q) * qd * qd;
   }
+  for (int j : m.order) place_child(m, ws, j);
+}
 
-  // Planar tree kinematics: the child's frame from its parent's and its joint's motion.
-  void place_child(int j) {
-    const auto& jt = s.joints[j];
-    const Kin P = jt.parent == models::kGround ? Kin{} : body[s.body_index(jt.parent)];
-    const double cP = std::cos(P.th), sP = std::sin(P.th);
-    double px = jt.parent_point.x, py = jt.parent_point.y, arx = 0, ary = 0;
-    Kin C = P;
-    if (jt.type == models::JointType::Revolute) {
-      C.th = P.th + jt.offset_rad + qj[j];
-      C.w = P.w + uj[j];
-      C.al = P.al + aj[j];
-    } else {  // slides along the axis (parent frame) by q_j
-      px += jt.axis.x * qj[j];
-      py += jt.axis.y * qj[j];
-      const double ux = cP * jt.axis.x - sP * jt.axis.y, uy = sP * jt.axis.x + cP * jt.axis.y;
-      // relative acceleration u q̈ plus Coriolis 2 ω k × (u q̇)
-      arx = ux * aj[j] - 2 * P.w * uy * uj[j];
-      ary = uy * aj[j] + 2 * P.w * ux * uj[j];
-    }
-    const double dx = cP * px - sP * py, dy = sP * px + cP * py;  // parent origin → joint point
-    double Jax, Jay;
-    transfer(P, dx, dy, Jax, Jay);
-    Jax += arx, Jay += ary;
-    const double cC = std::cos(C.th), sC = std::sin(C.th);
-    const double ex = -(cC * jt.child_point.x - sC * jt.child_point.y);  // joint point → child origin
-    const double ey = -(sC * jt.child_point.x + cC * jt.child_point.y);
-    C.x = P.x + dx + ex;
-    C.y = P.y + dy + ey;
-    Kin Jk = C;
-    Jk.ax = Jax, Jk.ay = Jay;
-    transfer(Jk, ex, ey, C.ax, C.ay);
-    const int b = s.body_index(jt.child);
-    body[b] = C;
-    const auto& bd = s.bodies[b];
-    const double fx = cC * bd.com_m.x - sC * bd.com_m.y, fy = sC * bd.com_m.x + cC * bd.com_m.y;
-    cx[b] = C.x + fx, cy[b] = C.y + fy;
-    transfer(C, fx, fy, cax[b], cay[b]);
-  }
-};
+// The reactions of one state from its reaction lines (the run's constraint forces) and motion.
+struct StateReactions {
+  const JointOutputModel& m;
+  const JointOutputWorkspace& k;
+  const double* forces;  // the run's constraint forces, in the order make_joint_output_model was given
 
-// The reactions of one row from its reaction lines (the run's constraint forces) and motion.
-struct RowReactions {
-  const models::Scene& s;
-  const models::TimeSeries& ts;
-  const RowKinematics& k;
-  size_t i = 0;  // the row
-
-  const std::vector<double>& force(const std::string& name) const {
-    for (size_t f = 0; f < ts.force_names.size(); ++f)
-      if (ts.force_names[f] == name) return ts.forces[f];
-    throw TableError("the reduced run has no constraint line '" + name + "'");
-  }
   // A revolute joint's reaction: the child-frame reaction lines turned into ground by the child's angle.
-  void revolute(const std::string& joint, double& Rx, double& Ry) const {
-    const double fx = force(internal_request_name(joint, 'x'))[i], fy = force(internal_request_name(joint, 'y'))[i];
-    const double th = k.body[s.body_index(s.find_joint(joint)->child)].th;
+  void revolute(int j, double& Rx, double& Ry) const {
+    const double fx = forces[m.line_x[j]], fy = forces[m.line_y[j]];
+    const double th = k.body[m.child[j]].th;
     Rx = std::cos(th) * fx - std::sin(th) * fy;
     Ry = std::sin(th) * fx + std::cos(th) * fy;
   }
   // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
   // R_parent + Σ(−R_children) + F_loop + m g = m a_c.
-  void loop(const models::Loop& l, double& Rx, double& Ry) const {
-    const auto [bname, sign] = loop_balance_body(s, l);
-    const int b = s.body_index(bname);
-    const double m_b = s.bodies[b].mass_kg;
-    double Fx = m_b * (k.cax[b] - k.gx), Fy = m_b * (k.cay[b] - k.gy);
-    for (const auto& j : s.joints) {
+  void loop(int l, double& Rx, double& Ry) const {
+    const int b = m.loop_body[l];
+    const double m_b = m.scene.bodies[b].mass_kg;
+    double Fx = m_b * (k.cax[b] - m.gx), Fy = m_b * (k.cay[b] - m.gy);
+    for (size_t j = 0; j < m.child.size(); ++j) {
       double jx, jy;
-      if (j.child == bname) revolute(j.name, jx, jy), Fx -= jx, Fy -= jy;
-      if (j.parent == bname) revolute(j.name, jx, jy), Fx += jx, Fy += jy;
+      if (m.child[j] == b) revolute(static_cast<int>(j), jx, jy), Fx -= jx, Fy -= jy;
+      if (m.parent[j] == b) revolute(static_cast<int>(j), jx, jy), Fx += jx, Fy += jy;
     }
-    Rx = sign * Fx, Ry = sign * Fy;
+    Rx = m.loop_sign[l] * Fx, Ry = m.loop_sign[l] * Fy;
   }
   // Prismatic: Newton–Euler of the child C about the joint's child point P:
   // R = m (a_c − g) − Σ F_loops on C + Σ R_children; M = I α + (r_c − P) × m (a_c − g)
   // − Σ (r_k − P) × F_k over the other forces on C. Writes x, y, normal and moment.
-  void prismatic(const models::Joint& jt, double out[4]) const {
-    const int b = s.body_index(jt.child);
-    const auto& bd = s.bodies[b];
+  void prismatic(int j, double out[4]) const {
+    const auto& jt = m.scene.joints[j];
+    const int b = m.child[j];
+    const auto& bd = m.scene.bodies[b];
     const Kin& C = k.body[b];
     const double cC = std::cos(C.th), sC = std::sin(C.th);
     auto at = [&](models::Vec2 p, double& x, double& y) {
@@ -287,29 +243,30 @@ struct RowReactions {
     };
     double Px, Py;
     at(jt.child_point, Px, Py);
-    const double mx = bd.mass_kg * (k.cax[b] - k.gx), my = bd.mass_kg * (k.cay[b] - k.gy);
+    const double mx = bd.mass_kg * (k.cax[b] - m.gx), my = bd.mass_kg * (k.cay[b] - m.gy);
     double Rx = mx, Ry = my;
     double M = bd.inertia_kgm2 * C.al + (k.cx[b] - Px) * my - (k.cy[b] - Py) * mx;
     auto other = [&](double x, double y, double fx, double fy) {  // another force on C at (x, y)
       Rx -= fx, Ry -= fy;
       M -= (x - Px) * fy - (y - Py) * fx;
     };
-    for (const auto& kj : s.joints)
-      if (kj.parent == jt.child) {
+    for (size_t kj = 0; kj < m.parent.size(); ++kj)
+      if (m.parent[kj] == b) {
         double kx, ky, x, y;
-        revolute(kj.name, kx, ky);
-        at(kj.parent_point, x, y);
+        revolute(static_cast<int>(kj), kx, ky);
+        at(m.scene.joints[kj].parent_point, x, y);
         other(x, y, -kx, -ky);
       }
-    for (const auto& l : s.loops) {
+    for (size_t li = 0; li < m.scene.loops.size(); ++li) {
+      const auto& l = m.scene.loops[li];
       if (l.body_a != jt.child && l.body_b != jt.child) continue;
       double fx, fy, x, y;
-      loop(l, fx, fy);
+      loop(static_cast<int>(li), fx, fy);
       const bool on_b = l.body_b == jt.child;
       at(on_b ? l.point_b : l.point_a, x, y);
       other(x, y, on_b ? fx : -fx, on_b ? fy : -fy);
     }
-    const Kin P = jt.parent == models::kGround ? Kin{} : k.body[s.body_index(jt.parent)];
+    const Kin P = m.parent[j] < 0 ? Kin{} : k.body[m.parent[j]];
     const double ux = std::cos(P.th) * jt.axis.x - std::sin(P.th) * jt.axis.y;
     const double uy = std::sin(P.th) * jt.axis.x + std::cos(P.th) * jt.axis.y;
     out[0] = Rx, out[1] = Ry, out[2] = -uy * Rx + ux * Ry, out[3] = M;
@@ -317,9 +274,9 @@ struct RowReactions {
   // The mechanism's load on the ground: −(Σ m a_c − Σ m g), moment about O likewise.
   void shaking(double out[3]) const {
     double Fx = 0, Fy = 0, M = 0;
-    for (size_t b = 0; b < s.bodies.size(); ++b) {
-      const auto& bd = s.bodies[b];
-      const double fx = bd.mass_kg * (k.gx - k.cax[b]), fy = bd.mass_kg * (k.gy - k.cay[b]);
+    for (size_t b = 0; b < m.scene.bodies.size(); ++b) {
+      const auto& bd = m.scene.bodies[b];
+      const double fx = bd.mass_kg * (m.gx - k.cax[b]), fy = bd.mass_kg * (m.gy - k.cay[b]);
       Fx += fx, Fy += fy;
       M += k.cx[b] * fy - k.cy[b] * fx - bd.inertia_kgm2 * k.body[b].al;
     }
@@ -340,39 +297,111 @@ void drop_internal_lines(const models::Scene& s, models::TimeSeries& ts) {
 
 }  // namespace
 
+JointOutputModel make_joint_output_model(const models::Scene& scene, const Table& table,
+                                         const std::vector<std::string>& force_names) {
+  JointOutputModel m;
+  m.scene = scene;
+  m.names = joint_output_names(scene);
+  const auto& s = m.scene;
+  const size_t nj = s.joints.size();
+  auto col = [&](const std::string& name) {
+    const int c = table.column(name);
+    if (c < 0)
+      throw TableError("the reduced table has no column '" + name +
+                       "': extract it from a scene that asks for outputs.joints, reactions or shaking");
+    return c;
+  };
+  for (const auto& jt : s.joints) {
+    m.c_p.push_back(col("p_" + jt.name));
+    m.c_k.push_back(col("k_" + jt.name));
+    m.c_r.push_back(col("r_" + jt.name));
+    m.parent.push_back(jt.parent == models::kGround ? -1 : s.body_index(jt.parent));
+    m.child.push_back(s.body_index(jt.child));
+  }
+  // Joints with parents before children (a tree rooted at ground).
+  std::vector<char> done(nj, 0);
+  for (size_t pass = 0; pass <= nj && m.order.size() < nj; ++pass)
+    for (size_t j = 0; j < nj; ++j) {
+      if (done[j]) continue;
+      bool ready = m.parent[j] < 0;
+      for (int o : m.order) ready |= m.child[o] == m.parent[j];
+      if (ready) m.order.push_back(static_cast<int>(j)), done[j] = 1;
+    }
+  m.gx = s.gravity.enabled ? s.gravity.g_m_s2.x : 0.0, m.gy = s.gravity.enabled ? s.gravity.g_m_s2.y : 0.0;
+  // The reaction lines the requested reactions read (with_reaction_requests asked for them).
+  m.line_x.assign(nj, -1), m.line_y.assign(nj, -1);
+  auto line = [&](const std::string& name) {
+    const auto it = std::find(force_names.begin(), force_names.end(), name);
+    if (it == force_names.end()) throw TableError("the reduced run has no constraint line '" + name + "'");
+    return static_cast<int>(it - force_names.begin());
+  };
+  for (const auto& j : reaction_line_joints(s)) {
+    const int ji = s.joint_index(j);
+    m.line_x[ji] = line(internal_request_name(j, 'x'));
+    m.line_y[ji] = line(internal_request_name(j, 'y'));
+  }
+  // Every loop a requested reaction balances: its body (reaction_line_joints has checked it can).
+  m.loop_body.assign(s.loops.size(), -1), m.loop_sign.assign(s.loops.size(), 0);
+  for (size_t l = 0; l < s.loops.size(); ++l) {
+    const auto& lp = s.loops[l];
+    bool needed = std::find(s.outputs.reactions.begin(), s.outputs.reactions.end(), lp.name) != s.outputs.reactions.end();
+    for (const auto& r : s.outputs.reactions)
+      if (const auto* j = s.find_joint(r); j && j->type != models::JointType::Revolute)
+        needed |= lp.body_a == j->child || lp.body_b == j->child;
+    if (!needed) continue;
+    const auto [body, sign] = loop_balance_body(s, lp);
+    m.loop_body[l] = s.body_index(body), m.loop_sign[l] = sign;
+  }
+  return m;
+}
+
+JointOutputWorkspace::JointOutputWorkspace(const JointOutputModel& m)
+    : qj(m.scene.joints.size()),
+      uj(m.scene.joints.size()),
+      aj(m.scene.joints.size()),
+      body(m.scene.bodies.size()),
+      cax(m.scene.bodies.size()),
+      cay(m.scene.bodies.size()),
+      cx(m.scene.bodies.size()),
+      cy(m.scene.bodies.size()) {}
+
+void calc_joint_outputs(const JointOutputModel& m, const Table& table, JointOutputWorkspace& ws, double q,
+                        double qdot, double qddot, const double* forces, double* out) {
+  calc_kinematics(m, table, ws, q, qdot, qddot);
+  const StateReactions R{m, ws, forces};
+  const auto& s = m.scene;
+  size_t c = 0;
+  for (const auto& name : s.outputs.joints) {
+    const int j = s.joint_index(name);
+    out[c++] = ws.qj[j];
+    out[c++] = ws.uj[j];
+    out[c++] = ws.aj[j];
+  }
+  for (const auto& name : s.outputs.reactions) {
+    double v[4] = {0, 0, 0, 0};
+    const int j = s.joint_index(name);
+    const bool prismatic = j >= 0 && s.joints[j].type != models::JointType::Revolute;
+    if (j >= 0 && !prismatic) R.revolute(j, v[0], v[1]);
+    else if (prismatic) R.prismatic(j, v);
+    else
+      for (size_t l = 0; l < s.loops.size(); ++l)
+        if (s.loops[l].name == name) R.loop(static_cast<int>(l), v[0], v[1]);
+    for (int n = 0; n < (prismatic ? 4 : 2); ++n) out[c++] = v[n];
+  }
+  if (s.outputs.shaking) R.shaking(out + c);
+}
+
 void add_joint_outputs(const models::Scene& s, const ReducedModel& m, models::TimeSeries& ts) {
-  const auto names = joint_output_names(s);
-  RowKinematics k(s, m.table);
+  const JointOutputModel jm = make_joint_output_model(s, m.table, ts.force_names);
+  JointOutputWorkspace ws(jm);
   const size_t ns = ts.t.size();
-  ts.column_names = names;
-  ts.columns.assign(names.size(), std::vector<double>(ns));
-  RowReactions R{s, ts, k};
+  ts.column_names = jm.names;
+  ts.columns.assign(jm.names.size(), std::vector<double>(ns));
+  std::vector<double> forces(ts.forces.size()), out(jm.names.size());
   for (size_t i = 0; i < ns; ++i) {
-    k.calc(ts.q[i], ts.qdot[i], ts.qddot[i]);
-    R.i = i;
-    size_t c = 0;
-    for (const auto& name : s.outputs.joints) {
-      const int j = s.joint_index(name);
-      ts.columns[c++][i] = k.qj[j];
-      ts.columns[c++][i] = k.uj[j];
-      ts.columns[c++][i] = k.aj[j];
-    }
-    for (const auto& name : s.outputs.reactions) {
-      double v[4] = {0, 0, 0, 0};
-      const auto* jt = s.find_joint(name);
-      const bool prismatic = jt && jt->type != models::JointType::Revolute;
-      if (jt && !prismatic) R.revolute(name, v[0], v[1]);
-      else if (prismatic) R.prismatic(*jt, v);
-      else
-        for (const auto& l : s.loops)
-          if (l.name == name) R.loop(l, v[0], v[1]);
-      for (int n = 0; n < (prismatic ? 4 : 2); ++n) ts.columns[c++][i] = v[n];
-    }
-    if (s.outputs.shaking) {
-      double v[3];
-      R.shaking(v);
-      for (double x : v) ts.columns[c++][i] = x;
-    }
+    for (size_t f = 0; f < forces.size(); ++f) forces[f] = ts.forces[f][i];
+    calc_joint_outputs(jm, m.table, ws, ts.q[i], ts.qdot[i], ts.qddot[i], forces.data(), out.data());
+    for (size_t c = 0; c < out.size(); ++c) ts.columns[c][i] = out[c];
   }
   drop_internal_lines(s, ts);
 }

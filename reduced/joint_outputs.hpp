@@ -12,6 +12,7 @@
 #include "models/timeseries.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/samples.hpp"
+#include "reduced/table.hpp"
 
 namespace rdyn::reduced {
 
@@ -39,6 +40,10 @@ void add_joint_position_columns(const models::Scene& scene, const std::vector<do
 inline std::string internal_request_name(const std::string& joint, char axis) {
   return std::string("R_") + joint + "_c" + axis;
 }
+// The revolute joints whose reaction lines the scene's requested reactions read: each revolute
+// joint in outputs.reactions, and the joints Newton–Euler of a loop's body or a prismatic
+// joint's child uses. Throws TableError for reactions the reduced model cannot give (below).
+std::vector<std::string> reaction_line_joints(const models::Scene& scene);
 // `scene` plus those requests (extract and build the reduced model from it). Throws TableError
 // for reactions the reduced model cannot give: a prismatic joint's, or a loop neither of whose
 // bodies hangs from revolute joints only, touches no spring and no other loop.
@@ -52,6 +57,48 @@ struct ReducedReactions {
   std::vector<std::pair<std::string, std::string>> not_given;  // reaction name, why
 };
 ReducedReactions split_reduced_reactions(const models::Scene& scene);
+
+// One body's planar motion at one state (ground frame): angle [rad], rate [rad/s] and
+// acceleration [rad/s²], its origin [m] and the origin's acceleration [m/s²].
+struct BodyMotion {
+  double th = 0, w = 0, al = 0, x = 0, y = 0, ax = 0, ay = 0;
+};
+
+// What the joint outputs of one state read, fixed once from the scene, the table and the run's
+// constraint lines: add_joint_outputs evaluates it per row, the runtime per step
+// (reduced/runtime.hpp), so both give the same numbers.
+struct JointOutputModel {
+  models::Scene scene;               // the scene whose joint outputs these are
+  std::vector<std::string> names;    // joint_output_names(scene): calc_joint_outputs' order
+  std::vector<int> c_p, c_k, c_r;    // per joint: the table's p_, k_, r_ columns
+  std::vector<int> parent, child;    // per joint: body indices (parent −1: ground)
+  std::vector<int> order;            // joints with parents before children (a tree rooted at ground)
+  std::vector<int> line_x, line_y;   // per joint: its reaction lines R_<j>_cx, _cy among the forces (−1: none)
+  std::vector<int> loop_body, loop_sign;  // per loop a reaction needs: the body that balances it, ±1 (−1, 0: none)
+  double gx = 0.0, gy = 0.0;         // gravity [m/s²] (0 when disabled)
+};
+// `force_names`: the run's constraint forces in the order calc_joint_outputs gets their values
+// (a reduced model's force_names). Throws TableError when the table lacks a joint's p_, k_ or r_
+// column (extracted without joint outputs) or the forces a reaction line, or for a reaction
+// the reduced model cannot give.
+JointOutputModel make_joint_output_model(const models::Scene& scene, const Table& table,
+                                         const std::vector<std::string>& force_names);
+
+// Scratch of one evaluation, sized once: calc_joint_outputs allocates nothing.
+struct JointOutputWorkspace {
+  explicit JointOutputWorkspace(const JointOutputModel& m);
+  std::vector<double> qj, uj, aj;  // joint coordinates [rad or m], rates, accelerations
+  std::vector<BodyMotion> body;    // per body
+  std::vector<double> cax, cay, cx, cy;  // per body: centre of mass acceleration [m/s²], position [m]
+};
+
+// The joint outputs at (q, q̇, q̈) with the run's constraint forces there (`forces`, in the order
+// make_joint_output_model was given) into out[0 … names.size()): joint motion q_j = p_j + k_j q,
+// q̇_j = r_j q̇, q̈_j = r_j q̈ + (dr_j/dq) q̇²; revolute reactions from their lines turned into
+// ground by the child's angle; loops and prismatic joints and the shaking load by Newton–Euler
+// with the bodies' accelerations from planar tree kinematics. Allocation-free.
+void calc_joint_outputs(const JointOutputModel& m, const Table& table, JointOutputWorkspace& ws, double q,
+                        double qdot, double qddot, const double* forces, double* out);
 
 // Fills ts.columns with joint_output_names(scene) for a reduced run of the model built from
 // with_reaction_requests(scene), from the table (p_, k_, r_ columns, dr_/dq of the cubic) and

@@ -118,12 +118,21 @@ rdyn_status rdyn_model_initial_state(const rdyn_model* model, double* q, double*
 }
 
 int rdyn_model_num_forces(const rdyn_model* model) {
-  return model ? static_cast<int>(model->model.reduced.force_names.size()) : 0;
+  return model ? static_cast<int>(model->model.force_names.size()) : 0;
 }
 
 const char* rdyn_model_force_name(const rdyn_model* model, int k) {
   if (!model || k < 0 || k >= rdyn_model_num_forces(model)) return nullptr;
-  return model->model.reduced.force_names[k].c_str();
+  return model->model.force_names[k].c_str();
+}
+
+int rdyn_model_num_joint_outputs(const rdyn_model* model) {
+  return model && model->model.joint_outputs ? static_cast<int>(model->model.joint_outputs->names.size()) : 0;
+}
+
+const char* rdyn_model_joint_output_name(const rdyn_model* model, int k) {
+  if (!model || k < 0 || k >= rdyn_model_num_joint_outputs(model)) return nullptr;
+  return model->model.joint_outputs->names[k].c_str();
 }
 
 int rdyn_model_num_drive_torques(const rdyn_model* model) {
@@ -182,6 +191,13 @@ rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int
   if (!workspace || n < 0 || (n > 0 && !forces)) return RDYN_BAD_ARGUMENT;
   const auto& f = workspace->ws.get_forces();
   for (int k = 0; k < n && k < static_cast<int>(f.size()); ++k) forces[k] = f[k];
+  return RDYN_OK;
+}
+
+rdyn_status rdyn_get_joint_outputs(const rdyn_workspace* workspace, double* out, int n) {
+  if (!workspace || n < 0 || (n > 0 && !out)) return RDYN_BAD_ARGUMENT;
+  const auto& v = workspace->ws.get_joint_outputs();
+  for (int k = 0; k < n && k < static_cast<int>(v.size()); ++k) out[k] = v[k];
   return RDYN_OK;
 }
 

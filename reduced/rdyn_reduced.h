@@ -3,7 +3,9 @@
  * A thin layer over reduced/runtime.hpp: the same model, workspace and fixed RK4 step on
  * Eksergian's equation m1(q) q̈ + m2(q) q̇² = F*. Opaque handles; every function returns a
  * status and never lets an exception or abort through. Loading allocates and may fail with
- * a message; rdyn_step and the getters allocate nothing.
+ * a message; rdyn_step and the getters allocate nothing. A scene that asks for joint outputs
+ * takes the table `rdyn extract` writes for it; its reactions and shaking load come with each
+ * step (rdyn_get_joint_outputs).
  *
  *   rdyn_model* m; rdyn_workspace* ws; char msg[512];
  *   if (rdyn_model_load("bicycle.csv", "bicycle", &m, msg, sizeof msg) != RDYN_OK) puts(msg);
@@ -78,6 +80,13 @@ rdyn_status rdyn_model_initial_state(const rdyn_model* model, double* q, double*
 /* Requested constraint forces: count, and the name of force k (owned by the model). */
 int rdyn_model_num_forces(const rdyn_model* model);
 const char* rdyn_model_force_name(const rdyn_model* model, int k); /* NULL when out of range */
+/* The scene's joint outputs (outputs.joints, reactions, shaking): count, and the name of output
+ * k (owned by the model), as `rdyn simulate --model reduced` names its columns: q_<joint>,
+ * qdot_<joint>, qddot_<joint> [rad or m, /s, /s²], R_<joint>_x, R_<joint>_y [N] (a prismatic
+ * joint adds R_<joint>_normal [N], R_<joint>_M [N·m]), shaking_x, shaking_y [N], shaking_M [N·m].
+ * 0 and NULL when the scene asks for none. */
+int rdyn_model_num_joint_outputs(const rdyn_model* model);
+const char* rdyn_model_joint_output_name(const rdyn_model* model, int k);
 /* The scene's joint torques the drive commands: count, and the scene value of torque i. */
 int rdyn_model_num_drive_torques(const rdyn_model* model);
 rdyn_status rdyn_model_drive_torque(const rdyn_model* model, int i, double* nominal);
@@ -105,6 +114,10 @@ rdyn_status rdyn_drive_torque(const rdyn_model* model, rdyn_workspace* workspace
 
 /* Copies min(n, number of forces) constraint forces F_E,k [N] into forces. */
 rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int n);
+/* Copies min(n, number of joint outputs) joint outputs at the current state into out, in the
+ * order of rdyn_model_joint_output_name: what `rdyn simulate --model reduced` writes in a row
+ * at the same state. Computed with every step; allocates nothing. */
+rdyn_status rdyn_get_joint_outputs(const rdyn_workspace* workspace, double* out, int n);
 
 #ifdef __cplusplus
 }

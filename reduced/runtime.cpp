@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "models/scene_yaml.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/simulate_reduced.hpp"
 
 namespace rdyn::reduced {
@@ -40,8 +41,14 @@ RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& sce
   const Interpolation interp = options.interpolation.value_or(
       samples.periodic ? Interpolation::Fourier : Interpolation::CubicSpline);
   RuntimeModel m;
-  m.reduced = make_reduced_model(samples, scene, interp,
+  // Joint outputs as `rdyn extract` and `rdyn simulate --model reduced` give them: the scene with
+  // the reaction lines they need (its hash is the table's), `reactions: all` those it can give.
+  const models::Scene oscene = scene.outputs.reactions_all ? split_reduced_reactions(scene).scene : scene;
+  const bool joints = wants_joint_outputs(oscene);
+  m.reduced = make_reduced_model(samples, joints ? with_reaction_requests(oscene) : scene, interp,
                                  options.energy_consistent_m2);  // checks the scene hash
+  for (const auto& f : scene.outputs.constraint_forces) m.force_names.push_back(f.name);  // first in reduced's
+  if (joints) m.joint_outputs = make_joint_output_model(oscene, m.reduced.table, m.reduced.force_names);
   // The runtime gives every constraint force at every step, with no way to leave one out near
   // a pole (check_force_poles): a table with one is refused here rather than answered wrongly.
   for (size_t k = 0; k < m.reduced.force_poles.size(); ++k)
@@ -70,11 +77,15 @@ RuntimeModel load_runtime_model(const std::string& table_path,
 
 RuntimeWorkspace::RuntimeWorkspace(const RuntimeModel& model)
     : state_(model.reduced),
-      forces_(model.reduced.force_names.size()),
+      lines_(model.reduced.force_names.size()),
+      forces_(model.force_names.size()),
+      joint_out_(model.joint_outputs ? model.joint_outputs->names.size() : 0),
       saved_(model.reduced),
-      forces_saved_(model.reduced.force_names.size()),
+      forces_saved_(forces_.size()),
+      joint_out_saved_(joint_out_.size()),
       inverse_(model.reduced),
       forces_inverse_(model.reduced.force_names.size()) {
+  if (model.joint_outputs) joint_ws_.emplace(*model.joint_outputs);
   // The scene's initial state was checked with the scene (limits::kMaxRate, kMaxAngle_rad);
   // a non-periodic table may still not cover it, which the first reset() would report.
   if (reset(model, *this, model.initial_q, model.initial_qdot) != Status::Ok) {
@@ -89,7 +100,9 @@ bool RuntimeWorkspace::fits(const RuntimeModel& model) const {
          state_.scratch.size() == m.rhs_cols.size() &&
          state_.scratch_out.size() == m.out_cols.size() &&
          state_.scratch_rec.size() == m.record_cols.size() &&
-         forces_.size() == m.force_names.size() &&
+         lines_.size() == m.force_names.size() && forces_.size() == model.force_names.size() &&
+         joint_out_.size() == (model.joint_outputs ? model.joint_outputs->names.size() : 0) &&
+         joint_ws_.has_value() == model.joint_outputs.has_value() &&
          inverse_.scratch_rec.size() == m.record_cols.size() &&
          inverse_.gate_on.size() == m.gates.size() &&
          inverse_.torque_value.size() == m.torques.size() &&
@@ -111,13 +124,19 @@ Status RuntimeWorkspace::apply_drive(const RuntimeModel& model, const Drive& dri
   return Status::Ok;
 }
 
-// q̈, energy and constraint forces at the current state from one fused table lookup.
+// q̈, energy and constraint forces at the current state from one fused table lookup, then the
+// joint outputs from them (the rows' route, reduced::calc_joint_outputs).
 Status RuntimeWorkspace::calc_outputs(const RuntimeModel& model) {
   double qddot, power;
   const double energy =
-      calc_sample(model.reduced, state_, state_.q, state_.qdot, qddot, power, forces_.data());
+      calc_sample(model.reduced, state_, state_.q, state_.qdot, qddot, power, lines_.data());
+  std::copy(lines_.begin(), lines_.begin() + static_cast<std::ptrdiff_t>(forces_.size()), forces_.begin());
+  if (model.joint_outputs)
+    calc_joint_outputs(*model.joint_outputs, model.reduced.table, *joint_ws_, state_.q, state_.qdot, qddot,
+                       lines_.data(), joint_out_.data());
   bool finite = std::isfinite(qddot) && std::isfinite(power) && std::isfinite(energy);
   for (double f : forces_) finite = finite && std::isfinite(f);
+  for (double f : joint_out_) finite = finite && std::isfinite(f);
   if (!finite) return Status::NonFinite;
   qddot_ = qddot, power_nc_ = power, energy_ = energy;
   return Status::Ok;
@@ -145,6 +164,7 @@ Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double q
     return Status::BadState;
   copy_state(ws.state_, ws.saved_);
   std::copy(ws.forces_.begin(), ws.forces_.end(), ws.forces_saved_.begin());
+  std::copy(ws.joint_out_.begin(), ws.joint_out_.end(), ws.joint_out_saved_.begin());
   if (const Status s = ws.apply_drive(model, drive); s != Status::Ok) return s;
   auto& st = ws.state_;
   st.t = 0.0, st.q = q, st.qdot = qdot, st.work = 0.0;
@@ -152,6 +172,7 @@ Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double q
   if (const Status s = ws.calc_outputs(model); s != Status::Ok) {
     copy_state(ws.saved_, ws.state_);
     std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
+    std::copy(ws.joint_out_saved_.begin(), ws.joint_out_saved_.end(), ws.joint_out_.begin());
     return s;
   }
   ws.guard_ = start_divergence_guard(ws.energy_, model.potential_min, 0.0);
@@ -167,6 +188,7 @@ Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
   auto& st = ws.state_;
   copy_state(st, ws.saved_);
   std::copy(ws.forces_.begin(), ws.forces_.end(), ws.forces_saved_.begin());
+  std::copy(ws.joint_out_.begin(), ws.joint_out_.end(), ws.joint_out_saved_.begin());
   const double qddot0 = ws.qddot_, power0 = ws.power_nc_, energy0 = ws.energy_;
   if (const Status s = ws.apply_drive(model, drive); s != Status::Ok) return s;
 
@@ -183,6 +205,7 @@ Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
   if (s != Status::Ok) {  // roll back: the caller sees the state before the call
     copy_state(ws.saved_, st);
     std::copy(ws.forces_saved_.begin(), ws.forces_saved_.end(), ws.forces_.begin());
+    std::copy(ws.joint_out_saved_.begin(), ws.joint_out_saved_.end(), ws.joint_out_.begin());
     ws.qddot_ = qddot0, ws.power_nc_ = power0, ws.energy_ = energy0;
     ws.guard_ = guard0;
     return s;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "models/scene.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/samples.hpp"
 #include "reduced/table.hpp"
@@ -56,9 +57,15 @@ struct RuntimeOptions {
   bool energy_consistent_m2 = false;  // m2 = ½ dm1/dq of the m1 interpolant
 };
 
-// The immutable model: the reduced table joined with its scene's loads.
+// The immutable model: the reduced table joined with its scene's loads. A scene that asks for
+// joint outputs (outputs.joints, reactions, shaking) is joined as `rdyn extract` and `rdyn
+// simulate --model reduced` join it: with the reaction lines its reactions need
+// (reduced::with_reaction_requests; `reactions: all`: those the reduced model can give), so the
+// table `rdyn extract` wrote for it fits, and the runtime gives the same joint outputs per step.
 struct RuntimeModel {
-  ReducedModel reduced;
+  ReducedModel reduced;                  // its force_names: the scene's, then the reaction lines
+  std::vector<std::string> force_names;  // the scene's constraint forces (get_forces' order)
+  std::optional<JointOutputModel> joint_outputs;  // none: the scene asks for no joint output
   std::string scene_name;
   bool revolute = true;                  // q in rad (else m)
   double initial_q = 0.0;                // the scene's initial state [rad or m]
@@ -90,8 +97,12 @@ class RuntimeWorkspace {
   double get_qddot() const { return qddot_; }      // [rad/s² or m/s²] at (q, q̇), current drive
   double get_work() const { return state_.work; }  // work of the non-conservative loads [J]
   double get_energy() const { return energy_; }    // ½ m1 q̇² + V [J]
-  // Constraint forces F_E,k [N] in the order of model.reduced.force_names.
+  // Constraint forces F_E,k [N] in the order of model.force_names (the scene's).
   const std::vector<double>& get_forces() const { return forces_; }
+  // The scene's joint outputs at the current state (q_<j> [rad or m], …, R_<j>_x [N], shaking_x
+  // [N], …) in the order of model.joint_outputs->names — what `rdyn simulate --model reduced`
+  // writes in its row (reduced::calc_joint_outputs); empty when the scene asks for none.
+  const std::vector<double>& get_joint_outputs() const { return joint_out_; }
   // Joint torques applied by the last drive [N·m or N], in the order of model.drive_names.
   const std::vector<double>& get_drive_torques() const { return state_.torque_value; }
   long get_steps() const { return steps_; }        // steps since the last reset
@@ -111,11 +122,14 @@ class RuntimeWorkspace {
   ReducedWorkspace state_;
   double qddot_ = 0.0, power_nc_ = 0.0, energy_ = 0.0;
   DivergenceGuard guard_;  // divergence guard (reduced_model.hpp)
-  std::vector<double> forces_;
+  std::vector<double> lines_;      // every constraint line of model.reduced (the scene's, then reaction lines)
+  std::vector<double> forces_;     // the scene's constraint forces
+  std::vector<double> joint_out_;  // the scene's joint outputs
+  std::optional<JointOutputWorkspace> joint_ws_;
   long steps_ = 0, switches_ = 0;
   // Scratch for rolling back a failed step.
   ReducedWorkspace saved_;
-  std::vector<double> forces_saved_;
+  std::vector<double> forces_saved_, joint_out_saved_;
   // Scratch for calc_drive_torque, which sets gates of its own and must not touch the state.
   ReducedWorkspace inverse_;
   std::vector<double> forces_inverse_;

@@ -232,9 +232,9 @@ _plans = {}  # a worker's plans by their definition: a process pool's worker pla
 
 def _plan(spec):
     if spec not in _plans:
-        scene, sets, vary, cadence_hz, power_w, load, grid_deg, drive_cadence_hz = spec
+        scene, sets, vary, cadence_hz, power_w, load, grid_deg, drive_cadence_hz, peaks = spec
         _plans[spec] = _rdyn.plan_sweep(scene, list(sets), list(vary), cadence_hz, power_w, load, grid_deg,
-                                        drive_cadence_hz, None)
+                                        drive_cadence_hz, list(peaks), None)
     return _plans[spec]
 
 
@@ -247,11 +247,13 @@ def sweep_case(case):
 
 
 def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_deg=10, drive_cadence_hz=None,
-          threads=None):
+          threads=None, peaks=()):
     """``rdyn sweep``: every combination of the ``vary`` axes ({scene key: (a, b, n)} or
     {key: "a:b:n"}), each case calibrated on the reduced model (or, with ``drive_cadence_hz``,
     driven at that constant rate for one revolution). Returns one dict per case in case order
-    with the CLI CSV's columns (case, the varied keys, status, …, error).
+    with the CLI CSV's columns (case, the varied keys, status, …, error); ``peaks``: output
+    columns whose peak over the case's steady cycle (revolution) each row adds as
+    ``peak_<column>`` (``rdyn sweep --peak``).
 
     ``map``: any executor's map (``ThreadPoolExecutor().map``, ``ProcessPoolExecutor().map``,
     a dask client's map followed by gather, …) over the cases; the work item is a small tuple
@@ -260,7 +262,8 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
             tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
             None if cadence_hz is None else float(cadence_hz), None if power_w is None else float(power_w),
-            load or "", float(grid_deg), None if drive_cadence_hz is None else float(drive_cadence_hz))
+            load or "", float(grid_deg), None if drive_cadence_hz is None else float(drive_cadence_hz),
+            tuple(peaks))
     plan = _plan(spec)  # checked here, before any case runs: bad input raises at once
     header = _csv_rows(plan.header)[0]
     if map is None:
@@ -312,5 +315,14 @@ class Runtime:
     work = property(lambda self: self._rt.work, doc="work of the non-conservative loads [J]")
     forces = property(lambda self: self._rt.forces, doc="constraint forces [N] (force_names order)")
     force_names = property(lambda self: self._rt.force_names)
+    joint_outputs = property(lambda self: self._rt.joint_outputs,
+                             doc="the scene's joint outputs at the current state: reactions [N], shaking "
+                                 "load, joint motion (joint_output_names order; empty when it asks for none)")
+    joint_output_names = property(lambda self: self._rt.joint_output_names,
+                                  doc="their names, as rdyn simulate --model reduced names its columns")
+
+    def joint_output_dict(self):
+        """The joint outputs at the current state as {name: value}."""
+        return dict(zip(self._rt.joint_output_names, self._rt.joint_outputs.tolist()))
     drive_names = property(lambda self: self._rt.drive_names)
     drive_torques = property(lambda self: self._rt.drive_torques)

@@ -136,6 +136,25 @@ def test_runtime_matches_fixed_step_simulate():
     np.testing.assert_allclose(qs, run["q"][1:], rtol=0, atol=1e-12)
 
 
+def test_runtime_joint_outputs_are_the_reduced_runs_rows():
+    # A scene that asks for reactions and the shaking load: the runtime takes the table extract
+    # gives it, and reset to a row's state gives that row's joint outputs (runtime_test.cpp
+    # checks them against closed forms).
+    scene = rdyn.load_scene("slider-crank", {"outputs.reactions": "all", "outputs.shaking": "true"})
+    table = rdyn.extract(scene, grid_deg=10)
+    run = rdyn.simulate(scene, model="reduced", duration=0.05, table=table, interpolation="fourier")
+    rt = rdyn.Runtime(table, scene)
+    assert rt.force_names == ["rod_axial"]
+    assert rt.joint_output_names[:2] == ["R_crank_x", "R_crank_y"] and rt.joint_output_names[-1] == "shaking_M"
+    for i in (0, len(run["t"]) // 2, len(run["t"]) - 1):
+        rt.reset(run["q"][i], run["qdot"][i])
+        values = rt.joint_output_dict()
+        assert list(values) == rt.joint_output_names
+        for name, v in values.items():
+            assert v == pytest.approx(run[name][i], rel=1e-9, abs=1e-9 * np.max(np.abs(run[name]))), name
+    assert runtime_for("fourbar", 30).joint_output_names == []
+
+
 def test_runtime_errors_leave_the_state():
     rt = runtime_for("fourbar", 30)
     q0, qdot0 = rt.q, rt.qdot
@@ -324,6 +343,21 @@ def test_calibrating_sweep_on_a_thread_pool_is_the_cli_sweep(rdyn_cli, tmp_path)
         rows = rdyn.sweep(scene, {"bicycle_leg.crank_length_m": "0.16:0.18:2"}, map=pool.map)
     assert rows == read_sweep_csv(tmp_path / "c.csv")
     assert rows[0]["drive_torque_Nm"] > rows[1]["drive_torque_Nm"] > 0  # a longer crank needs less torque
+
+
+def test_sweep_peaks_on_a_thread_pool_are_the_cli_sweep(rdyn_cli, tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+    scene = rdyn.load_scene("bicycle")
+    rdyn_cli("sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:2", "--peak", "F_knee",
+             "--out", str(tmp_path / "p.csv"))
+    with ThreadPoolExecutor(2) as pool:
+        rows = rdyn.sweep(scene, {"bicycle_leg.crank_length_m": "0.16:0.18:2"}, map=pool.map, peaks=["F_knee"])
+    assert rows == read_sweep_csv(tmp_path / "p.csv")
+    for r in rows:  # the sampled cycle's peak against the refined one (sweep_peaks_test.cpp)
+        assert r["peak_F_knee"] == pytest.approx(r["peak_knee_force_N"], rel=1e-4)
+    with pytest.raises(rdyn.SceneError) as e:
+        rdyn.sweep(scene, {"bicycle_leg.crank_length_m": (0.16, 0.18, 2)}, peaks=["R_knee_x"])
+    assert e.value.field == "--peak"
 
 
 def test_sweep_errors_have_their_fields():

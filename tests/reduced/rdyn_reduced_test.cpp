@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cli_table.hpp"
+#include "pendulum_table.hpp"
 #include "reduced/runtime.hpp"
 
 namespace rdyn::reduced {
@@ -119,6 +120,11 @@ TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
   EXPECT_TRUE(std::isnan(f[1]));
   EXPECT_EQ(rdyn_get_forces(ws, f, -1), RDYN_BAD_ARGUMENT);
   EXPECT_EQ(rdyn_get_forces(ws, nullptr, 1), RDYN_BAD_ARGUMENT);
+  // The bicycle asks for no joint output: none, and copying none is fine.
+  EXPECT_EQ(rdyn_model_num_joint_outputs(m), 0);
+  EXPECT_EQ(rdyn_model_joint_output_name(m, 0), nullptr);
+  EXPECT_EQ(rdyn_get_joint_outputs(ws, f, 3), RDYN_OK);
+  EXPECT_TRUE(std::isnan(f[1]));
 
   // Refusals are the C++ statuses, and change nothing.
   EXPECT_EQ(rdyn_step(m, ws, NAN, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_STEP);
@@ -147,6 +153,49 @@ TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
   rdyn_workspace_free(fb_ws);
   rdyn_model_free(m);
   rdyn_model_free(fb);
+}
+
+// The joint outputs through C: names and count as the C++ model's, the values the C++ runtime's
+// after the same steps, field by field (the C++ values are checked against closed forms and
+// `rdyn simulate` rows in runtime_test.cpp), and the pendulum's pivot reaction while it hangs.
+TEST_F(CApi, JointOutputsAreTheCxxRuntimesAndThePivotsClosedForm) {
+  const fs::path pdir = dir_ / "joint-outputs";
+  ASSERT_EQ(test::write_pendulum_table(pdir), 0);
+  const std::string table = (pdir / "pendulum.csv").string(), scene = (pdir / "pendulum.yaml").string();
+  char msg[512];
+  rdyn_model* m = nullptr;
+  ASSERT_EQ(rdyn_model_load(table.c_str(), scene.c_str(), &m, msg, sizeof msg), RDYN_OK) << msg;
+  const auto model = load_runtime_model(table, scene);
+  ASSERT_EQ(rdyn_model_num_joint_outputs(m), 8);
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(rdyn_model_joint_output_name(m, k), model.joint_outputs->names[k]);
+  EXPECT_STREQ(rdyn_model_joint_output_name(m, 4), "R_pivot_y");
+  EXPECT_EQ(rdyn_model_joint_output_name(m, 8), nullptr);
+  EXPECT_EQ(rdyn_model_joint_output_name(m, -1), nullptr);
+  EXPECT_EQ(rdyn_model_num_forces(m), 0);  // the reaction lines are not the scene's forces
+  rdyn_workspace* ws = nullptr;
+  ASSERT_EQ(rdyn_workspace_new(m, &ws), RDYN_OK);
+  // Hanging at ω = 2 rad/s: R_y = m (g + l ω²).
+  ASSERT_EQ(rdyn_reset(m, ws, -M_PI / 2, 2.0, {RDYN_DRIVE_SCALE, 1.0}), RDYN_OK);
+  double o[9];
+  o[8] = -7.0;
+  ASSERT_EQ(rdyn_get_joint_outputs(ws, o, 9), RDYN_OK);  // copies the eight there are
+  EXPECT_EQ(o[8], -7.0);
+  const double m_kg = test::kPendulumMass_kg, l = test::kPendulumArm_m;
+  EXPECT_NEAR(o[4], m_kg * (9.81 + l * 4.0), 1e-9 * m_kg * 9.81);
+  EXPECT_NEAR(o[3], 0.0, 1e-9 * m_kg * 9.81);
+  RuntimeWorkspace cxx(model);
+  ASSERT_EQ(reset(model, cxx, -M_PI / 2, 2.0), Status::Ok);
+  for (int i = 0; i < 700; ++i) {
+    ASSERT_EQ(rdyn_step(m, ws, 1e-3, {RDYN_DRIVE_SCALE, 1.0}), RDYN_OK);
+    ASSERT_EQ(step(model, cxx, 1e-3, Drive{}), Status::Ok);
+  }
+  ASSERT_EQ(rdyn_get_joint_outputs(ws, o, 8), RDYN_OK);
+  for (int k = 0; k < 8; ++k) EXPECT_EQ(o[k], cxx.get_joint_outputs()[k]) << model.joint_outputs->names[k];
+  EXPECT_EQ(rdyn_get_joint_outputs(ws, o, -1), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_get_joint_outputs(ws, nullptr, 1), RDYN_BAD_ARGUMENT);
+  EXPECT_EQ(rdyn_get_joint_outputs(nullptr, o, 1), RDYN_BAD_ARGUMENT);
+  rdyn_workspace_free(ws);
+  rdyn_model_free(m);
 }
 
 // A body on a pivot with gravity and a viscous bearing: m = 2 kg, centre of mass l = 0.3 m from

@@ -8,12 +8,17 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <map>
+#include <sstream>
 #include <tuple>
 
 #include "analytic_source.hpp"
 #include "cli_table.hpp"
 #include "count_allocations.hpp"
+#include "models/scene_yaml.hpp"
+#include "pendulum_table.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/simulate_reduced.hpp"
 
@@ -370,6 +375,113 @@ TEST(Runtime, LoadsATableFileCheckedAgainstItsScene) {
   EXPECT_THROW(load_runtime_model((dir / "missing.csv").string(), "fourbar"), TableError);
   EXPECT_THROW(load_runtime_model(table, "no-such-scene"), models::SceneError);
   fs::remove_all(dir);
+}
+
+// The pendulum's pivot reaction in closed form, R = m (a_c − g) with a_c the centre of mass's
+// acceleration: hanging (q = −90°) at ω, a_c = l ω² up, so R = (0, m (g + l ω²)); horizontal
+// (q = 0) at ω, a_c = (−l ω², l α) with α = −m g l / I_O (I_O = I + m l²), so R = (−m l ω²,
+// m (g + l α)). The shaking load on the ground is −R, and the joint's own motion is the state.
+TEST(Runtime, PendulumPivotReactionIsItsClosedForm) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_runtime_pendulum_" + std::to_string(::getpid()));
+  ASSERT_EQ(test::write_pendulum_table(dir), 0);
+  const auto model = load_runtime_model((dir / "pendulum.csv").string(), (dir / "pendulum.yaml").string());
+  fs::remove_all(dir);
+  ASSERT_TRUE(model.joint_outputs.has_value());
+  EXPECT_EQ(model.joint_outputs->names,
+            (std::vector<std::string>{"q_pivot", "qdot_pivot", "qddot_pivot", "R_pivot_x", "R_pivot_y", "shaking_x",
+                                      "shaking_y", "shaking_M"}));
+  EXPECT_TRUE(model.force_names.empty());  // the reaction lines are the model's own
+  RuntimeWorkspace ws(model);
+  EXPECT_TRUE(ws.get_forces().empty());
+  const double m = test::kPendulumMass_kg, l = test::kPendulumArm_m, g = 9.81, w = 3.0;
+  const double I_O = test::kPendulumInertia_kgm2 + m * l * l, alpha = -m * g * l / I_O;
+  struct Case {
+    double q, Rx, Ry, qddot;
+  };
+  for (const Case& c : {Case{-M_PI / 2, 0.0, m * (g + l * w * w), 0.0}, Case{0.0, -m * l * w * w, m * (g + l * alpha), alpha}}) {
+    ASSERT_EQ(reset(model, ws, c.q, w), Status::Ok);
+    const auto& o = ws.get_joint_outputs();
+    ASSERT_EQ(o.size(), 8u);
+    const double scale = m * (g + l * w * w);  // the largest reaction component here [N]
+    EXPECT_NEAR(o[0], c.q, 1e-12);
+    EXPECT_NEAR(o[1], w, 1e-12);
+    EXPECT_NEAR(o[2], c.qddot, 1e-9 * std::abs(alpha));
+    EXPECT_NEAR(o[3], c.Rx, 1e-9 * scale) << "at q = " << c.q;
+    EXPECT_NEAR(o[4], c.Ry, 1e-9 * scale) << "at q = " << c.q;
+    EXPECT_NEAR(o[5], -o[3], 1e-9 * scale);
+    EXPECT_NEAR(o[6], -o[4], 1e-9 * scale);
+  }
+}
+
+// A row of timeseries.csv by column name.
+std::map<std::string, std::vector<double>> read_columns(const std::filesystem::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream hs(line);
+  for (std::string f; std::getline(hs, f, ',');) names.push_back(f);
+  std::map<std::string, std::vector<double>> c;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    size_t k = 0;
+    for (std::string f; std::getline(ls, f, ',') && k < names.size(); ++k) c[names[k]].push_back(std::stod(f));
+  }
+  return c;
+}
+
+// The runtime takes the table `rdyn extract` writes for a scene that asks for joint outputs (it
+// used to refuse it as "extracted from a different scene") and gives, at every state of a
+// `rdyn simulate --model reduced` run, that row's joint outputs and constraint force: the
+// slider-crank with every joint's motion and reaction (revolute, prismatic, the wrist-pin loop;
+// `reactions: all`) and the shaking load, reset to each row's (q, q̇), to 1e-9 of each column's
+// peak. Reset and step allocate nothing with the joint outputs either.
+TEST(Runtime, JointOutputsAreTheReducedRunsRows) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_runtime_joints_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::vector<std::string> sets{"--set", "outputs.reactions=all", "--set", "outputs.shaking=true",
+                                      "--set", "outputs.joints=all"};
+  const std::string table = (dir / "slider-crank.csv").string();
+  std::vector<std::string> extract{"extract", "slider-crank", "--out", table};
+  extract.insert(extract.end(), sets.begin(), sets.end());
+  ASSERT_EQ(test::run_rdyn_cli(extract), 0);
+  std::vector<std::string> simulate{"simulate", "slider-crank", "--model", "reduced", "--table", table,
+                                    "--duration", "0.3", "--out", (dir / "run").string()};
+  simulate.insert(simulate.end(), sets.begin(), sets.end());
+  ASSERT_EQ(test::run_rdyn_cli(simulate), 0);
+  auto rows = read_columns(dir / "run" / "timeseries.csv");
+  const auto scene = models::load_scene(
+      "slider-crank", {{"outputs.reactions", "all"}, {"outputs.shaking", "true"}, {"outputs.joints", "all"}});
+  const auto model = make_runtime_model(read_samples_csv(table), scene);
+  fs::remove_all(dir);
+  ASSERT_TRUE(model.joint_outputs.has_value());
+  const auto& names = model.joint_outputs->names;
+  ASSERT_EQ(names.size(), 3u * 3 + 2 + 2 + 4 + 2 + 3);  // motions; crank, rod, slider (prismatic), wrist_pin; shaking
+  EXPECT_EQ(model.force_names, std::vector<std::string>{"rod_axial"});
+  RuntimeWorkspace ws(model);
+  ASSERT_GT(rows["t"].size(), 100u);
+  std::vector<std::string> compared = names;
+  compared.push_back("F_rod_axial");
+  std::map<std::string, double> peak;
+  for (const auto& n : compared) {
+    ASSERT_EQ(rows[n].size(), rows["t"].size()) << n;
+    for (double v : rows[n]) peak[n] = std::max(peak[n], std::abs(v));
+  }
+  for (size_t i = 0; i < rows["t"].size(); ++i) {
+    ASSERT_EQ(reset(model, ws, rows["q"][i], rows["qdot"][i]), Status::Ok);
+    for (size_t c = 0; c < names.size(); ++c)
+      ASSERT_NEAR(ws.get_joint_outputs()[c], rows[names[c]][i], 1e-9 * std::max(peak[names[c]], 1e-9))
+          << names[c] << " at row " << i;
+    ASSERT_NEAR(ws.get_forces()[0], rows["F_rod_axial"][i], 1e-9 * peak["F_rod_axial"]) << i;
+  }
+  const long before = g_allocations;
+  ASSERT_EQ(reset(model, ws, scene.initial.q, scene.initial.qdot), Status::Ok);
+  for (int i = 0; i < 500; ++i) ASSERT_EQ(step(model, ws, 1e-3, Drive{}), Status::Ok);
+  step(model, ws, NAN, Drive{});
+  EXPECT_EQ(g_allocations - before, 0);
 }
 
 }  // namespace

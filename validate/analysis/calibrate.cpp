@@ -97,10 +97,8 @@ struct FullCheck {
 // The full model at the calibrated values, started from the reduced steady cycle's point: its
 // one initial state is q and q̇ of that cycle at the same phase (the scene's own initial speed,
 // whether it gave qdot or cadence_Hz, and its q are replaced, never combined), run until steady.
-FullCheck confirm_on_full(const models::Scene& scene, const Selection& sel, const CalibrationOptions& opt,
-                          const CalibrationResult& r) {
-  models::Scene sf = with_load(scene, sel, std::abs(r.load_value), r.resistance_coefficient);
-  sf.initial = models::Initial{r.steady_q, r.steady_qdot};
+FullCheck confirm_on_full(const models::Scene& scene, const CalibrationOptions& opt, const CalibrationResult& r) {
+  const models::Scene sf = scene_at_operating_point(scene, opt, r);
   SteadyConfirmOptions fc;
   fc.cadence_hz = r.mean_cadence_hz_reduced;
   fc.max_duration_s = opt.full_max_s;
@@ -681,7 +679,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& 
     return r;
   }
   progress.note("calibrate: confirming with the full model");
-  const FullCheck full = confirm_on_full(scene, sel, opt, r);
+  const FullCheck full = confirm_on_full(scene, opt, r);
   r.mean_cadence_hz_full = full.c.measures.cadence_hz;
   r.speed_fluctuation_full = full.c.measures.speed_fluctuation;
   r.peak_force_full_N = full.c.measures.peak_force_N;

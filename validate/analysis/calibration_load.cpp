@@ -136,6 +136,13 @@ models::Scene with_load(models::Scene s, const Selection& sel, double T, double 
   return s;
 }
 
+models::Scene scene_at_operating_point(const models::Scene& scene, const CalibrationOptions& opt,
+                                       const CalibrationResult& r) {
+  models::Scene s = with_load(scene, select_load(scene, opt), std::abs(r.load_value), r.resistance_coefficient);
+  s.initial = models::Initial{r.steady_q, r.steady_qdot};
+  return s;
+}
+
 void set_load(reduced::ReducedModel& m, const Selection& sel, double T) {
   for (const auto& e : sel.entries) value_of(m, e) = e.sign * T;
 }

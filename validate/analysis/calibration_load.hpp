@@ -41,6 +41,12 @@ const char* unit_of(const models::Scene& s, const std::string& joint);
 // The selected load set to magnitude T (signs kept) in a scene, and with a power the one
 // resistance's coefficient (NaN: unchanged).
 models::Scene with_load(models::Scene s, const Selection& sel, double T, double coefficient);
+// The scene at a calibration's operating point: its load and resistance at the values found and
+// its one initial state the point (steady_q, steady_qdot) of the reduced steady cycle (the scene's
+// own initial speed and q replaced, never combined). What the full model confirms and a sweep's
+// peak columns run.
+models::Scene scene_at_operating_point(const models::Scene& scene, const CalibrationOptions& opt,
+                                       const CalibrationResult& r);
 // The same in the reduced model.
 void set_load(reduced::ReducedModel& m, const Selection& sel, double T);
 

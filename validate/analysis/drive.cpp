@@ -303,6 +303,24 @@ DriveRecord calc_drive_reduced(const models::Scene& scene, const reduced::Reduce
   return r;
 }
 
+std::vector<std::string> drive_column_names(const std::vector<std::string>& force_names,
+                                            const std::vector<std::string>& column_names, bool revolute) {
+  std::vector<std::string> names{"t", "q", "qdot", "qddot", revolute ? "drive_Nm" : "drive_N", "drive_W"};
+  for (const auto& n : force_names) names.push_back("F_" + n);  // names are checked by the scene reader
+  names.insert(names.end(), column_names.begin(), column_names.end());
+  return names;
+}
+
+std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute) {
+  return drive_column_names(r.force_names, r.column_names, revolute);
+}
+
+const std::vector<double>& drive_column(const DriveRecord& r, size_t k) {
+  const std::vector<double>* fixed[] = {&r.t, &r.q, &r.qdot, &r.qddot, &r.drive, &r.power};
+  if (k < 6) return *fixed[k];
+  return k - 6 < r.forces.size() ? r.forces[k - 6] : r.columns[k - 6 - r.forces.size()];
+}
+
 DriveStats calc_drive_stats(const DriveRecord& r) {
   DriveStats s;
   const size_t n = r.drive.size();

@@ -60,6 +60,14 @@ struct DriveRecord {
   double wall_s = 0.0;
 };
 
+// The columns of `rdyn drive`'s CSV in order: t, q, qdot, qddot, drive_Nm (drive_N for a
+// prismatic q), drive_W, F_<name> per constraint force, then the joint outputs.
+std::vector<std::string> drive_column_names(const std::vector<std::string>& force_names,
+                                            const std::vector<std::string>& column_names, bool revolute);
+std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute);
+// Column k of that list (k < its size).
+const std::vector<double>& drive_column(const DriveRecord& r, size_t k);
+
 // Inverse dynamics of the full model along the motion (continuation from the assembled
 // configuration). Throws engine::EngineError where the motion leaves the mechanism's range.
 DriveRecord calc_drive_full(const models::Scene& scene, const PrescribedMotion& motion);

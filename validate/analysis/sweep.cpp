@@ -18,6 +18,7 @@
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/analysis/drive.hpp"
+#include "validate/analysis/sweep_peaks.hpp"
 #include "validate/io/escape.hpp"
 #include "validate/io/progress.hpp"
 
@@ -115,8 +116,17 @@ struct TableCache {
   long walks = 0;  // tables whose dead-point walk ran
 };
 
-// A calibrated case's fields after its status.
-std::string calibrated_fields(const SweepPlan& plan, const models::Scene& scene, TableCache& cache) {
+// The peak columns' fields, each followed by its comma ("" without --peak).
+std::string peak_fields(const std::vector<double>& peaks) {
+  std::string f;
+  for (const double p : peaks) f += fmt::format("{:.10g},", p);
+  return f;
+}
+
+// A calibrated case's fields after its status. With --peak joint outputs the table carries the
+// reaction lines they need (the calibration reads m1, m2 and the loads' ratios only: the same).
+std::string calibrated_fields(const SweepPlan& plan, const models::Scene& case_scene, TableCache& cache) {
+  const models::Scene scene = peak_table_scene(case_scene, plan.opt.peaks);
   const std::string key = table_key(scene);
   if (!cache.calibration || cache.calibration->first != key) {
     cache.calibration.reset();  // a failed extraction leaves none
@@ -127,16 +137,24 @@ std::string calibrated_fields(const SweepPlan& plan, const models::Scene& scene,
     cache.neighbour = neighbour_of(scene, cache.calibration->second);
     if (cache.calibration->second.walked) ++cache.walks;
   }
+  // calibrate()'s reduced part on the model of the table's scene, checked on the case's own (its
+  // reaction lines' reserved names are the reduced model's, not the user's).
   Progress quiet(false);
-  const auto r = calibrate(scene, cache.calibration->second, plan.calibration, quiet);
+  const CalibrationTable& table = cache.calibration->second;
+  const auto model = reduced::make_reduced_model(table.samples, with_unit_load(scene, plan.calibration), table.table);
+  const auto r = calibrate_reduced(model, case_scene, plan.calibration, quiet);
   // No constraint force requested: an empty field, never NaN.
   const std::string peak = plan.force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
-  return fmt::format("{:.10g},{:.10g},{:.10g},{},{:.10g},", r.load_value, r.mean_cadence_hz_reduced, r.mean_power_w,
-                     peak, r.speed_fluctuation);
+  const auto peaks = plan.opt.peaks.empty() ? std::vector<double>()
+                                            : calc_steady_cycle_peaks(case_scene, scene, cache.calibration->second,
+                                                                      plan.calibration, r, plan.opt.peaks);
+  return fmt::format("{:.10g},{:.10g},{:.10g},{},{:.10g},{}", r.load_value, r.mean_cadence_hz_reduced, r.mean_power_w,
+                     peak, r.speed_fluctuation, peak_fields(peaks));
 }
 
 // A driven case's fields after its status: the reduced model over one revolution at the rate.
-std::string driven_fields(const SweepPlan& plan, const models::Scene& scene, TableCache& cache) {
+std::string driven_fields(const SweepPlan& plan, const models::Scene& case_scene, TableCache& cache) {
+  const models::Scene scene = peak_table_scene(case_scene, plan.opt.peaks);
   const std::string key = table_key(scene);
   if (!cache.drive || cache.drive->first != key) {
     cache.drive.reset();
@@ -144,11 +162,19 @@ std::string driven_fields(const SweepPlan& plan, const models::Scene& scene, Tab
     cache.drive.emplace(key, extract_from_full(scene, plan.opt.grid_deg, reduced::Method::Kinetostatic).samples);
   }
   const auto model = reduced::make_reduced_model(cache.drive->second, scene, reduced::Interpolation::Fourier);
-  const DriveRecord r = calc_drive_reduced(model, revolution_motion(scene.initial.q, plan.opt.drive_cadence_hz));
+  const auto motion = revolution_motion(scene.initial.q, plan.opt.drive_cadence_hz);
+  // With joint-output peaks: the rows' reactions and shaking from the table's reaction lines,
+  // which calc_drive_reduced then drops (the scene's own forces stay, first as before).
+  const DriveRecord r = peaks_need_joint_outputs(case_scene, plan.opt.peaks)
+                            ? calc_drive_reduced(reduced_joint_output_scene(case_scene), model, motion)
+                            : calc_drive_reduced(model, motion);
   const DriveStats st = calc_drive_stats(r);
   const std::string peak = st.force_peaks.empty() ? std::string() : fmt::format("{:.10g}", st.force_peaks[0]);
-  return fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},", st.rms, st.peak, st.mean, st.mean_power_W,
-                     st.peak_power_W, peak);
+  const auto peaks = calc_column_peaks(
+      drive_column_names(r, true), [&](size_t k) -> const std::vector<double>& { return drive_column(r, k); },
+      plan.opt.peaks);
+  return fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{}", st.rms, st.peak, st.mean, st.mean_power_W,
+                     st.peak_power_W, peak, peak_fields(peaks));
 }
 
 // Case `index`'s row; `ok` false when it failed (its row then has status "error" and the message).
@@ -162,7 +188,8 @@ std::string case_row(const SweepPlan& plan, long index, TableCache& cache, bool&
     return fmt::format("{}{},ok,{}", index, c.params, fields);
   } catch (const std::exception& e) {
     ok = false;
-    return fmt::format("{}{},error,{}{}", index, c.params, drive ? ",,,,,," : ",,,,,", csv_field(e.what()));
+    return fmt::format("{}{},error,{}{}", index, c.params, std::string(static_cast<size_t>(plan.result_fields), ','),
+                       csv_field(e.what()));
   }
 }
 
@@ -224,6 +251,10 @@ SweepPlan plan_sweep(const SweepOptions& opt) {
                                "give it, or a validation.calibrate block in the scene");
     check_calibratable(base, copt);  // a scene that cannot be calibrated fails here, not in every case
   }
+  // The peak columns: each a column of the base scene's reduced run, its reactions ones the
+  // reduced model gives (with_reaction_requests' TableError otherwise), before any case runs.
+  check_peak_columns(base, opt.peaks, drive);
+  peak_table_scene(base, opt.peaks);
   // Every axis at both ends of its range on the base scene: unknown keys and values out of
   // range fail here, before any thread starts. Ends of two tables: the axis changes the mechanism.
   for (const auto& a : opt.axes) {
@@ -253,12 +284,14 @@ SweepPlan plan_sweep(const SweepOptions& opt) {
   for (const auto& a : opt.axes) plan.header += "," + csv_field(a.key);
   const std::string force_column = plan.force.empty() ? "constraint" : plan.force;
   if (drive)
-    plan.header += fmt::format(",status,drive_rms_Nm,drive_peak_Nm,drive_mean_Nm,mean_power_w,peak_power_w,peak_{}_force_N,"
-                               "error",
+    plan.header += fmt::format(",status,drive_rms_Nm,drive_peak_Nm,drive_mean_Nm,mean_power_w,peak_power_w,peak_{}_force_N",
                                force_column);
   else
-    plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation,error",
+    plan.header += fmt::format(",status,{},mean_cadence_hz,mean_power_w,peak_{}_force_N,speed_fluctuation",
                                load_value_column(base, copt), force_column);
+  for (const auto& p : opt.peaks) plan.header += "," + csv_field("peak_" + p);
+  plan.header += ",error";
+  plan.result_fields = (drive ? 6 : 5) + static_cast<int>(opt.peaks.size());
   plan.id.total = total;
   plan.id.scene_hex = models::scene_hash_hex(models::scene_hash(base));
   plan.id.sweep_hex = models::scene_hash_hex(models::fnv1a64(sweep_defining_text(base, plan)));

@@ -36,6 +36,10 @@ struct SweepOptions {
   // row gives the drive's RMS, peak and mean, the mean and peak power and the peak constraint
   // force (what `rdyn drive --model reduced` reports). Excludes cadence_hz, power_w and load.
   double drive_cadence_hz = 0.0;
+  // `--peak COLUMN` (repeatable): a peak_<COLUMN> column per name, after the others: the largest
+  // |value| of that output column of the case's reduced run over its steady cycle (a drive
+  // sweep: its revolution). validate/analysis/sweep_peaks.hpp.
+  std::vector<std::string> peaks;
 };
 
 // A sweep checked and described before any case runs.
@@ -47,13 +51,14 @@ struct SweepPlan {
   SweepIdentity id;                     // the whole sweep: its fingerprint, scene hash and cases
   SweepRange range;                     // this shard's cases
   std::string header;                   // the CSV's column header (no line break)
+  int result_fields = 0;                // fields between status and error (an error row leaves them empty)
   std::vector<bool> changes_mechanism;  // per axis: its two ends need two tables (run first)
 };
 
 // Loads the base scene and checks everything before work: every axis key is applied at both
 // ends of its range to the base scene, so an unknown key or an out-of-range value is a
 // SceneError here; the scene must be calibratable (a drive sweep: revolute, the rate finite);
-// at most 1e6 cases.
+// at most 1e6 cases; every --peak column one of the base scene's reduced run (check_peak_columns).
 SweepPlan plan_sweep(const SweepOptions& opt);
 
 struct SweepResult {

@@ -165,13 +165,17 @@ SweepPart parse_sweep_part(const std::string& text, const std::string& file) {
   if (cut) throw models::SceneError(file, records.back().line, "row", "the file is cut short (no final line break)");
   const Record& head = records.front();
   // case, the axes (at least one), status and the result columns (six of a calibrating sweep,
-  // seven of a drive sweep, the last `error`): status is the last field of that name.
+  // seven of a drive sweep, the last `error`), with a peak_<column> per --peak before `error`:
+  // status is the last field of that name (a peak column's name starts with peak_).
   const size_t n = head.fields.size();
   size_t status_at = 0;
   for (size_t k = 0; k < n; ++k)
     if (head.fields[k] == "status") status_at = k;
-  if (head.fields.empty() || head.fields[0] != "case" || status_at < 2 || n - status_at < 7 || n - status_at > 8 ||
-      head.fields[n - 1] != "error")
+  const size_t results = status_at + 1 < n && head.fields[status_at + 1] == "drive_rms_Nm" ? 8 : 7;
+  bool peaks_ok = n >= status_at + results;
+  for (size_t k = status_at + results - 1; peaks_ok && k + 1 < n; ++k)
+    peaks_ok = head.fields[k].rfind("peak_", 0) == 0;
+  if (head.fields.empty() || head.fields[0] != "case" || status_at < 2 || !peaks_ok || head.fields[n - 1] != "error")
     throw models::SceneError(file, head.line, "header", "expected case,<axes>,status,… as written by rdyn sweep");
   p.header = head.text;
   long previous = p.range.first - 1;

@@ -433,6 +433,7 @@ SweepOptions check_sweep_args(const SweepArgs& a) {
   o.load = a.load;
   o.threads = a.threads.value_or(0);  // 0: the hardware's threads
   o.grid_deg = a.grid_deg;
+  o.peaks = a.peaks;  // checked against the scene by plan_sweep
   require_grid("--grid-deg", a.grid_deg);
   if (a.drive_cadence_hz) {  // a typed 0 is refused, not "no drive sweep"
     const double f = *a.drive_cadence_hz;

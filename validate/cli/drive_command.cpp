@@ -229,13 +229,6 @@ void add_drive_results(nlohmann::json& run, const PrescribedMotion& motion, cons
 
 }  // namespace
 
-std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute) {
-  std::vector<std::string> names{"t", "q", "qdot", "qddot", revolute ? "drive_Nm" : "drive_N", "drive_W"};
-  for (const auto& n : r.force_names) names.push_back("F_" + n);  // names are checked by the scene reader
-  for (const auto& n : r.column_names) names.push_back(n);
-  return names;
-}
-
 namespace {
 
 // Everything checked and planned before any work or output: the option values, the motor and

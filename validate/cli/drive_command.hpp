@@ -42,8 +42,6 @@ struct DriveRun {
   bool revolute = true;  // drive_Nm (else drive_N)
 };
 DriveRun drive_scene(const models::Scene& scene, const DriveArgs& args, const reduced::Samples* table = nullptr);
-// timeseries.csv's header names of a run's rows, in order (t, q, qdot, qddot, drive_Nm or
-// drive_N, drive_W, F_<force>…, joint outputs…).
-std::vector<std::string> drive_column_names(const DriveRecord& r, bool revolute);
+// The CSV's header names of a run's rows: drive_column_names (validate/analysis/drive.hpp).
 
 }  // namespace rdyn::validate

@@ -154,7 +154,7 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       "sweep",
       "Population sweep: calibrate the drive load of many cases with the reduced model, in parallel threads. "
       "One CSV row per case: the varied parameters, the calibrated drive load, the peak of the first constraint "
-      "force and the speed fluctuation. --shard i/N runs the i-th of N contiguous blocks of cases "
+      "force, the speed fluctuation and a peak_COLUMN per --peak. --shard i/N runs the i-th of N contiguous blocks of cases "
       "(Slurm job arrays, GNU parallel), each CSV naming its sweep and cases; `rdyn sweep --merge OUT.csv PART...` "
       "checks the parts are one whole sweep and writes what one process would have.");
   sweep->add_option("scene", sw.inputs, "Scene name or YAML file (with --merge: the part CSVs)")->required();
@@ -183,6 +183,12 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       "Drive each case at this constant rate [rev/s] for one revolution (reduced model, as rdyn drive) instead of "
       "calibrating it: the rows give the drive's RMS, peak and mean, the mean and peak power");
   drive->excludes(cadence)->excludes(power)->excludes(load);
+  auto* peak = sweep->add_option(
+      "--peak", sw.peaks,
+      "COLUMN (repeatable): add peak_COLUMN, the largest |value| of that column of the case's reduced run over its "
+      "steady cycle (a drive sweep: its revolution): any column of `rdyn simulate --model reduced` but t (q, qdot, "
+      "qddot, energy, work, F_<force>, the joint outputs the scene requests: R_<joint>_x, shaking_y, q_<joint>, …; "
+      "a drive sweep's: also drive_Nm, drive_W); an unknown or unrequested column is refused, naming the available");
   sweep->add_option("--merge", sw.merge,
                     "OUT.csv: merge the part CSVs given as positional arguments (one sweep, every case once) into "
                     "one file in case order")
@@ -196,7 +202,8 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       ->excludes(power)
       ->excludes(load)
       ->excludes(grid)
-      ->excludes(drive);
+      ->excludes(drive)
+      ->excludes(peak);
 }
 
 void add_inspect_command(CLI::App& app, InspectArgs& ins) {

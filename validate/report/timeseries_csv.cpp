@@ -16,9 +16,8 @@ void write_timeseries_csv(const std::string& path, const engine::TimeSeries& ts)
       throw models::NumericalError(fmt::format("the time series has a non-finite {} at t = {:.6g} s", what, ts.t[i]));
   };
   TextSink sink(path);
-  std::string header = "t,q,qdot,qddot,energy,work";
-  for (const auto& n : ts.force_names) header += ",F_" + n;  // names are checked by the scene reader
-  for (const auto& n : ts.column_names) header += "," + n;
+  std::string header;  // names are checked by the scene reader
+  for (const auto& n : models::timeseries_column_names(ts)) header += (header.empty() ? "" : ",") + n;
   sink.add(header + "\n");
   std::string row;
   for (size_t i = 0; i < ts.t.size(); ++i) {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,46 @@ TEST_F(SweepCli, DriveCadenceGivesTheDrivesColumns) {
     const auto b = sweep(args);
     EXPECT_EQ(b.status, 2) << more[1] << " " << b.err;
     EXPECT_FALSE(fs::exists(dir / "bad.csv")) << more[1];
+  }
+}
+
+// --peak through the binary: its columns in the header, shards with --peak merged byte for byte
+// into the one-process sweep, a part with other --peak columns refused by --merge, and an
+// unknown or unrequested column refused before any case runs (exit 2, naming --peak and the
+// columns there are, nothing written). Values: tests/validate/analysis/sweep_peaks_test.cpp.
+TEST_F(SweepCli, PeakColumnsShardMergeAndRefuse) {
+  const std::vector<std::string> args{"sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:2",
+                                      "--peak", "F_knee", "--peak", "qdot"};
+  auto run = [&](std::vector<std::string> more) {
+    std::vector<std::string> a = args;
+    a.insert(a.end(), more.begin(), more.end());
+    return test::run_rdyn(a, dir);
+  };
+  const auto whole = run({"--threads", "2", "--out", "whole.csv"});
+  ASSERT_EQ(whole.status, 0) << whole.err;
+  const std::string csv = test::slurp(dir / "whole.csv");
+  EXPECT_NE(csv.find(",speed_fluctuation,peak_F_knee,peak_qdot,error\n"), std::string::npos) << csv;
+  for (const char* shard : {"0/2", "1/2"})
+    ASSERT_EQ(run({"--threads", "1", "--shard", shard, "--out", std::string("p") + shard[0] + ".csv"}).status, 0);
+  const auto m = test::run_rdyn({"sweep", "--merge", "merged.csv", "p1.csv", "p0.csv"}, dir);
+  ASSERT_EQ(m.status, 0) << m.err;
+  EXPECT_EQ(test::slurp(dir / "merged.csv"), csv);
+  // The same shard without --peak is another sweep.
+  ASSERT_EQ(test::run_rdyn({"sweep", "bicycle", "--vary", "bicycle_leg.crank_length_m=0.16:0.18:2", "--threads", "1",
+                            "--shard", "1/2", "--out", "plain1.csv"},
+                           dir)
+                .status,
+            0);
+  const auto mixed = test::run_rdyn({"sweep", "--merge", "mixed.csv", "p0.csv", "plain1.csv"}, dir);
+  EXPECT_EQ(mixed.status, 2) << mixed.err;
+  EXPECT_NE(mixed.err.find("plain1.csv:1: field 'sweep'"), std::string::npos) << mixed.err;
+  EXPECT_FALSE(fs::exists(dir / "mixed.csv"));
+  for (const char* column : {"F_hip", "R_knee_x"}) {
+    const auto bad = run({"--peak", column, "--out", "bad.csv"});
+    EXPECT_EQ(bad.status, 2) << bad.err;
+    EXPECT_NE(bad.err.find("field '--peak'"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("this sweep's columns: q, qdot, qddot, energy, work, F_knee"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.csv"));
   }
 }
 
