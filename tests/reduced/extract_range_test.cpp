@@ -32,16 +32,23 @@ Samples range_samples(test::AnalyticSource& src, const models::Scene& scene, dou
 TEST(ExtractRange, GridRules) {
   // Never fewer intervals than a full turn at the same grid (360/g); a revolute range wider
   // than a turn's worth keeps intervals no longer than the step.
-  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true), 36);
-  EXPECT_EQ(range_intervals(125 * kDeg, 1 * kDeg, true), 360);
-  EXPECT_EQ(range_intervals(500 * kDeg, 10 * kDeg, true), 50);
-  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false), 36);
-  EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false), 180);
-  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 36);
-  EXPECT_EQ(range_intervals(20 * kDeg, 90 * kDeg, true), 4);  // never fewer than 4 (5 points: Akima's minimum)
-  EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true), TableError);
-  EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true), TableError);
-  EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true), TableError);  // > kMaxTableRows points
+  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true, false), 36);
+  EXPECT_EQ(range_intervals(125 * kDeg, 1 * kDeg, true, false), 360);
+  EXPECT_EQ(range_intervals(500 * kDeg, 10 * kDeg, true, false), 50);
+  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false, false), 36);
+  EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false, false), 180);
+  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true, false), 36);
+  EXPECT_EQ(range_intervals(20 * kDeg, 90 * kDeg, true, false), 4);  // never fewer than 4 (5 points: Akima's minimum)
+  EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true, false), TableError);
+  EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true, false), TableError);
+  EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true, false), TableError);  // > kMaxTableRows points
+  // A range ending at a dead point: kDeadPointRefinement× the intervals at every grid (so the
+  // ladder's halvings stay halvings), capped at the reader's limit instead of refused.
+  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false, true), 36 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(0.1, 5 * kDeg, false, true), 72 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(48 * kDeg, 10 * kDeg, true, true), 36 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(0.1, 0.01 * kDeg, false, true), kMaxTableRows - 1);
+  EXPECT_EQ(range_intervals(0.1, 0.01 * kDeg, false, false), 36000);
 }
 
 TEST(ExtractRange, SamplesTheRangeWithClosedFormValuesAndNoWrap) {
