@@ -117,6 +117,24 @@ std::string format_coordinate(double q, bool revolute) {
   return revolute ? fmt::format("q = {:.9g}°", q * 180 / kPi) : fmt::format("q = {:.9g} m", q);
 }
 
+double calc_dead_point_margin(const IndependentDomain& d) {
+  return d.dead_min && d.dead_max ? kDeadPointMargin * (*d.dead_max - *d.dead_min) : 0.0;
+}
+
+std::string describe_domain(const IndependentDomain& d, const std::string& joint) {
+  const double k = d.revolute ? 180 / kPi : 1.0;
+  const std::string unit = d.revolute ? "°" : " m";
+  if (d.periodic) return fmt::format("full turn: '{}' turns fully (the walk met no dead point in 360°)", joint);
+  if (!d.unbounded_reason.empty()) return d.unbounded_reason;
+  if (!d.dead_min || !d.dead_max)
+    return fmt::format("declared by the scene: independent_range [{:.9g}, {:.9g}]{}", d.min * k, d.max * k, unit);
+  return fmt::format(
+      "dead points found at {:.9g}{} and {:.9g}{} (the loops cannot close beyond them; located by bisection); "
+      "the range stops {:.6g}{} ({:g} % of their distance) short of each: [{:.9g}, {:.9g}]{}",
+      *d.dead_min * k, unit, *d.dead_max * k, unit, calc_dead_point_margin(d) * k, unit, 100 * kDeadPointMargin,
+      d.min * k, d.max * k, unit);
+}
+
 namespace {
 
 IndependentDomain calc_domain_edges(const FullModel& model) {
@@ -168,7 +186,7 @@ IndependentDomain calc_domain_edges(const FullModel& model) {
   }
   d.dead_min = *down.dead;
   d.dead_max = *up.dead;
-  const double margin = kDeadPointMargin * (*d.dead_max - *d.dead_min);
+  const double margin = calc_dead_point_margin(d);
   d.min = *d.dead_min + margin;
   d.max = *d.dead_max - margin;
   d.min_edge = d.max_edge = "dead point";

@@ -14,9 +14,12 @@ namespace rdyn::engine {
 // A found range stops short of each dead point by this fraction of the distance between the
 // two dead points: m1 grows without bound there (like 1/distance for a slider-crank driven
 // from its slider: dθ/ds ∝ 1/√(s_dead − s)), so a table reaching the dead point cannot be
-// interpolated. 5 %: m1 at the edges of the slider-crank-slider scene is 1.5–2× its mid-stroke
-// value, 2–3× its minimum for fourbar-rocker (docs/theory.md, "Range tables").
-inline constexpr double kDeadPointMargin = 0.05;
+// interpolated. 1 %, with range tables ending at a dead point sampled kDeadPointRefinement
+// (reduced/extract.hpp) times finer, so that the last grid interval is 0.28 of its distance to
+// the dead point at a 10° grid: measured on slider-crank-slider released 1e-7 m inside the edge,
+// reduced against full ≤ 2.4e-4 of the scale on the rod force and 6e-5 on q̇ (the 5 % margin
+// this replaced, at 36 intervals: 3.3e-3 and 8.9e-4; docs/theory.md, "Range tables").
+inline constexpr double kDeadPointMargin = 0.01;
 
 // A configuration inside the domain where the loop Jacobian loses rank (a parallelogram lying
 // flat): the full model passes it in the partitioned formulation (engine/singular_passage.hpp).
@@ -65,6 +68,15 @@ IndependentDomain calc_independent_domain_edges(const FullModel& model);
 // centres of mass, joint locations) from its frame's origin, and the travel of prismatic joints (guesses; the independent one's initial q and declared range); at least 1 mm. Sets the
 // continuation moves of a prismatic coordinate.
 double calc_length_scale(const models::Scene& scene);
+
+// The distance a found range keeps from each dead point, kDeadPointMargin of theirs [rad or m];
+// 0 when the domain has no dead points (full turn, declared, unbounded).
+double calc_dead_point_margin(const IndependentDomain& domain);
+
+// Why the domain is what it is, one sentence for `rdyn inspect` (text and JSON): "full turn: …",
+// "declared by the scene: …", "dead points found at … and …; the range stops … (1 % of their
+// distance) short of each: […]", or the unbounded reason. `joint` is the independent joint.
+std::string describe_domain(const IndependentDomain& domain, const std::string& joint);
 
 // "q = 12.5°" or "q = 0.2345 m".
 std::string format_coordinate(double q, bool revolute);

@@ -1,7 +1,7 @@
 // What a newcomer needs while writing a scene (`rdyn inspect`): the configuration the full
 // model assembles at t = 0, its degrees of freedom, the loops' closure gaps, and the domain of
 // the independent coordinate exactly as the models use it (engine/independent_range.hpp: full
-// turn, declared range, or the dead points less the 5 % margin). Plain records; no Simbody type.
+// turn, declared range, or the dead points less the kDeadPointMargin of 1 %). Plain records; no Simbody type.
 #pragma once
 
 #include <string>

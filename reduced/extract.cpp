@@ -135,7 +135,7 @@ long check_grid_step(double step_rad) {
   return n;
 }
 
-long range_intervals(double span, double step_rad, bool revolute) {
+long range_intervals(double span, double step_rad, bool revolute, bool ends_at_dead_point) {
   if (!(std::isfinite(span) && span > 0))
     throw TableError(fmt::format("the range of the independent coordinate must be finite and positive (got {:g})",
                                  span));
@@ -147,7 +147,9 @@ long range_intervals(double span, double step_rad, bool revolute) {
   if (!(n + 1 <= static_cast<double>(kMaxTableRows)))
     throw TableError(fmt::format("a range table of {:.6g} with a {:.6g}° grid would have {:.3g} points, more than {}",
                                  span, step_rad * 180 / kPi, n + 1, kMaxTableRows));
-  return std::max(4L, static_cast<long>(n));
+  const long base = std::max(4L, static_cast<long>(n));
+  if (!ends_at_dead_point) return base;
+  return std::min(base * kDeadPointRefinement, kMaxTableRows - 1);
 }
 
 namespace {
@@ -175,7 +177,9 @@ GridPlan plan_grid(KinetostaticSource& src, const models::Scene& scene, const Ex
     throw TableError("a prismatic independent coordinate needs a range: a table over [q_min, q_max] "
                      "(independent_range, or the range rdyn finds from the dead points)");
   if (!std::isfinite(scene.initial.q)) throw TableError("the initial q is not finite");
-  g.n = g.periodic ? per_turn : range_intervals(opt.range->max - opt.range->min, opt.step_rad, g.revolute) + 1;
+  // A range found from the dead points is sampled finer (kDeadPointRefinement): m1 ∝ 1/distance there.
+  const bool dead_edge = opt.range && (opt.range->min_edge == "dead point" || opt.range->max_edge == "dead point");
+  g.n = g.periodic ? per_turn : range_intervals(opt.range->max - opt.range->min, opt.step_rad, g.revolute, dead_edge) + 1;
   g.h = g.periodic ? 2 * kPi / g.n : (opt.range->max - opt.range->min) / static_cast<double>(g.n - 1);
   g.nk = src.num_constraint_forces(), g.nj = src.num_joints();
   if (g.nk != static_cast<int>(scene.outputs.constraint_forces.size()) || g.nj != static_cast<int>(scene.joints.size()))

@@ -37,12 +37,22 @@ struct ExtractRange {
   std::string min_edge, max_edge;  // what ends it: "dead point" or "declared limit" (recorded in the table)
 };
 
+// A range table ending at a dead point gets this many times the intervals of one ending at
+// declared limits. The range stops 1 % of the dead points' distance short of each
+// (engine::kDeadPointMargin), where m1 still grows like 1/distance (docs/theory.md, "Range
+// tables"); a uniform grid interpolates that to a given accuracy when its step is a fixed
+// fraction of the distance to the dead point: 10× gives 360 intervals at a 10° grid, a last
+// interval 0.28 of its distance to the dead point (the same ratio at every grid of the ladder).
+inline constexpr long kDeadPointRefinement = 10;
+
 // Intervals of a range table for a grid step [rad]: a revolute range gets the fewest equal
 // intervals no longer than the step; a prismatic one as many intervals as the step makes over a
 // turn (a 10° grid: 36 intervals over the stroke), so the grid ladders of `rdyn validate` apply
-// to both. At least 4 intervals (5 points, what every interpolation takes: GSL's Akima needs 5). Throws TableError when the
-// span is not finite and positive, or makes more than kMaxTableRows points.
-long range_intervals(double span, double step_rad, bool revolute);
+// to both; kDeadPointRefinement times that when an edge is a dead point (capped at
+// kMaxTableRows points). At least 4 intervals (5 points, what every interpolation takes: GSL's
+// Akima needs 5). Throws TableError when the span is not finite and positive, or the unrefined
+// grid makes more than kMaxTableRows points.
+long range_intervals(double span, double step_rad, bool revolute, bool ends_at_dead_point);
 
 struct ExtractOptions {
   double step_rad = 10.0 * 3.14159265358979323846 / 180.0;  // grid step (revolute) [rad]

@@ -29,6 +29,16 @@ TEST(IndependentRange, SliderDeadPointsAreRodMinusAndPlusCrank) {
   EXPECT_NEAR(d.max, 0.25 - kDeadPointMargin * 0.10, 1e-8);
   EXPECT_EQ(d.min_edge, "dead point");
   EXPECT_EQ(d.max_edge, "dead point");
+  // The documented margin: 1 % of the 0.1 m stroke, 1 mm from each closed-form dead point (a
+  // rehabilitation press loses no more than that of its stroke), and the sentence inspect prints.
+  EXPECT_NEAR(calc_dead_point_margin(d), 0.001, 1e-10);
+  EXPECT_LT(0.25 - d.max, 0.001 + 1e-8);
+  EXPECT_GT(0.25 - d.max, 0.001 - 1e-8);
+  const std::string why = describe_domain(d, "slider");
+  EXPECT_EQ(why.rfind("dead points found at 0.149999999 m and 0.250000001 m", 0), 0u) << why;
+  EXPECT_NE(why.find("stops 0.001 m (1 % of their distance) short of each: [0.150999999, 0.249000001] m"),
+            std::string::npos)
+      << why;
 }
 
 TEST(IndependentRange, RockerDeadPointsAreWhereCrankAndCouplerAlign) {
@@ -60,6 +70,8 @@ TEST(IndependentRange, ADeclaredRangeIsTakenAsGiven) {
   EXPECT_EQ(d.max, 0.23);
   EXPECT_EQ(d.min_edge, "declared limit");
   EXPECT_FALSE(d.dead_min);
+  EXPECT_EQ(calc_dead_point_margin(d), 0.0);  // no margin taken from a declared limit
+  EXPECT_EQ(describe_domain(d, "slider"), "declared by the scene: independent_range [0.17, 0.23] m");
 }
 
 TEST(IndependentRange, ADeclaredRangeAcrossADeadPointIsRefused) {
@@ -97,7 +109,7 @@ initial: {q: 0.1}
 
 TEST(IndependentRange, AnInitialPositionNextToADeadPointIsRefused) {
   auto scene = models::load_scene("slider-crank-slider");
-  scene.initial.q = 0.151;  // inside the loops' range, within the 5 % margin of the dead point
+  scene.initial.q = 0.1505;  // inside the loops' range, within the 1 % margin (0.001 m) of the dead point
   const FullModel model(scene);
   try {
     calc_independent_domain(model);

@@ -12,6 +12,7 @@
 
 #include "../reduced/analytic_source.hpp"
 #include "engine/kinetostatic.hpp"
+#include "reduced/table.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/joint_outputs.hpp"
@@ -544,13 +545,13 @@ RangeTable range_table(const models::Scene& scene, double step_deg) {
 // crank, so m1(s) = m1_θ(θ)·(dθ/ds)² with m1_θ the crank-driven closed form (test::SliderCrank)
 // and θ(s) from s² = r² + l² ... (law of cosines: l² = r² + s² − 2rs cos θ, crank above the line).
 TEST(ReducedSourceRange, SliderDrivenSliderCrankMatchesTheClosedForm) {
-  const auto t = range_table(models::load_scene("slider-crank-slider"), 5);  // 72 intervals over the stroke
+  const auto t = range_table(models::load_scene("slider-crank-slider"), 5);  // 72 × 10 intervals over the stroke
   const auto& d = t.domain;
   const auto& s = t.samples;
   ASSERT_FALSE(d.periodic);
   EXPECT_FALSE(s.periodic);
   EXPECT_FALSE(s.revolute);
-  ASSERT_EQ(s.q.size(), 73u);
+  ASSERT_EQ(s.q.size(), 721u);  // dead-point edges: kDeadPointRefinement × 72 intervals
   EXPECT_DOUBLE_EQ(s.q.front(), d.min);
   EXPECT_DOUBLE_EQ(s.q.back(), d.max);
   const test::SliderCrank sc;
@@ -564,11 +565,45 @@ TEST(ReducedSourceRange, SliderDrivenSliderCrankMatchesTheClosedForm) {
     EXPECT_NEAR(s.columns[c_m1][i], sc.m1(th) / (ds_dth * ds_dth), 1e-9 * sc.m1(th) / (ds_dth * ds_dth)) << q;
     EXPECT_NEAR(s.columns[c_r_slider][i], 1.0, 1e-12);
   }
-  // m1 grows toward the dead points (dθ/ds → ∞): at the range's edges (5 % of the stroke short
-  // of them) it is 1.5–2 times its mid-stroke value.
-  const double mid = s.columns[c_m1][36];
+  // m1 grows toward the dead points (dθ/ds → ∞): at the range's edges (1 % of the stroke short
+  // of them) it is more than 1.5–2 times its mid-stroke value.
+  const double mid = s.columns[c_m1][360];
   EXPECT_GT(s.columns[c_m1].front(), 1.9 * mid);
   EXPECT_GT(s.columns[c_m1].back(), 1.5 * mid);
+}
+
+// The range's ends 1 % of the stroke from the dead points, with the default 10° grid refined
+// kDeadPointRefinement×: the not-a-knot table interpolates m1 ∝ 1/distance at the midpoints of
+// its last intervals to 2e-3 of the closed form (measured 9.6e-4 and 8.7e-4); the same range
+// with 36 intervals (declared limits: no refinement) is at least 10× worse there.
+TEST(ReducedSourceRange, TheRefinedTableInterpolatesM1NextToTheDeadPoints) {
+  const auto t = range_table(models::load_scene("slider-crank-slider"), 10);
+  const auto& s = t.samples;
+  ASSERT_EQ(s.q.size(), 361u);
+  EXPECT_NEAR(s.q.front() - 0.15, 0.001, 1e-8);
+  EXPECT_NEAR(0.25 - s.q.back(), 0.001, 1e-8);
+  const auto table = reduced::build_table(s, reduced::Interpolation::CubicSpline);
+  const test::SliderCrank sc;
+  auto m1_exact = [&](double q) {
+    const double th = std::acos((sc.r * sc.r + q * q - sc.l * sc.l) / (2 * sc.r * q));
+    const double ds_dth = -sc.r * std::sin(th) - sc.r * sc.r * std::sin(th) * std::cos(th) /
+                                                     std::sqrt(sc.l * sc.l - sc.r * sc.r * std::sin(th) * std::sin(th));
+    return sc.m1(th) / (ds_dth * ds_dth);
+  };
+  const int c = table.column("m1");
+  const size_t n = s.q.size();
+  for (const double q : {0.5 * (s.q[0] + s.q[1]), 0.5 * (s.q[n - 2] + s.q[n - 1])})
+    EXPECT_NEAR(table.eval(c, q), m1_exact(q), 2e-3 * m1_exact(q)) << q;
+  // The unrefined grid over the same range: the end interval is 10× longer.
+  auto scene = models::load_scene("slider-crank-slider");
+  scene.independent_range = models::IndependentRange{s.q.front(), s.q.back()};
+  const auto coarse = range_table(scene, 10).samples;
+  ASSERT_EQ(coarse.q.size(), 37u);
+  const auto ct = reduced::build_table(coarse, reduced::Interpolation::CubicSpline);
+  const double q_end = 0.5 * (coarse.q[35] + coarse.q[36]);
+  const double q_fine = 0.5 * (s.q[n - 2] + s.q[n - 1]);
+  EXPECT_GT(std::abs(ct.eval(c, q_end) - m1_exact(q_end)) / m1_exact(q_end),
+            10 * std::abs(table.eval(c, q_fine) - m1_exact(q_fine)) / m1_exact(q_fine));
 }
 
 }  // namespace

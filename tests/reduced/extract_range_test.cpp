@@ -20,28 +20,36 @@ namespace {
 
 constexpr double kDeg = M_PI / 180;
 
+// Declared limits: the grid rules without the dead-point refinement (tested apart below).
 Samples range_samples(test::AnalyticSource& src, const models::Scene& scene, double lo, double hi, double deg,
-                      Method method = Method::Kinetostatic) {
+                      Method method = Method::Kinetostatic, const std::string& min_edge = "declared limit") {
   ExtractOptions opt;
   opt.step_rad = deg * kDeg;
   opt.method = method;
-  opt.range = ExtractRange{lo, hi, "dead point", "declared limit"};
+  opt.range = ExtractRange{lo, hi, min_edge, "declared limit"};
   return extract_samples(src, scene, opt);
 }
 
 TEST(ExtractRange, GridRules) {
   // Never fewer intervals than a full turn at the same grid (360/g); a revolute range wider
   // than a turn's worth keeps intervals no longer than the step.
-  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true), 36);
-  EXPECT_EQ(range_intervals(125 * kDeg, 1 * kDeg, true), 360);
-  EXPECT_EQ(range_intervals(500 * kDeg, 10 * kDeg, true), 50);
-  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false), 36);
-  EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false), 180);
-  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true), 36);
-  EXPECT_EQ(range_intervals(20 * kDeg, 90 * kDeg, true), 4);  // never fewer than 4 (5 points: Akima's minimum)
-  EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true), TableError);
-  EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true), TableError);
-  EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true), TableError);  // > kMaxTableRows points
+  EXPECT_EQ(range_intervals(120 * kDeg, 10 * kDeg, true, false), 36);
+  EXPECT_EQ(range_intervals(125 * kDeg, 1 * kDeg, true, false), 360);
+  EXPECT_EQ(range_intervals(500 * kDeg, 10 * kDeg, true, false), 50);
+  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false, false), 36);
+  EXPECT_EQ(range_intervals(0.1, 2 * kDeg, false, false), 180);
+  EXPECT_EQ(range_intervals(20 * kDeg, 10 * kDeg, true, false), 36);
+  EXPECT_EQ(range_intervals(20 * kDeg, 90 * kDeg, true, false), 4);  // never fewer than 4 (5 points: Akima's minimum)
+  EXPECT_THROW(range_intervals(0.0, 10 * kDeg, true, false), TableError);
+  EXPECT_THROW(range_intervals(NAN, 10 * kDeg, true, false), TableError);
+  EXPECT_THROW(range_intervals(1e3, 0.01 * kDeg, true, false), TableError);  // > kMaxTableRows points
+  // A range ending at a dead point: kDeadPointRefinement× the intervals at every grid (so the
+  // ladder's halvings stay halvings), capped at the reader's limit instead of refused.
+  EXPECT_EQ(range_intervals(0.1, 10 * kDeg, false, true), 36 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(0.1, 5 * kDeg, false, true), 72 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(48 * kDeg, 10 * kDeg, true, true), 36 * kDeadPointRefinement);
+  EXPECT_EQ(range_intervals(0.1, 0.01 * kDeg, false, true), kMaxTableRows - 1);
+  EXPECT_EQ(range_intervals(0.1, 0.01 * kDeg, false, false), 36000);
 }
 
 TEST(ExtractRange, SamplesTheRangeWithClosedFormValuesAndNoWrap) {
@@ -55,8 +63,15 @@ TEST(ExtractRange, SamplesTheRangeWithClosedFormValuesAndNoWrap) {
   EXPECT_DOUBLE_EQ(s.q.front(), 0.3);
   EXPECT_DOUBLE_EQ(s.q.back(), 2.5);
   EXPECT_NEAR(s.step, 2.2 / 36, 1e-15);
-  EXPECT_EQ(s.min_edge, "dead point");
+  EXPECT_EQ(s.min_edge, "declared limit");
   EXPECT_EQ(s.max_edge, "declared limit");
+  // One edge a dead point: kDeadPointRefinement × the intervals, the edges recorded.
+  const Samples fine = range_samples(src, scene, 0.3, 2.5, 10, Method::Kinetostatic, "dead point");
+  ASSERT_EQ(fine.q.size(), 36u * kDeadPointRefinement + 1);
+  EXPECT_NEAR(fine.step, 2.2 / (36 * kDeadPointRefinement), 1e-15);
+  EXPECT_DOUBLE_EQ(fine.q.back(), 2.5);
+  EXPECT_EQ(fine.min_edge, "dead point");
+  EXPECT_EQ(fine.max_edge, "declared limit");
   for (size_t i = 0; i < s.q.size(); ++i) {
     EXPECT_NEAR(s.columns[s.require("m1")][i], src.sc.m1(s.q[i]), 1e-14);
     EXPECT_NEAR(s.columns[s.require("Q_cons")][i], -2.0 * std::sin(s.q[i]), 1e-14);
@@ -154,7 +169,7 @@ TEST(ExtractRange, SwitchAnglesInsideTheRangeAreExact) {
 TEST(ExtractRange, CsvRoundTripKeepsTheRangeAndItsEdges) {
   test::AnalyticSource src;
   const auto scene = test::analytic_scene();
-  const Samples s = range_samples(src, scene, 0.3, 2.5, 10);
+  const Samples s = range_samples(src, scene, 0.3, 2.5, 10, Method::Kinetostatic, "dead point");
   const Samples r = parse_samples_csv(format_samples_csv(s), "t.csv");
   EXPECT_FALSE(r.periodic);
   EXPECT_EQ(r.min_edge, "dead point");
@@ -217,7 +232,7 @@ TEST(ExtractRange, NotAKnotRangeTablesAreAsAccurateAsPeriodicOnes) {
 TEST(ExtractRange, ReducedModelStopsAtTheEdgeAndReversesInside) {
   test::AnalyticSource src;
   const auto scene = test::analytic_scene();
-  const Samples s = range_samples(src, scene, 0.3, 2.5, 5);
+  const Samples s = range_samples(src, scene, 0.3, 2.5, 5, Method::Kinetostatic, "dead point");
   const ReducedModel m = make_reduced_model(s, scene, Interpolation::CubicSpline);
   ReducedOptions opt;
   opt.duration_s = 5;

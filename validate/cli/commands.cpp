@@ -265,12 +265,14 @@ int run_extract(const ExtractArgs& a) {
     if (e.dead_min && e.dead_max)
       range += fmt::format(", dead points at {:.9g}{} and {:.9g}{}", *e.dead_min * k, unit, *e.dead_max * k, unit);
   }
-  // A slider's grid is a length: --grid-deg sets its intervals per range (360/grid, as a turn's).
+  // A range table's step follows from --grid-deg (reduced/extract.hpp, range_intervals): a slider's
+  // grid is a length, and a range ending at dead points is sampled kDeadPointRefinement× finer.
   const std::string grid =
-      e.samples.revolute
+      e.samples.periodic
           ? fmt::format("{}° grid", a.grid_deg)
-          : fmt::format("{:.6g} m grid: {} intervals from --grid-deg {}", e.samples.step,
-                        e.samples.q.size() > 0 ? e.samples.q.size() - 1 : 0, a.grid_deg);
+          : fmt::format("{:.6g}{} grid: {} intervals from --grid-deg {}", e.samples.step * (e.samples.revolute ? 180 / M_PI : 1.0),
+                        e.samples.revolute ? "°" : " m", e.samples.q.size() > 0 ? e.samples.q.size() - 1 : 0,
+                        a.grid_deg);
   std::fprintf(stderr, "%s\n",
                fmt::format("rdyn: extracted {} ({}, {}, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
                            "wrote {}",

@@ -58,9 +58,12 @@ nlohmann::json inspection_json(const models::Scene& scene, const engine::Inspect
   nlohmann::json dead = nlohmann::json::array();
   if (d.dead_min && d.dead_max) {
     dead = {*d.dead_min * k, *d.dead_max * k};
-    range["dead_point_margin"] = engine::kDeadPointMargin;
+    range["dead_point_margin"] = engine::kDeadPointMargin;               // of the dead points' distance
+    range["margin"] = engine::calc_dead_point_margin(d) * k;              // the same in deg or m
   }
   range["dead_points"] = dead;
+  // Why: full turn, declared by the scene, dead points found (and the margin), or unbounded.
+  range["reason"] = engine::describe_domain(d, scene.independent);
   // Configurations of rank loss inside the domain (a parallelogram lying flat): passable, not
   // edges; the full model crosses them in its partitioned formulation (docs/theory.md §7a).
   nlohmann::json singular = nlohmann::json::array();
@@ -94,6 +97,10 @@ int run_inspect(const InspectArgs& a) {
   const engine::FullModel model(scene);
   const auto in = engine::calc_inspection(model);
   for (const auto& w : in.warnings) std::fprintf(stderr, "rdyn: warning: %s\n", w.c_str());
+  // The range in words (standard output stays JSON): the same sentence as range.reason.
+  if (in.range.unbounded_reason.empty())
+    std::fprintf(stderr, "rdyn: range of '%s': %s\n", scene.independent.c_str(),
+                 engine::describe_domain(in.range, scene.independent).c_str());
   if (svg) {
     svg->write(inspect_svg(scene, in));
     svg->commit();

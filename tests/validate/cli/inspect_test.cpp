@@ -47,6 +47,7 @@ TEST(InspectCli, FourbarPrintsTheAssembledConfiguration) {
   EXPECT_NEAR(j["joints"]["rocker"]["q_deg"].get<double>(), 90.27, 0.01);
   EXPECT_LT(j["loops"]["C"]["gap_m"].get<double>(), 1e-10);
   EXPECT_TRUE(j["range"]["full_turn"].get<bool>());
+  EXPECT_EQ(j["range"]["reason"].get<std::string>().rfind("full turn: 'crank' turns fully", 0), 0u);
   EXPECT_TRUE(j["warnings"].empty());
 }
 
@@ -61,10 +62,18 @@ TEST(InspectCli, RockerDrivenRangeHasTwoDeadPoints) {
   const double lo = 90.1909862854, hi = 138.5903778907;  // acos((0.36² − 0.13)/0.12), acos((0.20² − 0.13)/0.12)
   EXPECT_NEAR(range["dead_points"][0].get<double>(), lo, 1e-6);
   EXPECT_NEAR(range["dead_points"][1].get<double>(), hi, 1e-6);
-  // The domain the models use: 5 % of the dead points' distance inside each.
-  EXPECT_EQ(range["dead_point_margin"].get<double>(), 0.05);
-  EXPECT_NEAR(range["min"].get<double>(), lo + 0.05 * (hi - lo), 2e-6);
-  EXPECT_NEAR(range["max"].get<double>(), hi - 0.05 * (hi - lo), 2e-6);
+  // The domain the models use: 1 % of the dead points' distance inside each, stated in degrees
+  // and in words (JSON and standard error).
+  EXPECT_EQ(range["dead_point_margin"].get<double>(), 0.01);
+  EXPECT_NEAR(range["margin"].get<double>(), 0.01 * (hi - lo), 2e-6);
+  EXPECT_NEAR(range["min"].get<double>(), lo + 0.01 * (hi - lo), 2e-6);
+  EXPECT_NEAR(range["max"].get<double>(), hi - 0.01 * (hi - lo), 2e-6);
+  const std::string why = range["reason"].get<std::string>();
+  EXPECT_EQ(why.rfind("dead points found at 90.19098", 0), 0u) << why;
+  EXPECT_NE(why.find("and 138.59037"), std::string::npos) << why;
+  EXPECT_NE(why.find("0.483994"), std::string::npos) << why;  // 1 % of 48.3994° (the closed forms)
+  EXPECT_NE(why.find("(1 % of their distance)"), std::string::npos) << why;
+  EXPECT_NE(r.err.find("rdyn: range of 'rocker': " + why), std::string::npos) << r.err;
   EXPECT_EQ(range["min_edge"], "dead_point");
   EXPECT_EQ(range["max_edge"], "dead_point");
   EXPECT_TRUE(range["min_is_dead_point"].get<bool>());
@@ -75,7 +84,7 @@ TEST(InspectCli, AnInitialQNextToADeadPointIsExitTwo) {
   // The same refusal simulate and extract give: no output, the dead points named.
   const CliRun r = rdyn("inspect fourbar-rocker --set initial.q_deg=90.5");
   EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("within 5 % of a dead point of 'rocker' (dead points at 90.19"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("within 1 % of a dead point of 'rocker' (dead points at 90.19"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty());
 }
 
@@ -114,6 +123,8 @@ TEST(InspectCli, DeclaredAndUnboundedRanges) {
   EXPECT_EQ(j["range"]["min_edge"], "declared_limit");
   EXPECT_FALSE(j["range"]["max_is_dead_point"].get<bool>());
   EXPECT_TRUE(j["range"]["dead_points"].empty());
+  EXPECT_EQ(j["range"]["reason"], "declared by the scene: independent_range [-0.5, 0.75] m");
+  EXPECT_NE(r.err.find("rdyn: range of 'slide': declared by the scene"), std::string::npos) << r.err;
   EXPECT_TRUE(j["warnings"].empty());
   fs::remove_all(dir);
 }

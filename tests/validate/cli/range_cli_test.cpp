@@ -30,11 +30,13 @@ struct RangeCli : ::testing::Test {
 TEST_F(RangeCli, ExtractWritesARangeTableAndReportsTheDeadPoints) {
   const auto r = test::run_rdyn({"extract", "slider-crank-slider", "--out", "t.csv"}, dir);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("range [0.154999999, 0.245000001] m (dead point / dead point), dead points at 0.149999999 m "
+  EXPECT_NE(r.err.find("range [0.150999999, 0.249000001] m (dead point / dead point), dead points at 0.149999999 m "
                        "and 0.250000001 m"),
             std::string::npos)
       << r.err;
   const std::string t = test::slurp(dir / "t.csv");
+  // The stroke between the dead points sampled kDeadPointRefinement × finer: 360 intervals at 10°.
+  EXPECT_NE(r.err.find("0.000272222 m grid: 360 intervals from --grid-deg 10, 361 points"), std::string::npos) << r.err;
   EXPECT_NE(t.find("periodic=0"), std::string::npos);
   EXPECT_NE(t.find("edges=dead_point,dead_point"), std::string::npos);
   EXPECT_NE(t.find("\nq_m,m1,"), std::string::npos);
@@ -52,8 +54,8 @@ TEST_F(RangeCli, BothModelsStopAtTheSameEdgeWithStatusOneAndNoOutput) {
                                    "--out", std::string("out_") + model},
                                   dir);
     EXPECT_EQ(r.status, 1) << model << ": " << r.err;
-    EXPECT_NE(r.err.find(std::string(model) + " model left the validity domain at q = 0.245000001 m (dead point) at "
-                                              "t = 0.00729"),
+    EXPECT_NE(r.err.find(std::string(model) + " model left the validity domain at q = 0.249000001 m (dead point) at "
+                                              "t = 0.00939"),
               std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(dir / (std::string("out_") + model))) << model;
@@ -76,7 +78,11 @@ TEST_F(RangeCli, AConstraintForcePoleIsRecordedAndTheReducedModelRefusesItsRows)
   EXPECT_NE(test::slurp(dir / "t.csv").find("\n# pole rod_axial: "), std::string::npos);
   const auto r = test::run_rdyn({"simulate", scene, "--model", "reduced", "--table", "t.csv", "--out", "red"}, dir);
   EXPECT_EQ(r.status, 1) << r.err;
-  EXPECT_NE(r.err.find("cannot give constraint force 'rod_axial' at t = 0 s"), std::string::npos) << r.err;
+  // The refusal radius is 8 grid steps (reduced_model.cpp); the range ends at dead points, so the
+  // table is kDeadPointRefinement× finer (8 × 0.00108889 m) and the run is refused on reaching it,
+  // no longer at its start.
+  EXPECT_NE(r.err.find("cannot give constraint force 'rod_axial' at t = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("within 0.00871111 m of it"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "red"));
   const auto f = test::run_rdyn({"simulate", scene, "--model", "full", "--duration", "0.2", "--out", "full"}, dir);
   EXPECT_EQ(f.status, 0) << f.err;
