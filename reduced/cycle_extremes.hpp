@@ -47,9 +47,11 @@ void golden_max(F&& f, double lo, double hi, double f_lo, double f_hi, double xt
 // ≥ `samples` points per period P, then refines each quantity's largest sample by golden
 // section over the sub-intervals on either side of it (in the neighbouring piece when the
 // sample is a piece's end; the pieces wrap around: the cycle is periodic).
-template <typename Eval>
+// `scan(j, θ, out)` gives the samples (it may be a cheap approximation of eval: it only picks
+// which sample each refinement starts beside); every value returned comes from `eval`.
+template <typename Scan, typename Eval>
 void find_extremes(const std::vector<double>& a, const std::vector<double>& b, int samples, double P, int nq,
-                   Eval&& eval, std::vector<double>& value, std::vector<double>& where) {
+                   Scan&& scan, Eval&& eval, std::vector<double>& value, std::vector<double>& where) {
   const int pieces = static_cast<int>(a.size());
   std::vector<int> subs(pieces);
   struct Best {
@@ -61,7 +63,7 @@ void find_extremes(const std::vector<double>& a, const std::vector<double>& b, i
   for (int j = 0; j < pieces; ++j) {
     subs[j] = std::max(1, static_cast<int>(std::ceil((b[j] - a[j]) * samples / P - 1e-9)));
     for (int i = 0; i <= subs[j]; ++i) {
-      eval(j, sample_theta(a[j], b[j], i, subs[j]), out.data());
+      scan(j, sample_theta(a[j], b[j], i, subs[j]), out.data());
       for (int k = 0; k < nq; ++k)
         if (out[k] > best[k].v) best[k] = {out[k], j, i};
     }
@@ -71,8 +73,9 @@ void find_extremes(const std::vector<double>& a, const std::vector<double>& b, i
   const double xtol = 1e-10 * std::max(1.0, P);
   for (int k = 0; k < nq; ++k) {
     const Best& bk = best[k];
-    value[k] = bk.v;
     where[k] = sample_theta(a[bk.piece], b[bk.piece], bk.i, subs[bk.piece]);
+    eval(bk.piece, where[k], out.data());  // the scan's value may be an approximation
+    value[k] = out[k];
     // Sub-intervals (piece, i_lo) on either side of the best sample.
     std::pair<int, int> side[2];
     const int jl = (bk.piece + pieces - 1) % pieces, jr = (bk.piece + 1) % pieces;
@@ -88,6 +91,13 @@ void find_extremes(const std::vector<double>& a, const std::vector<double>& b, i
       golden_max(f, lo, hi, f_lo, f_hi, xtol, where[k], value[k]);
     }
   }
+}
+
+// Samples and refinement both from eval.
+template <typename Eval>
+void find_extremes(const std::vector<double>& a, const std::vector<double>& b, int samples, double P, int nq,
+                   Eval&& eval, std::vector<double>& value, std::vector<double>& where) {
+  find_extremes(a, b, samples, P, nq, eval, eval, value, where);
 }
 
 }  // namespace rdyn::reduced

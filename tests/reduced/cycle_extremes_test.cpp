@@ -64,5 +64,34 @@ TEST(CycleExtremes, AMaximumJustBeforeTheWrapIsRefinedInThePreviousPiece) {
   EXPECT_NEAR(std::remainder(where[0] + 0.05, kTwoPi), 0.0, 1e-6);
 }
 
+TEST(CycleExtremes, AnApproximateScanPicksTheSampleAndEveryValueComesFromEval) {
+  // The scan is off by up to 1e-6 (the steady cycle's Hermite scan: ~1e-8): the same maxima as
+  // the exact scan, to the refinement's own accuracy, and each value is eval's at its `where`.
+  const std::vector<double> a{0.0, 3.0}, b{3.0, kTwoPi};
+  auto eval = [](int piece, double th, double* out) {
+    out[0] = std::cos(th - 1.234);
+    out[1] = piece == 0 ? th : th - 4.0;
+  };
+  int scans = 0, evals = 0;
+  auto scan = [&](int piece, double th, double* out) {
+    ++scans;
+    eval(piece, th, out);
+    out[0] += 1e-6 * std::sin(37 * th), out[1] += 1e-6 * std::cos(41 * th);
+  };
+  auto counted = [&](int piece, double th, double* out) { ++evals, eval(piece, th, out); };
+  std::vector<double> value, where, exact_value, exact_where;
+  find_extremes(a, b, 12, kTwoPi, 2, scan, counted, value, where);
+  find_extremes(a, b, 12, kTwoPi, 2, eval, exact_value, exact_where);
+  EXPECT_EQ(scans, 15);  // ≥ 12 per period: 6 + 1 points on [0, 3], 7 + 1 on [3, 2π]
+  EXPECT_LT(evals, 2 * (1 + 2 * 70));  // the refinement alone: the best sample and golden on two sides
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_NEAR(value[k], exact_value[k], 1e-14) << k;
+    double at[2];
+    eval(0, where[k], at);  // both maxima lie on the first piece (1.234 and its end 3)
+    EXPECT_NEAR(value[k], at[k], 1e-14) << k;  // no scan offset (1e-6) left in a value
+  }
+  EXPECT_EQ(value[1], 3.0);
+}
+
 }  // namespace
 }  // namespace rdyn::reduced

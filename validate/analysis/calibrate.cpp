@@ -544,10 +544,11 @@ double calc_motor_mean_power(const reduced::ReducedModel& m, const reduced::Redu
 // mean power.
 CalibrationResult calibrate_reduced(const reduced::ReducedModel& model, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress) {
-  // The searches below set load values and the resistance coefficient on the calibration's own
-  // copy: the caller's model is never left at some shape's values (issue #23: a model shared by
-  // two strategies kept the last one's coefficient). The result carries the values found.
-  reduced::ReducedModel m = model;
+  return calibrate_reduced(reduced::ReducedModel(model), scene, opt, progress);  // a copy (issue #23)
+}
+
+CalibrationResult calibrate_reduced(reduced::ReducedModel&& m, const models::Scene& scene,
+                                    const CalibrationOptions& opt, Progress& progress) {
   const Selection sel = select_load(scene, opt);
   const std::string load_field = opt.load.empty() ? "loads" : opt.load_field;
   CalibrationResult r;
@@ -669,8 +670,8 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& 
   const auto start = std::chrono::steady_clock::now();
   check_calibration_input(scene, opt);
   const Selection sel = select_load(scene, opt);
-  const auto m = reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table);
-  CalibrationResult r = calibrate_reduced(m, scene, opt, progress);
+  CalibrationResult r = calibrate_reduced(
+      reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table), scene, opt, progress);
 
   // Confirmation with the full model from the same point of the steady cycle.
   r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;

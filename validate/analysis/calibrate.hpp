@@ -124,6 +124,12 @@ models::Scene with_unit_load(const models::Scene& scene, const CalibrationOption
 // reaches F to 1e-6. A search over load shapes calls it once per shape on the same table.
 CalibrationResult calibrate_reduced(const reduced::ReducedModel& m, const models::Scene& scene,
                                     const CalibrationOptions& opt, Progress& progress);
+// The same on a model the calibration owns and changes (calibrate() passes the one it builds;
+// the const& overload a copy, so a caller's model is never left at some shape's values — issue
+// #23: a model shared by two strategies kept the last one's coefficient): no copy of its table and column blocks (~2 MB at 10° fourier, resampled at 0.25°;
+// the copy, with its page faults, was ~10 % of a sweep case over the rider's height).
+CalibrationResult calibrate_reduced(reduced::ReducedModel&& m, const models::Scene& scene,
+                                    const CalibrationOptions& opt, Progress& progress);
 
 // The calibration's table: the kinetostatic extraction at opt.grid_deg and its interpolant
 // (opt.interpolation). It depends on the mechanism and where loads act, not on load values,

@@ -648,3 +648,31 @@ TEST(Calibrate, WrittenSceneCarriesTheLoadValue) {
 
 }  // namespace
 }  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// calibrate() hands the model it builds to calibrate_reduced by move (no copy of its ~2 MB
+// table and blocks); the const& overload calibrates a copy. Both give the same result bit for
+// bit, and the caller's model keeps its unit load and coefficient (issue #23).
+TEST(Calibrate, TheMovedModelAndTheCopiedModelGiveOneResult) {
+  const auto scene = models::parse_scene(
+      flywheel_yaml("  - {type: joint_torque, name: drive, joint: wheel, torque_Nm: 0.3}\n"), "flywheel.yaml");
+  CalibrationOptions o = calibration_options_of(scene, 2.0, 40.0, "drive");
+  o.full_max_s = 0.0;
+  const CalibrationTable t = extract_calibration_table(scene, o);
+  const auto m = reduced::make_reduced_model(t.samples, with_unit_load(scene, o), t.table);
+  Progress quiet(false);
+  const CalibrationResult copied = calibrate_reduced(m, scene, o, quiet);
+  EXPECT_EQ(m.torques[0].value, 1.0);
+  EXPECT_EQ(m.brakes[0].coefficient, calc_resistance_coefficient(scene, o));
+  const CalibrationResult moved = calibrate_reduced(reduced::ReducedModel(m), scene, o, quiet);
+  EXPECT_EQ(moved.load_value, copied.load_value);
+  EXPECT_EQ(moved.resistance_coefficient, copied.resistance_coefficient);
+  EXPECT_EQ(moved.speed_fluctuation, copied.speed_fluctuation);
+  EXPECT_EQ(calibrate(scene, t, o, quiet).load_value, copied.load_value);
+  EXPECT_NEAR(copied.load_value, 40.0 / (2 * M_PI * 2.0), 1e-8);  // T = P/ω
+}
+
+}  // namespace
+}  // namespace rdyn::validate
