@@ -32,7 +32,8 @@ typedef struct rdyn_workspace rdyn_workspace; /* per-run state of one model */
 typedef enum rdyn_status {
   RDYN_OK = 0,
   RDYN_BAD_STEP = 1,        /* dt not finite or outside [1e-7, 1] s */
-  RDYN_BAD_DRIVE = 2,       /* drive not finite or a commanded torque beyond ±1e6 */
+  RDYN_BAD_DRIVE = 2,       /* drive not finite, a commanded torque beyond ±1e6, or a torque for a scene
+                               without joint torques (only the scene's own drive, scale 1, is accepted) */
   RDYN_BAD_STATE = 3,       /* q, q̇ not finite, |q̇| > 1e4, or q outside the table */
   RDYN_WRONG_WORKSPACE = 4, /* workspace made for another model */
   RDYN_NON_FINITE = 5,      /* the step produced a non-finite value; state kept */

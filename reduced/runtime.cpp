@@ -18,7 +18,8 @@ const char* status_message(Status s) {
     case Status::BadStep:
       return "step size is not finite or outside [1e-7, 1] s";
     case Status::BadDrive:
-      return "drive is not finite or a joint torque it commands exceeds 1e6 N·m (N)";
+      return "drive is not finite, a joint torque it commands exceeds 1e6 N·m (N), or the scene has no joint "
+             "torque to command";
     case Status::BadState:
       return "state is not finite, |q̇| exceeds 1e4 rad/s (m/s), or q lies outside the table's "
              "range";
@@ -118,6 +119,9 @@ Status RuntimeWorkspace::apply_drive(const RuntimeModel& model, const Drive& dri
                                             : (nominal < 0 ? -1.0 : 1.0) * drive.value;
   };
   if (!std::isfinite(drive.value)) return Status::BadDrive;
+  // A scene without joint torques has nothing to command: a torque (or a scale other than the
+  // scene's own) would be ignored in silence, and the caller's controller would run open loop.
+  if (torques.empty() && !(drive.mode == Drive::Mode::Scale && drive.value == 1.0)) return Status::BadDrive;
   for (size_t i = 0; i < torques.size(); ++i)
     if (!(std::abs(commanded(i)) <= models::limits::kMaxForce)) return Status::BadDrive;
   for (size_t i = 0; i < torques.size(); ++i) state_.torque_value[i] = commanded(i);

@@ -29,7 +29,8 @@ namespace rdyn::reduced {
 enum class Status : int {
   Ok = 0,
   BadStep = 1,         // dt not finite or outside [kMinFixedStep_s, kMaxFixedStep_s]
-  BadDrive = 2,        // drive not finite, or a resulting joint torque beyond ±limits::kMaxForce
+  BadDrive = 2,        // drive not finite, a resulting joint torque beyond ±limits::kMaxForce, or a
+                       // torque (a scale ≠ 1) commanded to a scene without joint torques
   BadState = 3,        // reset, calc_drive_torque: q, q̇ (q̈) not finite, |q̇| > limits::kMaxRate
                        // (|q̈| > kMaxDriveAcceleration), q outside the table
   WrongWorkspace = 4,  // the workspace was made for a model of another shape

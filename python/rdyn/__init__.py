@@ -286,7 +286,18 @@ class Runtime:
     """
 
     def __init__(self, table, scene=None, interpolation=None, energy_consistent=False):
+        # A path is read for its scene (load_table); anything else but a Table is a TypeError
+        # that says what to give, not an AttributeError from inside.
+        if isinstance(table, (str, bytes, _os.PathLike)):
+            if scene is None:
+                raise TypeError("Runtime(path, scene): a table file needs the scene it was extracted from")
+            table = load_table(table, scene)
+        if not isinstance(table, Table):
+            raise TypeError(f"Runtime: table must be an rdyn.Table (rdyn.extract, rdyn.load_table) or a path, "
+                            f"not {type(table).__name__}")
         scene = table.scene if scene is None else scene
+        if not isinstance(scene, Scene):
+            raise TypeError(f"Runtime: scene must be an rdyn.Scene (rdyn.load_scene), not {type(scene).__name__}")
         self._rt = _rdyn.Runtime(table._samples, scene._scene, interpolation, energy_consistent)
         self.step_raw = self._rt.step  # (dt, torque=None, scale=None): the call without this wrapper
 

@@ -165,6 +165,29 @@ def test_runtime_errors_leave_the_state():
     assert (rt.q, rt.qdot) == (q0, qdot0)
 
 
+def test_runtime_refuses_a_drive_it_cannot_apply_and_wrong_types(tmp_path):
+    # fourbar has no joint torque: a commanded drive was ignored in silence (the controller ran
+    # open loop); the scene's own drive (none given) still steps.
+    rt = runtime_for("fourbar", 30)
+    with pytest.raises(rdyn.ArgumentError, match="no joint torque"):
+        rt.step(1e-3, drive=5.0)
+    with pytest.raises(rdyn.ArgumentError, match="no joint torque"):
+        rt.step(1e-3, scale=2.0)
+    q0 = rt.q
+    rt.step(1e-3)
+    assert rt.q != q0
+    # A path is read for its scene; a path without one, or another type, is a TypeError.
+    scene = rdyn.load_scene("fourbar")
+    rdyn.extract(scene, grid_deg=30).save(tmp_path / "t.csv")
+    assert rdyn.Runtime(str(tmp_path / "t.csv"), scene).q == pytest.approx(rdyn.Runtime(tmp_path / "t.csv", scene).q)
+    with pytest.raises(TypeError, match="needs the scene"):
+        rdyn.Runtime(str(tmp_path / "t.csv"))
+    with pytest.raises(TypeError, match="must be an rdyn.Table"):
+        rdyn.Runtime(42, scene)
+    with pytest.raises(TypeError, match="must be an rdyn.Scene"):
+        rdyn.Runtime(tmp_path / "t.csv", "fourbar")
+
+
 def test_control_loop_1khz_bicycle():
     # A PD controller holds the reduced bicycle at 1 Hz, 1 kHz from Python (docs/embedding.md).
     rt = runtime_for("bicycle")

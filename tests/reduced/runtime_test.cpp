@@ -211,6 +211,26 @@ TEST(Runtime, BadArgumentsAreRefusedAndChangeNothing) {
   EXPECT_EQ(reset(model, ws, 0.0, -1e4), Status::Ok);
 }
 
+// A scene without joint torques has nothing a drive commands: a torque or a scale other than
+// 1 is refused (was ignored, so a controller ran open loop without knowing); the scene's own
+// drive steps.
+TEST(Runtime, ADriveForASceneWithoutJointTorquesIsRefused) {
+  auto scene = test::analytic_scene();
+  scene.resistances.push_back({"brake", "crank", models::ResistanceLaw::Viscous, 1e-4});
+  ASSERT_TRUE(scene.joint_torques.empty());
+  const auto model = make_runtime_model(analytic_samples(scene), scene, {Interpolation::CubicSpline});
+  RuntimeWorkspace ws(model);
+  ASSERT_EQ(reset(model, ws, 0.3, 10.0), Status::Ok);
+  const auto before = snapshot(ws);
+  for (const Drive& d : {Drive::torque(5.0), Drive::torque(0.0), Drive::scaled(2.0)}) {
+    EXPECT_EQ(step(model, ws, 1e-3, d), Status::BadDrive) << d.value;
+    EXPECT_EQ(snapshot(ws), before);
+  }
+  EXPECT_EQ(reset(model, ws, 0.3, 10.0, Drive::torque(5.0)), Status::BadDrive);
+  EXPECT_EQ(step(model, ws, 1e-3, Drive{}), Status::Ok);
+  EXPECT_NE(std::string(status_message(Status::BadDrive)).find("no joint torque"), std::string::npos);
+}
+
 TEST(Runtime, AWorkspaceOfAnotherModelIsRefused) {
   const auto model = driven_model(0.05);
   auto plain_scene = test::analytic_scene();  // no torque, no brake: other sizes

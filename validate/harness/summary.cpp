@@ -225,6 +225,34 @@ nlohmann::json run_json(const RunRecord& r) {
   return j;
 }
 
+namespace {
+
+// The first screen's records (validate/report/first_screen.hpp): the recommended run's one
+// comparison, its verdicts and baselines.
+void add_first_screen_json(const ValidationResult& v, nlohmann::json& j) {
+  // The first screen's one comparison: the recommended run against the cheapest full run at
+  // equal or better error (null: none was, the reference stands in; see baselines).
+  j["recommended_full"] =
+      v.recommended_full >= 0 ? run_json(v.runs[v.recommended_full]) : nlohmann::json(nullptr);
+  j["recommended_speedup"] = v.recommended_speedup ? num(*v.recommended_speedup) : nullptr;
+  nlohmann::json verdicts = nlohmann::json::array();
+  for (const auto& d : v.verdicts)
+    verdicts.push_back({{"quantity", d.quantity},
+                        {"error", num(d.error)},
+                        {"target", num(d.target)},
+                        {"within_target", d.within_target}});
+  j["verdicts"] = verdicts;
+  nlohmann::json baselines = nlohmann::json::array();
+  for (const auto& b : v.baselines)
+    baselines.push_back({{"what", b.what},
+                         {"label", b.label},
+                         {"wall_s", num(b.wall_s)},
+                         {"speedup", num(b.speedup)}});
+  j["baselines"] = baselines;
+}
+
+}  // namespace
+
 nlohmann::json summary_json(const ValidationResult& v) {
   nlohmann::json j;
   j["scene"] = v.scene;
@@ -275,25 +303,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
       v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
   j["showcase_reduced"] =
       v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
-  // The first screen's one comparison: the recommended run against the cheapest full run at
-  // equal or better error (null: none was, the reference stands in; see baselines).
-  j["recommended_full"] =
-      v.recommended_full >= 0 ? run_json(v.runs[v.recommended_full]) : nlohmann::json(nullptr);
-  j["recommended_speedup"] = v.recommended_speedup ? num(*v.recommended_speedup) : nullptr;
-  nlohmann::json verdicts = nlohmann::json::array();
-  for (const auto& d : v.verdicts)
-    verdicts.push_back({{"quantity", d.quantity},
-                        {"error", num(d.error)},
-                        {"target", num(d.target)},
-                        {"within_target", d.within_target}});
-  j["verdicts"] = verdicts;
-  nlohmann::json baselines = nlohmann::json::array();
-  for (const auto& b : v.baselines)
-    baselines.push_back({{"what", b.what},
-                         {"label", b.label},
-                         {"wall_s", num(b.wall_s)},
-                         {"speedup", num(b.speedup)}});
-  j["baselines"] = baselines;
+  add_first_screen_json(v, j);
   if (v.budget)
     j["error_budget"] = {
         {"quantity", v.headline_quantity}, {"reference", num(v.budget->reference)},
