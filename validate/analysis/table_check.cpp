@@ -33,11 +33,23 @@ std::string q_text(const reduced::Samples& t, double q) {
 }
 
 // The --grid-deg the table was extracted with: its step for a full turn; a range table has as
-// many intervals as a full turn at that grid (reduced::range_intervals; a revolute range wider
-// than a turn, more: the re-extraction's grid then differs and is refused as such).
+// many intervals as a full turn at that grid, kDeadPointRefinement times as many when an edge is
+// a dead point (reduced::range_intervals). The grid whose intervals those are; else 360/n, and
+// the re-extraction's grid then differs and is refused as such.
 double extraction_grid_deg(const reduced::Samples& t) {
   if (t.periodic || t.q.size() < 2) return t.step * 180.0 / kPi;
-  return 360.0 / static_cast<double>(t.q.size() - 1);
+  const long n = static_cast<long>(t.q.size()) - 1;
+  const bool dead = t.min_edge == "dead point" || t.max_edge == "dead point";
+  for (long per_turn : {n, n / reduced::kDeadPointRefinement}) {
+    if (per_turn < 4) continue;
+    const double g = 360.0 / static_cast<double>(per_turn);
+    try {
+      if (reduced::range_intervals(t.q.back() - t.q.front(), g * kPi / 180.0, t.revolute, dead) == n) return g;
+    } catch (const reduced::TableError&) {
+      // not this grid
+    }
+  }
+  return 360.0 / static_cast<double>(n);
 }
 
 }  // namespace
