@@ -12,19 +12,7 @@ using json = nlohmann::json;
 using namespace report_format;
 }  // namespace
 
-std::string calibrated_run_csv(const json& c) {
-  const json& curve = c.at("curve");
-  std::string s;
-  for (size_t k = 0; k < curve.at("names").size(); ++k)
-    s += (k ? "," : "") + csv_field(curve.at("names")[k].get<std::string>());
-  s += "\n";
-  for (const auto& row : curve.at("rows")) {
-    for (size_t k = 0; k < row.size(); ++k)
-      s += (k ? "," : "") + (row[k].is_number() ? fmt::format("{:.10g}", row[k].get<double>()) : std::string());
-    s += "\n";
-  }
-  return s;
-}
+std::string calibrated_run_csv(const json& c) { return table_csv(c.at("curve")); }
 
 std::string calibrated_run_gp(const json& c) {
   const bool force = !str(c, "force_name").empty();

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "validate/io/escape.hpp"
+#include "validate/report/report_tables.hpp"
 
 namespace rdyn::validate {
 
@@ -23,19 +24,7 @@ std::string shown(double x, const char* spec = "{:.4g}") {
 
 }  // namespace
 
-std::string drive_cycle_csv(const json& c) {
-  const json& curve = c.at("curve");
-  std::string s;
-  for (size_t k = 0; k < curve.at("names").size(); ++k)
-    s += (k ? "," : "") + csv_field(curve.at("names")[k].get<std::string>());
-  s += "\n";
-  for (const auto& row : curve.at("rows")) {
-    for (size_t k = 0; k < row.size(); ++k)
-      s += (k ? "," : "") + (row[k].is_number() ? fmt::format("{:.10g}", row[k].get<double>()) : std::string());
-    s += "\n";
-  }
-  return s;
-}
+std::string drive_cycle_csv(const json& c) { return report_format::table_csv(c.at("curve")); }
 
 std::string drive_cycle_gp(const json& c) {
   const std::string title = fmt::format("Drive over one revolution at {} rev/s (every load of the scene applied)",

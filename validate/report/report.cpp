@@ -31,21 +31,6 @@ std::string read_text(const std::string& path) {
   return s.str();
 }
 
-// A {"names", "rows"} table of the summary as CSV.
-std::string table_csv(const json& t) {
-  std::string s;
-  for (size_t c = 0; c < t.at("names").size(); ++c)
-    s += (c ? "," : "") + csv_field(t.at("names")[c].get<std::string>());
-  s += "\n";
-  for (const auto& row : t.at("rows")) {
-    for (size_t c = 0; c < row.size(); ++c)
-      s += (c ? "," : "") +
-           (row[c].is_number() ? fmt::format("{:.10g}", row[c].get<double>()) : std::string());
-    s += "\n";
-  }
-  return s;
-}
-
 const char* kSvgHead =
     "set terminal svg size 960,{} dynamic enhanced font 'sans,11' background rgb 'white'\n";
 

@@ -61,6 +61,19 @@ std::string compared_over(const json& s) {
                      num(d(w, "t_start_s"), "{:.3g}"));
 }
 
+std::string table_csv(const json& t) {
+  std::string s;
+  for (size_t c = 0; c < t.at("names").size(); ++c)
+    s += (c ? "," : "") + csv_field(t.at("names")[c].get<std::string>());
+  s += "\n";
+  for (const auto& row : t.at("rows")) {
+    for (size_t c = 0; c < row.size(); ++c)
+      s += (c ? "," : "") + (row[c].is_number() ? fmt::format("{:.10g}", row[c].get<double>()) : std::string());
+    s += "\n";
+  }
+  return s;
+}
+
 bool is_joint_output(const json& s, const json& q) {
   for (const auto& j : s.value("joint_output_quantities", json::array()))
     if (j == q) return true;

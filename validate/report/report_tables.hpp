@@ -30,6 +30,9 @@ std::string cost(const json& s, double wall_s);
 std::string quantity_words(const std::string& q);
 // What the errors were taken over: the steady revolutions, or the whole run.
 std::string compared_over(const json& s);
+// A {"names", "rows"} table of the summary as CSV (names quoted, numbers %.10g, null empty):
+// every figure's data file.
+std::string table_csv(const json& t);
 // Whether q is one of the summary's joint outputs (reactions, shaking, joint motion).
 bool is_joint_output(const json& s, const json& q);
 }  // namespace report_format
