@@ -1,6 +1,10 @@
 #include "models/gear_fold.hpp"
 
 #include <cmath>
+#include <numeric>
+#include <string>
+
+#include <fmt/format.h>
 
 namespace rdyn::models {
 
@@ -57,6 +61,48 @@ std::vector<GearFold> calc_gear_folds(const Scene& s) {
     folds.push_back(f);
   }
   return folds;
+}
+
+int calc_turns_to_repeat(const Scene& scene, std::string& why) {
+  why.clear();
+  // Rate ratios ρ_j = q̇_j / q̇ of the joints geared to the independent one, by a walk over the
+  // gears in both directions (q̇_driven = r·q̇_driver).
+  std::vector<double> rho(scene.joints.size(), NAN);
+  std::vector<std::string> via(scene.joints.size());
+  const int ind = scene.joint_index(scene.independent);
+  if (ind < 0) return 1;
+  rho[ind] = 1.0;
+  for (size_t pass = 0; pass < scene.gears.size(); ++pass)
+    for (const auto& g : scene.gears) {
+      const int a = scene.joint_index(g.driver), b = scene.joint_index(g.driven);
+      if (a < 0 || b < 0 || !(g.ratio != 0.0)) continue;
+      if (std::isfinite(rho[a]) && !std::isfinite(rho[b])) rho[b] = g.ratio * rho[a], via[b] = g.name;
+      if (std::isfinite(rho[b]) && !std::isfinite(rho[a])) rho[a] = rho[b] / g.ratio, via[a] = g.name;
+    }
+  int k_all = 1;
+  for (size_t j = 0; j < scene.joints.size(); ++j) {
+    if (!std::isfinite(rho[j]) || static_cast<int>(j) == ind || scene.joints[j].type != JointType::Revolute) continue;
+    int k = 1;
+    while (k <= kMaxTurnsToRepeat && std::abs(k * rho[j] - std::round(k * rho[j])) > 1e-9 * k * std::max(1.0, std::abs(rho[j])))
+      ++k;
+    if (k > kMaxTurnsToRepeat) {
+      why = fmt::format("gear '{}' turns '{}' {:.9g} turn(s) per turn of '{}', a ratio no whole number of turns "
+                        "(up to {}) brings back",
+                        via[j], scene.joints[j].name, rho[j], scene.independent, kMaxTurnsToRepeat);
+      return 0;
+    }
+    const int k_new = std::lcm(k_all, k);
+    if (k_new > kMaxTurnsToRepeat) {
+      why = fmt::format("the gears need more than {} turns of '{}' to bring every joint back", kMaxTurnsToRepeat,
+                        scene.independent);
+      return 0;
+    }
+    if (k_new > k_all || (k > 1 && why.empty()))
+      why = fmt::format("gear '{}' turns '{}' {:.9g} turn(s) per turn of '{}'", via[j], scene.joints[j].name, rho[j],
+                        scene.independent);
+    k_all = k_new;
+  }
+  return k_all;
 }
 
 }  // namespace rdyn::models

@@ -6,6 +6,7 @@
 // peer, so that every engine simulates the same bodies.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "models/scene.hpp"
@@ -36,5 +37,14 @@ std::vector<GearFold> calc_gear_folds(const Scene& scene);
 // c of gear `gear` in q_driven = r·q_driver + c: fixed by the joints' guesses (the assembly's
 // starting point), as for an unfolded gear's constraint. Both joints must exist.
 double calc_gear_offset(const Scene& scene, const Gear& gear);
+
+// How many turns of the independent coordinate bring every revolute joint geared to it (through
+// chains of gears, either way round) back to its angle mod 2π: the smallest k ≤ kMaxTurnsToRepeat
+// with k·ρ_j whole for every joint's rate ratio ρ_j (1 without gears; 0 when no such k exists).
+// `why` names the gear and ratio that needs the most turns. Geometry alone is not consulted: a
+// driven disc turning about its own centre repeats each turn whatever its ratio, so this says
+// what the gears allow, and a sweep that does not close one turn uses it for its message.
+inline constexpr int kMaxTurnsToRepeat = 1000;
+int calc_turns_to_repeat(const Scene& scene, std::string& why);
 
 }  // namespace rdyn::models

@@ -1,5 +1,7 @@
 #include "reduced/extract.hpp"
 
+#include "models/gear_fold.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -498,6 +500,16 @@ void check_turn_closes(KinetostaticSource& src, const models::Scene& scene, cons
   std::string singular;
   for (long i = 0; i < g.n; ++i)
     if (c.singular[i]) singular += fmt::format("{}{:.6g}°", singular.empty() ? "" : ", ", s.q[i] * 180 / kPi);
+  // Geared so that one turn does not bring every joint back (a five-bar driven from the fast crank of
+  // a 2:1 pair): no grid closes one turn; the slow joint repeats each turn (was "a finer grid").
+  std::string gears_why;
+  if (const int turns = models::calc_turns_to_repeat(scene, gears_why); turns != 1)
+    throw SweepNotClosed(fmt::format(
+        "{}: the sweep of '{}' over a full turn does not return to its start (a turn later at {:.6g}° it finds {}): "
+        "{}, so the mechanism {}; a table over one turn cannot describe it. Make the joint that turns the fewest "
+        "times the independent coordinate (every joint then repeats each turn of it), or use the full model",
+        scene.source_file, scene.independent, s.q[i0] * 180 / kPi, off, gears_why,
+        turns > 1 ? fmt::format("repeats only every {} turns of '{}'", turns, scene.independent) : "never repeats"));
   const std::string advice =
       singular.empty()
           ? "extract on a finer grid (--grid-deg)"

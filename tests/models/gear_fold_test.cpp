@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <cmath>
 #include <functional>
 
 #include "models/scene_yaml.hpp"
@@ -112,6 +113,34 @@ TEST(GearFold, InAChainOnlyTheLeafFoldsIntoTheMiddleBody) {
   EXPECT_EQ(s.bodies[folds[0].body].name, "dynamo");
   EXPECT_EQ(s.bodies[folds[0].driver_body].name, "flywheel");
   EXPECT_NEAR(folds[0].moved_inertia_kgm2, 4.0 * 0.01, 1e-15);
+}
+
+}  // namespace
+}  // namespace rdyn::models
+
+namespace rdyn::models {
+namespace {
+
+// Turns of the independent coordinate that bring every geared joint back: k·ρ whole for each
+// joint's rate ratio ρ (both gear directions, chains multiply).
+TEST(GearFold, TurnsToRepeatAreTheLeastCommonWholeTurns) {
+  Scene s = load_scene("fourbar");  // crank, coupler, rocker; no gears
+  std::string why;
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 1);
+  s.gears = {{"g", "crank", "rocker", 0.5}};
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 2);
+  EXPECT_NE(why.find("gear 'g' turns 'rocker' 0.5 turn(s) per turn of 'crank'"), std::string::npos) << why;
+  s.gears = {{"g", "crank", "rocker", 3.0}};  // a flywheel geared up: back every turn
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 1);
+  s.gears = {{"g", "rocker", "crank", 1.5}};  // driven is the independent: ρ_rocker = 1/1.5 = 2/3
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 3);
+  s.gears = {{"g", "crank", "rocker", 0.5}, {"h", "rocker", "coupler", 0.5}};  // ρ = 1/2, 1/4
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 4);
+  s.gears = {{"g", "crank", "rocker", 0.5}, {"h", "crank", "coupler", 1.0 / 3}};  // lcm(2, 3)
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 6);
+  s.gears = {{"g", "crank", "rocker", std::sqrt(2.0)}};
+  EXPECT_EQ(calc_turns_to_repeat(s, why), 0);
+  EXPECT_NE(why.find("no whole number of turns"), std::string::npos) << why;
 }
 
 }  // namespace

@@ -1,6 +1,10 @@
 #include "validate/cli/inspect.hpp"
 
+#include "models/gear_fold.hpp"
+
 #include <cstdio>
+
+#include <fmt/format.h>
 
 #include <memory>
 
@@ -19,6 +23,22 @@ nlohmann::json assembly_json(const engine::Inspection& a) {
   for (const auto& j : a.joints)
     joints[j.name] = j.revolute ? nlohmann::json{{"q_deg", j.q * kDeg}} : nlohmann::json{{"q_m", j.q}};
   return joints;
+}
+
+// The range in words (engine::describe_domain), and for a full turn what the gears allow: a joint
+// geared at 1:2 comes back only after two turns of q, and when its angle matters (a loop, an
+// off-axis mass) no table over one turn describes the mechanism (a five-bar driven from its fast
+// crank: inspect said "full turn" and extract blamed the grid).
+std::string range_reason(const models::Scene& scene, const engine::IndependentDomain& d) {
+  std::string reason = engine::describe_domain(d, scene.independent);
+  std::string why;
+  const int turns = d.periodic ? models::calc_turns_to_repeat(scene, why) : 1;
+  if (turns != 1)
+    reason += fmt::format("; but {}: where that joint's angle matters (a loop, an off-axis mass) the mechanism {}, "
+                          "and a table over one turn cannot describe it (make the joint that turns the fewest times "
+                          "the independent coordinate)",
+                          why, turns > 1 ? fmt::format("repeats only every {} turns", turns) : "never repeats");
+  return reason;
 }
 
 nlohmann::json inspection_json(const models::Scene& scene, const engine::Inspection& in) {
@@ -63,7 +83,10 @@ nlohmann::json inspection_json(const models::Scene& scene, const engine::Inspect
   }
   range["dead_points"] = dead;
   // Why: full turn, declared by the scene, dead points found (and the margin), or unbounded.
-  range["reason"] = engine::describe_domain(d, scene.independent);
+  range["reason"] = range_reason(scene, d);
+  // Gears that need k turns of q to bring every joint back (0: never; models/gear_fold.hpp).
+  std::string gears_why;
+  range["turns_to_repeat"] = models::calc_turns_to_repeat(scene, gears_why);
   // Configurations of rank loss inside the domain (a parallelogram lying flat): passable, not
   // edges; the full model crosses them in its partitioned formulation (docs/theory.md §7a).
   nlohmann::json singular = nlohmann::json::array();
@@ -100,7 +123,7 @@ int run_inspect(const InspectArgs& a) {
   // The range in words (standard output stays JSON): the same sentence as range.reason.
   if (in.range.unbounded_reason.empty())
     std::fprintf(stderr, "rdyn: range of '%s': %s\n", scene.independent.c_str(),
-                 engine::describe_domain(in.range, scene.independent).c_str());
+                 range_reason(scene, in.range).c_str());
   if (svg) {
     svg->write(inspect_svg(scene, in));
     svg->commit();

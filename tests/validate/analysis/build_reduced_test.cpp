@@ -104,3 +104,30 @@ TEST(BuildReduced, PolesBetweenGridPointsAreFoundAndListed) {
 
 }  // namespace
 }  // namespace rdyn::validate
+
+namespace rdyn::validate {
+namespace {
+
+// A five-bar driven from the fast crank of a 1:2 gear comes back only after two turns: the
+// one-turn sweep cannot close at any grid, and the message says so and names the way out (it
+// blamed the grid). From the slow crank every joint repeats each turn, and the table closes.
+TEST(BuildReduced, AMechanismGearedToRepeatEveryTwoTurnsIsToldAndTheSlowJointWorks) {
+  auto scene = models::load_scene(RDYN_SOURCE_DIR "/tests/validate/scenes/fivebar-geared.yaml");
+  try {
+    extract_from_full(scene, 10, reduced::Method::Kinetostatic);
+    ADD_FAILURE() << "a one-turn table of a two-turn mechanism was extracted";
+  } catch (const reduced::SweepNotClosed& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("gear 'g' turns 'c2' 0.5 turn(s) per turn of 'c1'"), std::string::npos) << m;
+    EXPECT_NE(m.find("repeats only every 2 turns of 'c1'"), std::string::npos) << m;
+    EXPECT_EQ(m.find("finer grid"), std::string::npos) << m;
+  }
+  scene.independent = "c2";
+  scene.initial = {M_PI / 4, 5.0};
+  const auto e = extract_from_full(scene, 5, reduced::Method::Kinetostatic);
+  EXPECT_TRUE(e.samples.periodic);
+  EXPECT_EQ(e.samples.q.size(), 72u);
+}
+
+}  // namespace
+}  // namespace rdyn::validate
