@@ -18,7 +18,9 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/runtime.hpp"
 #include "reduced/samples.hpp"
+#include "reduced/joint_outputs.hpp"
 #include "validate/analysis/sweep.hpp"
+#include "validate/analysis/table_check.hpp"
 #include "validate/cli/commands.hpp"
 #include "validate/cli/drive_command.hpp"
 #include "validate/cli/inspect.hpp"
@@ -223,6 +225,13 @@ PYBIND11_MODULE(_rdyn, m) {
     out.commit();
   });
   m.def("read_table", &rr::read_samples_csv);
+  // A table file without a content checksum against a fresh extraction of its scene, as the CLI
+  // checks it (validate/analysis/table_check.hpp): load_table runs it, so Runtime(path) does too.
+  m.def("check_table", [](const rr::Samples& s, const rm::Scene& scene) {
+    if (s.content_checked || s.file.empty()) return;
+    py::gil_scoped_release free;
+    rv::check_table_against_scene(s, rr::wants_joint_outputs(scene) ? rr::with_reaction_requests(scene) : scene);
+  });
 
   m.def("calibrate", [](const rm::Scene& scene, std::optional<double> cadence_hz, std::optional<double> power_w,
                         const std::string& load, double grid_deg, const std::string& interpolation) {

@@ -125,8 +125,21 @@ def extract(scene, grid_deg=10, method="kinetostatic"):
 def load_table(path, scene):
     """Reads a table written by ``rdyn extract`` (or Table.save) for ``scene``. Raises
     TableError (file, line and field in the message). The table is checked against the scene
-    when it is used (simulate, Runtime)."""
-    return Table(_rdyn.read_table(_os.fspath(path)), scene)
+    when it is used (simulate, Runtime); a table without a content checksum (written before rdyn
+    recorded one, or edited) is compared here with a fresh extraction of ``scene``."""
+    samples = _rdyn.read_table(_os.fspath(path))
+    _rdyn.check_table(samples, scene._scene)
+    return Table(samples, scene)
+
+
+def _as_table(table, scene, who):
+    """A Table, a path read for ``scene`` (load_table), or None; a TypeError naming ``who``."""
+    if table is None or isinstance(table, Table):
+        return table
+    if isinstance(table, (str, bytes, _os.PathLike)):
+        return load_table(table, scene)
+    raise TypeError(f"{who}: table must be an rdyn.Table (rdyn.extract, rdyn.load_table) or a path, "
+                    f"not {type(table).__name__}")
 
 
 class Run(_Columns):
@@ -153,6 +166,7 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
         if key in ("model", "duration", "table") or not hasattr(args, key):
             raise TypeError(f"simulate() got an unknown option {key!r}")
         setattr(args, key, value)
+    table = _as_table(table, scene, "simulate")
     columns, info = _rdyn.simulate(scene._scene, args, None if table is None else table._samples)
     return Run(columns, _json.loads(info))
 
@@ -188,6 +202,7 @@ def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, 
     args.interpolation = interpolation
     if motor is not None:
         args.motor = motor if isinstance(motor, str) else ",".join(repr(float(v)) for v in motor)
+    table = _as_table(table, scene, "drive")
     columns, info = _rdyn.drive(scene._scene, args, None if table is None else table._samples)
     return Run(columns, _json.loads(info))
 
@@ -259,6 +274,8 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
     a dask client's map followed by gather, …) over the cases; the work item is a small tuple
     and the worker ``rdyn.sweep_case``. None: the C++ sweep in ``threads`` threads (None: the
     hardware's), reusing a thread's table between cases as the CLI does."""
+    if isinstance(peaks, str):  # one column name, not its characters
+        peaks = (peaks,)
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
             tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
             None if cadence_hz is None else float(cadence_hz), None if power_w is None else float(power_w),
@@ -288,16 +305,14 @@ class Runtime:
     def __init__(self, table, scene=None, interpolation=None, energy_consistent=False):
         # A path is read for its scene (load_table); anything else but a Table is a TypeError
         # that says what to give, not an AttributeError from inside.
-        if isinstance(table, (str, bytes, _os.PathLike)):
-            if scene is None:
-                raise TypeError("Runtime(path, scene): a table file needs the scene it was extracted from")
-            table = load_table(table, scene)
-        if not isinstance(table, Table):
-            raise TypeError(f"Runtime: table must be an rdyn.Table (rdyn.extract, rdyn.load_table) or a path, "
-                            f"not {type(table).__name__}")
-        scene = table.scene if scene is None else scene
-        if not isinstance(scene, Scene):
+        if scene is not None and not isinstance(scene, Scene):
             raise TypeError(f"Runtime: scene must be an rdyn.Scene (rdyn.load_scene), not {type(scene).__name__}")
+        if isinstance(table, (str, bytes, _os.PathLike)) and scene is None:
+            raise TypeError("Runtime(path, scene): a table file needs the scene it was extracted from")
+        if table is None:
+            raise TypeError("Runtime: table must be an rdyn.Table (rdyn.extract, rdyn.load_table) or a path, not None")
+        table = _as_table(table, scene, "Runtime")
+        scene = table.scene if scene is None else scene
         self._rt = _rdyn.Runtime(table._samples, scene._scene, interpolation, energy_consistent)
         self.step_raw = self._rt.step  # (dt, torque=None, scale=None): the call without this wrapper
 

@@ -186,6 +186,25 @@ def test_runtime_refuses_a_drive_it_cannot_apply_and_wrong_types(tmp_path):
         rdyn.Runtime(42, scene)
     with pytest.raises(TypeError, match="must be an rdyn.Scene"):
         rdyn.Runtime(tmp_path / "t.csv", "fourbar")
+    # The same for simulate and drive; one peak column by name is one column.
+    with pytest.raises(TypeError, match="simulate: table must be an rdyn.Table"):
+        rdyn.simulate(scene, table=5)
+    assert rdyn.simulate(scene, table=tmp_path / "t.csv", duration=0.1)["q"].size > 0
+    # A table without its checksum is compared with a fresh extraction when loaded (as the CLI
+    # does): an edited value is refused, by load_table and so by Runtime(path).
+    text = (tmp_path / "t.csv").read_text()
+    first, rest = text.split("\n", 1)
+    unchecked = first.split(" content=")[0] + "\n" + rest
+    (tmp_path / "u.csv").write_text(unchecked)
+    assert rdyn.Runtime(tmp_path / "u.csv", scene).q == pytest.approx(rdyn.Runtime(tmp_path / "t.csv", scene).q)
+    header_end = unchecked.index("q_deg,")
+    row = unchecked.index("\n", header_end) + 1
+    cells = unchecked[row:unchecked.index("\n", row)].split(",")
+    cells[1] = repr(float(cells[1]) * 1.01)
+    edited = unchecked[:row] + ",".join(cells) + unchecked[unchecked.index("\n", row):]
+    (tmp_path / "e.csv").write_text(edited)
+    with pytest.raises(rdyn.TableError, match="the scene gives"):
+        rdyn.Runtime(tmp_path / "e.csv", scene)
 
 
 def test_control_loop_1khz_bicycle():
