@@ -31,7 +31,8 @@ std::string speedup_sentence(const json& s) {
   const json& full = s.value("recommended_full", json(nullptr));
   const std::string Q = str(s, "headline_quantity");
   if (!s.value("recommended_speedup", json(nullptr)).is_number())
-    return "No speedup is claimed: the compared window is too short to judge errors.";
+    return "No speedup is claimed (the summary has none: the compared window is too short to judge errors, or "
+           "the timing was not measured).";
   const double x = d(s, "recommended_speedup");
   if (full.is_object())
     return fmt::format("It is <b>{}× faster</b> than Simbody forward dynamics at equal or better error: the "
@@ -205,7 +206,15 @@ std::string first_screen_html(const json& s) {
 }
 
 std::string headline(const json& s) {
+  // A failed validation says so first: the CLI prints this paragraph alone (a tutorial scene that
+  // never settles printed a speedup without the word FAIL).
   std::string out;
+  if (str(s, "status") == "fail") {
+    std::string why;
+    for (const auto& f : s.value("failures", json::array()))
+      if (f.is_string()) why += (why.empty() ? "" : "; ") + f.get<std::string>();
+    out += "FAIL: " + (why.empty() ? std::string("see the report") : why) + ". ";
+  }
   const std::string Q = str(s, "headline_quantity");
   const json& rec = s.at("recommended_reduced");
   const json& full = s.value("recommended_full", json(nullptr));
@@ -213,7 +222,8 @@ std::string headline(const json& s) {
   if (rec.is_object() && speedup.is_number() && full.is_object()) {
     out += fmt::format(
         "On this machine ({}), the recommended reduced setting of '{}' ({}) takes {} against {} for Simbody "
-        "forward dynamics ({}, the cheapest full-model run at equal or better error on {}: {} vs {}): {}× faster. ",
+        "forward dynamics ({}, the cheapest full-model run at equal or better error on {}: reduced {}, full {}): "
+        "{}× faster. ",
         str(s, "machine"), str(s, "scene"), str(rec, "label"), cost(s, d(rec, "wall_s")), secs(d(full, "wall_s")),
         str(full, "label"), chosen_on_words(Q), chosen_errors(rec, Q), chosen_errors(full, Q),
         num(speedup.get<double>(), "{:.3g}"));
@@ -225,8 +235,8 @@ std::string headline(const json& s) {
         str(s, "machine"), str(s, "scene"), str(rec, "label"), cost(s, d(rec, "wall_s")), chosen_on_words(Q),
         num(speedup.get<double>(), "{:.3g}"));
   } else if (rec.is_object()) {
-    out += fmt::format("The recommended reduced setting of '{}' is {}; no speedup is claimed (the compared window "
-                       "is too short). ",
+    out += fmt::format("The recommended reduced setting of '{}' is {}; no speedup is claimed (none in the "
+                       "summary). ",
                        str(s, "scene"), str(rec, "label"));
   } else {
     out += fmt::format("No reduced run of '{}' reached the target of {} of the peaks of {}: no setting is "

@@ -71,6 +71,9 @@ TEST(FirstScreen, FailingThresholdIsNamedWithItsGrid) {
   auto s = summary_json(v);
   const std::string first = first_screen_of(render_html(s, {}));
   EXPECT_NE(first.find("1 of 1 fail: F 0.04 % on the 10° grid (limit 0.01 %)"), std::string::npos) << first;
+  // The headline, printed alone by the CLI, opens with the failure.
+  s["status"] = "fail";
+  EXPECT_EQ(headline(s).rfind("FAIL: threshold F. ", 0), 0u) << headline(s);
 }
 
 // None as accurate among the full runs: the reference stands in and says so; no recommended
