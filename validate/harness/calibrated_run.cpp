@@ -6,6 +6,7 @@
 #include "engine/full_model.hpp"
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
+#include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibration_load.hpp"
 #include "validate/harness/harness.hpp"
 
@@ -46,7 +47,11 @@ std::optional<CalibratedRun> calc_calibrated_run(const models::Scene& scene, con
   fo.output_interval_s = dt_s;
   fo.tolerance = 1e-10;
   c.full = engine::simulate_full(engine::FullModel(sc), fo);
-  const auto model = reduced::make_reduced_model(samples10, extraction_scene(sc), reduced::Interpolation::Fourier);
+  c.grid_deg = opt.grid_deg;
+  const bool same_grid = std::abs(samples10.step * 180 / M_PI - opt.grid_deg) < 1e-9 * opt.grid_deg;
+  const reduced::Samples table =
+      same_grid ? samples10 : extract_from_full(extraction_scene(sc), opt.grid_deg, reduced::Method::Kinetostatic).samples;
+  const auto model = reduced::make_reduced_model(table, extraction_scene(sc), reduced::Interpolation::Fourier);
   reduced::ReducedOptions ro;
   ro.duration_s = duration;
   ro.output_interval_s = dt_s;

@@ -17,6 +17,7 @@ namespace rdyn::validate {
 
 struct CalibratedRun {
   double cadence_hz = 0.0;  // the calibration's target [rev/s]
+  double grid_deg = 10.0;   // the reduced model's table: the calibration's grid (opt.grid_deg)
   models::TimeSeries full, reduced;  // the same t rows: q, q̇, the constraint forces
   std::string force_name;            // the first requested constraint force ("": none)
   // max |reduced − full| over the rows, relative to the full model's peak |·| (NaN: no force).
@@ -25,7 +26,9 @@ struct CalibratedRun {
 };
 
 // Nothing when the calibration did not hold (unconfirmed, or no steady point) or the 10° table is
-// missing. Both runs at tight tolerances (full 1e-10, reduced rk8pd 1e-10), rows `dt_s` apart.
+// missing. The reduced model runs on the calibration's own grid (the 10° table, or one extracted
+// at opt.grid_deg when the scene's validation.calibrate.grid_deg differs). Both runs at tight
+// tolerances (full 1e-10, reduced rk8pd 1e-10), rows `dt_s` apart.
 // Throws as engine::simulate_full / reduced::simulate_reduced.
 std::optional<CalibratedRun> calc_calibrated_run(const models::Scene& scene, const CalibrationOptions& opt,
                                                  const CalibrationResult& r, const reduced::Samples& samples10,

@@ -143,6 +143,7 @@ nlohmann::json calibrated_run_json(const CalibratedRun& c) {
     }
   }
   return {{"cadence_hz", num(c.cadence_hz)},
+          {"grid_deg", num(c.grid_deg)},
           {"force_name", c.force_name},
           {"qdot_error", num(c.qdot_error)},
           {"force_error", force ? num(c.force_error) : nlohmann::json(nullptr)},

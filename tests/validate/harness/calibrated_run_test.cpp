@@ -33,6 +33,14 @@ TEST(CalibratedRun, BothModelsHoldTheCalibratedCadenceAndAgree) {
   EXPECT_EQ(c->force_name, "knee");
   EXPECT_LT(c->force_error, 1e-2);
   EXPECT_GT(c->force_error, 0.0);  // two integrations of two models: never identical
+  EXPECT_EQ(c->grid_deg, 10.0);
+  // A calibration on a 5° grid (validation.calibrate.grid_deg) is shown on its own grid: closer.
+  auto opt5 = opt;
+  opt5.grid_deg = 5;
+  const auto c5 = calc_calibrated_run(scene, opt5, calibrate(scene, opt5, quiet), table, 0.005);
+  ASSERT_TRUE(c5);
+  EXPECT_EQ(c5->grid_deg, 5.0);
+  EXPECT_LT(c5->force_error, c->force_error);
   // An unconfirmed calibration has no operating point to show.
   auto missed = r;
   missed.unconfirmed = "the full model's mean cadence is 0.55 Hz";
