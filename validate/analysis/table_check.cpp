@@ -64,7 +64,7 @@ void check_table_against_scene(const reduced::Samples& t, const models::Scene& s
                        q_text(t, t.q.empty() ? 0.0 : t.q.front()), f.q.size(), q_text(f, f.q.empty() ? 0.0 : f.q.front())));
   for (size_t c = 0; c < f.names.size(); ++c) {
     const int tc = t.column(f.names[c]);
-    if (tc < 0) refuse(t, t.header_line, fmt::format("column '{}' of the scene is missing", f.names[c]));
+    if (tc < 0) refuse(t, t.header_line, fmt::format("the column header has no column '{}', which the scene needs", f.names[c]));
     const auto& want = f.columns[c];
     const auto& got = t.columns[tc];
     double scale = 0.0;

@@ -20,6 +20,7 @@
 #include "reduced/simulate_reduced.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/table_check.hpp"
+#include "models/scene_hash.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/analysis/calibrated_scene.hpp"
 #include "validate/cli/cli_limits.hpp"
@@ -178,18 +179,19 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
         if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
       }
     }
-    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
-                                                   a.energy_consistent);
     // A table read from a file (here or by the Python module) without a content checksum: its
-    // values and annotations against a fresh extraction (validate/analysis/table_check.hpp), once
-    // the table fits the scene's columns and hash.
-    if (!samples.file.empty() && !samples.content_checked) {
+    // values and annotations against a fresh extraction (validate/analysis/table_check.hpp),
+    // before the model is built from them (an m1 of 1e99 overshot to a negative interpolant there,
+    // reported without a line); a table of another scene keeps make_reduced_model's message.
+    if (!samples.file.empty() && !samples.content_checked && samples.scene_hash == models::scene_hash(rscene)) {
       std::fprintf(stderr,
                    "rdyn: warning: %s has no content checksum (written before rdyn recorded one): checking it "
                    "against a fresh extraction of its scene; extract it again to skip this\n",
                    samples.file.c_str());
       check_table_against_scene(samples, rscene);
     }
+    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
+                                                   a.energy_consistent);
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
     reduced::check_energy_balance(
