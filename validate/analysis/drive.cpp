@@ -12,6 +12,7 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <iterator>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -80,8 +81,13 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
   // Checked before opening: a FIFO without a writer would block, a device never ends.
   if (const std::string kind = models::non_regular_file_kind(path); !kind.empty())
     throw models::SceneError(path, 0, "--profile", "not a regular file (" + kind + "): give a CSV file t,q_deg or t,q_m");
-  std::ifstream in(path);
-  if (!in) throw models::SceneError(path, 0, "--profile", "cannot be read");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw models::SceneError(path, 0, "--profile", "cannot be read");
+  // An editor's byte-order mark and CR-only line ends change no value (as for tables).
+  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+  if (text.find('\n') == std::string::npos) std::replace(text.begin(), text.end(), '\r', '\n');
+  std::istringstream in(text);
   bool header_seen = false;
   auto quoted = [](const std::string& l) { return l.size() > 60 ? l.substr(0, 60) + "…" : l; };
   std::string line;
@@ -117,6 +123,12 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
       throw models::SceneError(path, line_no, "row", "t and q must be finite (|q| ≤ 1e7)");
     if (!t.empty() && !(tv > t.back()))
       throw models::SceneError(path, line_no, "t", fmt::format("times must increase ({:g} after {:g})", tv, t.back()));
+    // Rows closer than 1 µs make the spline's q̇ and q̈ overflow (1e-300 s apart: "non-finite
+    // value prescribed", exit 1): bad input, said on its line.
+    if (!t.empty() && tv - t.back() < kMinProfileStep_s)
+      throw models::SceneError(path, line_no, "t",
+                               fmt::format("rows must be at least {:g} s apart ({:g} after {:g})", kMinProfileStep_s, tv,
+                                           t.back()));
     if (t.size() >= 1000000) throw models::SceneError(path, line_no, "row", "more than 1e6 rows");
     t.push_back(tv);
     q.push_back(revolute ? qv * M_PI / 180 : qv);

@@ -43,6 +43,8 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
 // command can refuse one that would take hours before any work (kMaxDriveMoves), and a run
 // stops after kDriveMaxWall_s all the same.
 constexpr double kDriveMove = 5.0 * 3.14159265358979323846 / 180;
+// Closest two rows of a profile may be [s]: nearer, the spline's q̇ and q̈ overflow.
+constexpr double kMinProfileStep_s = 1e-6;
 constexpr double kMaxDriveMoves = 2e5;
 constexpr double kDriveMaxWall_s = 600.0;
 double calc_drive_moves(const PrescribedMotion& motion);

@@ -222,6 +222,19 @@ TEST(Drive, ProfileOfAConstantRateIsTheConstantRate) {
   refused("t,q_m\n0,0\n1,1\n2,2\n3,3\n", "header", 1);          // metres for a revolute coordinate
   refused("t,q_deg\n0,0\n1,nan\n2,2\n3,3\n", "row", 3);         // not finite
   refused("t,q_deg\n0,0\n1,1\n2,2\n", "rows", 4);               // too few rows
+  refused("t,q_deg\n0,30\n1e-300,31\n1,60\n2,90\n", "t", 3);  // rows closer than 1 µs (was exit 1)
+  // An editor's byte-order mark and CR-only line ends read as the plain file.
+  std::string plain = "t,q_deg\n0,0\n0.5,10\n1,20\n1.5,30\n";
+  std::ofstream(dir / "bom.csv") << "\xEF\xBB\xBF" + plain;
+  std::string cr_only = plain;
+  std::replace(cr_only.begin(), cr_only.end(), '\n', '\r');
+  std::ofstream(dir / "cr.csv") << cr_only;
+  std::ofstream(dir / "plain.csv") << plain;
+  const auto want = profile_motion((dir / "plain.csv").string(), true, std::nullopt, 0.01);
+  for (const char* f : {"bom.csv", "cr.csv"}) {
+    const auto got = profile_motion((dir / f).string(), true, std::nullopt, 0.01);
+    EXPECT_EQ(got.q, want.q) << f;
+  }
   fs::remove_all(dir);
 }
 

@@ -75,18 +75,23 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
     EXPECT_FALSE(fs::exists(dir / "o2")) << args[2];
   }
   // What is too long or too short is named: a cadence whose one revolution makes too many rows,
-  // a profile whose times span less than one output interval (was "--dt-out" and, for the
-  // profile, exit 1).
+  // profile rows 1e-300 s apart (was "--dt-out" and, for the profile, exit 1), a profile
+  // shorter than one output interval.
   r = run({"drive", "fourbar", "--cadence-hz", "1e-9", "--out", "o2"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("field '--cadence-hz': one revolution at 1e-09 rev/s (1e+09 s)"), std::string::npos) << r.err;
   {
     std::ofstream p(dir / "tiny.csv");
     p << "t,q_deg\n0,0\n1e-300,1\n2e-300,2\n3e-300,3\n";
+    std::ofstream(dir / "short.csv") << "t,q_deg\n0,0\n1e-4,1\n2e-4,2\n3e-4,3\n";
   }
+  r = run({"drive", "fourbar", "--profile", "short.csv", "--out", "o2"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("short.csv: field 't': the profile lasts 0.0003 s, shorter than --dt-out"), std::string::npos)
+      << r.err;
   r = run({"drive", "fourbar", "--profile", "tiny.csv", "--out", "o2"});
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("tiny.csv: field 't': the profile lasts 3e-300 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("tiny.csv:3: field 't': rows must be at least 1e-06 s apart"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "o2"));
   fs::remove_all(dir);
 }
