@@ -170,6 +170,31 @@ TEST(Drive, AForceWithAPoleAtASingularRowIsRefusedThere) {
     const std::string m = e.what();
     EXPECT_NE(m.find("constraint force 'rod_axial' grows without bound at t = 0.5 s"), std::string::npos) << m;
   }
+  // The same fold between two rows (q = 0 at t = 0.505 s, rows 10 ms apart): no row shows the
+  // pole, and the rows' peak depended on --dt-out; it is found from the scan and refused.
+  {
+    std::ofstream p(dir / "between.csv");
+    p << "t,q_m\n";
+    for (int i = 0; i <= 100; ++i) {
+      const double t = 0.01 * i - 0.505;
+      p << fmt::format("{},{:.17g}\n", 0.01 * i, 0.1 * t + 0.05 * t * t);
+    }
+  }
+  try {
+    calc_drive_full(scene, profile_motion((dir / "between.csv").string(), false, 1.0, 0.01));
+    ADD_FAILURE() << "a pole between two rows gave finite rows";
+  } catch (const models::NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("constraint force 'rod_axial' grows without bound at t = 0.50"), std::string::npos) << m;
+    EXPECT_NE(m.find("between two output rows"), std::string::npos) << m;
+  }
+  // A motion that never reaches the fold is not refused (the guard fires only where it must).
+  {
+    std::ofstream p(dir / "short.csv");
+    p << "t,q_m\n";
+    for (int i = 0; i <= 100; ++i) p << fmt::format("{},{:.17g}\n", 0.01 * i, 0.05 + 0.1 * 0.01 * i);
+  }
+  EXPECT_EQ(calc_drive_full(scene, profile_motion((dir / "short.csv").string(), false, 1.0, 0.01)).drive.size(), 101u);
   fs::remove_all(dir);
 }
 
