@@ -597,6 +597,12 @@ Scene parse_scene(const std::string& text, const std::string& file,
   return s;
 }
 
+std::string normalise_text_encoding(std::string text) {
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+  if (text.find('\n') == std::string::npos) std::replace(text.begin(), text.end(), '\r', '\n');
+  return text;
+}
+
 std::string non_regular_file_kind(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return "";

@@ -42,6 +42,11 @@ std::string read_scene_text(const std::string& name_or_path);
 // cannot be looked at (opening it reports that). Input files are refused on a non-empty answer.
 std::string non_regular_file_kind(const std::string& path);
 
+// An input text as rdyn writes it: an editor's UTF-8 byte-order mark dropped, and lines ended by
+// CR alone (classic Mac) ended by \n. Neither changes a value; tables and drive profiles read
+// through it (they were refused as a checksum mismatch or a garbled header).
+std::string normalise_text_encoding(std::string text);
+
 // Whether a dotted key path (as in overrides) exists in the scene's YAML.
 bool scene_yaml_has(const std::string& yaml_text, const std::string& path);
 

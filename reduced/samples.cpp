@@ -1,6 +1,7 @@
 #include "reduced/samples.hpp"
 
 #include "models/scene_hash.hpp"
+#include "models/scene_yaml.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -370,24 +371,11 @@ bool check_content(const TableReader& r, const std::string& text) {
 
 }  // namespace
 
-namespace {
-
-// The text as rdyn wrote it, before anything else reads it: an editor's UTF-8 byte-order mark
-// dropped, and lines ended by CR alone (classic Mac) ended by \n. Both change no value; they
-// were refused as a checksum mismatch or a malformed checksum field.
-std::string normalise_encoding(const std::string& text) {
-  std::string t = text.compare(0, 3, "\xEF\xBB\xBF") == 0 ? text.substr(3) : text;
-  if (t.find('\n') == std::string::npos) std::replace(t.begin(), t.end(), '\r', '\n');
-  return t;
-}
-
-}  // namespace
-
 Samples parse_samples_csv(const std::string& raw, const std::string& name) {
   if (static_cast<long long>(raw.size()) > kMaxTableBytes)
     throw TableError(fmt::format("{}:1: the table has {} bytes, more than the limit of {} bytes", name, raw.size(),
                                  kMaxTableBytes));
-  const std::string text = normalise_encoding(raw);
+  const std::string text = models::normalise_text_encoding(raw);
   TableReader r{text, name, 0, 0, {}};
   Samples s;
   s.file = name;

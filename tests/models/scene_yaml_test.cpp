@@ -621,3 +621,17 @@ TEST(SceneYaml, BadPointForcesAreRefusedNamingLineAndField) {
 
 }  // namespace
 }  // namespace rdyn::models
+
+namespace rdyn::models {
+namespace {
+
+// The byte-order mark and CR-only line ends go; CRLF and plain text stay as they are.
+TEST(SceneYaml, NormaliseTextEncodingDropsTheMarkAndEndsCrOnlyLines) {
+  EXPECT_EQ(normalise_text_encoding("\xEF\xBB\xBFt,q\n0,1\n"), "t,q\n0,1\n");
+  EXPECT_EQ(normalise_text_encoding("t,q\r0,1\r"), "t,q\n0,1\n");
+  EXPECT_EQ(normalise_text_encoding("t,q\r\n0,1\r\n"), "t,q\r\n0,1\r\n");
+  EXPECT_EQ(normalise_text_encoding(""), "");
+}
+
+}  // namespace
+}  // namespace rdyn::models

@@ -85,10 +85,8 @@ PrescribedMotion profile_motion(const std::string& path, bool revolute, std::opt
   std::ifstream file(path, std::ios::binary);
   if (!file) throw models::SceneError(path, 0, "--profile", "cannot be read");
   // An editor's byte-order mark and CR-only line ends change no value (as for tables).
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
-  if (text.find('\n') == std::string::npos) std::replace(text.begin(), text.end(), '\r', '\n');
-  std::istringstream in(text);
+  std::istringstream in(models::normalise_text_encoding(
+      std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>())));
   bool header_seen = false;
   auto quoted = [](const std::string& l) { return l.size() > 60 ? l.substr(0, 60) + "…" : l; };
   std::string line;
