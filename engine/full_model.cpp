@@ -590,11 +590,13 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   wrap_to_guesses(m, s);
   const auto [gap, loop] = m.worst_loop_gap(s);
   if (gap > 1e-8) {
-    throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {:.6g}: the best assembly attempt "
+    const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+    const std::string at = rev ? fmt::format("{:.6g}°", m.scene.initial.q * 180 / Pi) : fmt::format("{:.6g} m", m.scene.initial.q);
+    throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {}: the best assembly attempt "
                                   "leaves a gap of {:.6g} m (check lengths and ground points, and that the joints' "
                                   "guesses describe the configuration at this q: assembly walks from them to q, but "
                                   "not across a singular configuration)",
-                                  m.scene.source_file, loop, m.scene.independent, m.scene.initial.q, gap));
+                                  m.scene.source_file, loop, m.scene.independent, at, gap));
   }
   check_one_dof(m, s);
   // A start where the loops' Jacobian (less the prescribed columns) is singular by the measure

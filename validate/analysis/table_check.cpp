@@ -77,9 +77,15 @@ void check_table_against_scene(const reduced::Samples& t, const models::Scene& s
   }
   if (t.names.size() != f.names.size())
     refuse(t, t.header_line, fmt::format("it has {} columns, the scene gives {}", t.names.size(), f.names.size()));
-  if (!same_points(f.singular_q, t.singular_q, q_tol))
-    refuse(t, 2, fmt::format("its '# singular' line lists {} configuration(s) where the scene has {}", t.singular_q.size(),
-                             f.singular_q.size()));
+  if (!same_points(f.singular_q, t.singular_q, q_tol)) {
+    if (f.singular_q.size() != t.singular_q.size())
+      refuse(t, 2, fmt::format("its '# singular' line lists {} configuration(s) where the scene has {}", t.singular_q.size(),
+                               f.singular_q.size()));
+    size_t i = 0;  // same count: name the first configuration that moved
+    while (i + 1 < f.singular_q.size() && std::abs(f.singular_q[i] - t.singular_q[i]) <= q_tol) ++i;
+    refuse(t, 2, fmt::format("its '# singular' line lists q = {} where the scene's singular configuration is at q = {}",
+                             q_text(t, t.singular_q[i]), q_text(f, f.singular_q[i])));
+  }
   for (const auto& [force, qs] : f.poles) {
     const auto it = std::find_if(t.poles.begin(), t.poles.end(), [&](const auto& p) { return p.first == force; });
     if (it == t.poles.end() || !same_points(it->second, qs, q_tol))

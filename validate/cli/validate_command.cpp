@@ -81,7 +81,7 @@ nlohmann::json validate_one(const models::Scene& scene, const ValidationOptions&
                       {"note", v.note}};
   for (const char* k : {"speedup_at_matched_error", "extraction_ms", "thresholds", "reference", "steady_window",
                         "headline", "matched_full", "matched_reduced", "recommended_reduced", "recommended_full",
-                        "recommended_speedup", "verdicts", "baselines",
+                        "recommended_full_as_accurate", "recommended_speedup", "verdicts", "baselines",
                         "duration_s", "per_second_measured"})
     if (full.contains(k)) j[k] = full[k];
   j["headline"] = headline(full);
@@ -111,7 +111,8 @@ std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
   // The recommended setting against the cheapest full run at equal or better error.
   std::string speed = "—";
   if (entry.contains("recommended_speedup") && entry["recommended_speedup"].is_number())
-    speed = fmt::format("{:.3g}×", entry["recommended_speedup"].get<double>());
+    speed = fmt::format("{}{:.3g}×", entry.value("recommended_full_as_accurate", true) ? "" : "≥ ",
+                        entry["recommended_speedup"].get<double>());
   const std::string what = entry.contains("error") ? entry.value("error", std::string()) : entry.value("note", std::string());
   return fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td>"
                      "<td>{3}</td><td class=l>{4}</td></tr>",

@@ -465,17 +465,26 @@ void calc_first_screen(ValidationResult& v) {
   v.baselines.clear();
   v.budget.reset();
   v.recommended_full = -1;
+  v.recommended_full_as_accurate = true;
   v.recommended_speedup.reset();
   if (!rec) return;
   // One setting on the first screen: its errors, and its speed against the cheapest full run at
   // least as accurate on the quantities it was chosen on (so within the target on them too: a
   // threshold failing on another grid does not make this comparison less true; the status says it).
-  v.recommended_full = pick_matched_full(*rec, v.runs, {"qdot", v.headline_quantity});
+  const std::vector<std::string> chosen_on{"qdot", v.headline_quantity};
+  v.recommended_full = pick_matched_full(*rec, v.runs, chosen_on);
+  if (v.recommended_full < 0) {
+    // No ladder run as accurate (a --quick ladder, a very fine table): the reference's ratio
+    // would flatter the reduced model by the reference's extra accuracy (coarse-grid: 2.3e4×
+    // against ~3e3× at equal error); its floor, the most accurate ladder run, does not.
+    v.recommended_full = pick_most_accurate_full(*rec, v.runs, chosen_on);
+    v.recommended_full_as_accurate = v.recommended_full < 0;
+  }
   const RunRecord& against = v.recommended_full >= 0 ? v.runs[v.recommended_full] : v.reference_run;
   if (v.reference_change.samples >= kMinComparedSamples && rec->wall_s > 0 &&
       std::isfinite(against.wall_s))
     v.recommended_speedup = against.wall_s / rec->wall_s;
-  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.recommended_full);
+  v.baselines = calc_baselines(*rec, v.reference_run, v.runs, v.recommended_full, v.recommended_full_as_accurate);
   const SignalError* ref = v.reference_change.find(v.headline_quantity);
   v.budget = calc_error_budget(*rec, v.runs, ref ? ref->max_rel : NAN, v.headline_quantity, v.tightest_tolerance);
 }

@@ -71,9 +71,12 @@ struct ValidationResult {
   int matched_full = -1, matched_reduced = -1;  // indices into runs
   int recommended = -1;                         // cheapest reduced run within the target (index)
   // The cheapest full run at equal or better error than the recommended run on the speed and
-  // the headline quantity (index, −1: none, the reference stands in), and the recommended run's
-  // speedup over it: the first screen's one speedup.
+  // the headline quantity, and the recommended run's speedup over it: the first screen's one
+  // speedup. When no ladder run is that accurate, the ladder's most accurate run (still less
+  // accurate: recommended_full_as_accurate false), so the speedup is a floor, not the reference's
+  // inflated ratio; −1 when the ladder has no completed full run (the reference stands in).
   int recommended_full = -1;
+  bool recommended_full_as_accurate = true;
   std::optional<double> recommended_speedup;
   std::vector<Verdict> verdicts;
   std::vector<Baseline> baselines;              // the recommended run against full-model runs

@@ -232,9 +232,13 @@ namespace {
 // comparison, its verdicts and baselines.
 void add_first_screen_json(const ValidationResult& v, nlohmann::json& j) {
   // The first screen's one comparison: the recommended run against the cheapest full run at
-  // equal or better error (null: none was, the reference stands in; see baselines).
+  // equal or better error, else the ladder's most accurate run (null: no completed full run, the
+  // reference stands in; see baselines).
   j["recommended_full"] =
       v.recommended_full >= 0 ? run_json(v.runs[v.recommended_full]) : nlohmann::json(nullptr);
+  // false: no ladder run was as accurate; recommended_full is the most accurate one and
+  // recommended_speedup a floor ("at least").
+  j["recommended_full_as_accurate"] = v.recommended_full_as_accurate;
   j["recommended_speedup"] = v.recommended_speedup ? num(*v.recommended_speedup) : nullptr;
   nlohmann::json verdicts = nlohmann::json::array();
   for (const auto& d : v.verdicts)

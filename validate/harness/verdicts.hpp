@@ -31,6 +31,12 @@ std::vector<Verdict> calc_verdicts(const std::vector<std::string>& quantities,
 int pick_matched_full(const RunRecord& recommended, const std::vector<RunRecord>& runs,
                       const std::vector<std::string>& quantities);
 
+// When none is: the completed full run closest to it, the least worst ratio of its error to the
+// recommended run's over `quantities` (−1: no completed full run). The recommended run is both
+// faster and more accurate than it, so its speedup over it is a floor of the equal-error one.
+int pick_most_accurate_full(const RunRecord& recommended, const std::vector<RunRecord>& runs,
+                            const std::vector<std::string>& quantities);
+
 struct Baseline {
   std::string what;   // "reference", "full run at equal or better error", "cheapest full run"
   std::string label;  // the full run
@@ -38,10 +44,11 @@ struct Baseline {
   double speedup = 0.0;  // baseline wall / recommended wall
 };
 
-// Baselines: the reference, the full run at equal or better error (pick_matched_full's index,
-// −1: none) and the cheapest completed full run of the ladder.
+// Baselines: the reference, the full run compared with (index, −1: none; at equal or better
+// error, or when `as_accurate` is false the ladder's most accurate run, named so) and the
+// cheapest completed full run of the ladder.
 std::vector<Baseline> calc_baselines(const RunRecord& recommended, const RunRecord& reference,
-                                     const std::vector<RunRecord>& runs, int matched_full);
+                                     const std::vector<RunRecord>& runs, int compared_full, bool as_accurate = true);
 
 // Where the error of `quantity` at a reduced setting comes from (each relative to the peak):
 // the reference's own accuracy (its change when its tolerance is halved), the table (the same

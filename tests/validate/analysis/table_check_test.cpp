@@ -65,5 +65,20 @@ TEST(TableCheck, ADeletedPoleLineIsRefused) {
   EXPECT_NE(m.find("'# pole rod_axial' line is missing"), std::string::npos) << m;
 }
 
+// A `# singular` line with as many configurations as the scene's, one moved by 1 mm: the message
+// names both positions (it used to say "lists 1 where the scene has 1").
+TEST(TableCheck, AMovedSingularConfigurationIsNamed) {
+  const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/iso-slider-crank.yaml");
+  auto t = reduced::parse_samples_csv(unchecked_text(scene, 10), "t.csv");
+  ASSERT_EQ(t.singular_q.size(), 1u);
+  const double was = t.singular_q[0];
+  t.singular_q[0] += 1e-3;
+  const std::string m = message_of(t, scene);
+  EXPECT_NE(m.find(fmt::format("lists q = {:g} m where the scene's singular configuration is at q = {:g} m",
+                               was + 1e-3, was)),
+            std::string::npos)
+      << m;
+}
+
 }  // namespace
 }  // namespace rdyn::validate

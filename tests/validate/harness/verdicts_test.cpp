@@ -48,6 +48,25 @@ TEST(Verdicts, MatchedFullRunIsTheCheapestAtEqualOrBetterError) {
   EXPECT_EQ(pick_matched_full(exact, runs, {"qdot", "F"}), -1);
 }
 
+// None as accurate: the floor is the run whose worst error ratio to the recommended run's is
+// smallest — not the most accurate on one quantity, and never a stopped run.
+TEST(Verdicts, MostAccurateFullRunIsTheSmallestWorstRatio) {
+  const RunRecord rec = record("reduced", 1e-3, {{"qdot", 1e-6}, {"F", 1e-5}});
+  std::vector<RunRecord> runs{record("full", 2.0, {{"qdot", 2e-6}, {"F", 1e-3}}),  // ratios 2, 100
+                              record("full", 0.9, {{"qdot", 1e-5}, {"F", 5e-5}}),  // ratios 10, 5: it
+                              record("full", 0.1, {{"qdot", 1e-7}, {"F", 1e-7}}), rec};
+  runs[2].failure = "stopped";
+  EXPECT_EQ(pick_matched_full(rec, runs, {"qdot", "F"}), -1);
+  EXPECT_EQ(pick_most_accurate_full(rec, runs, {"qdot", "F"}), 1);
+  EXPECT_EQ(pick_most_accurate_full(rec, runs, {"qdot"}), 0);
+  runs.resize(1);
+  runs[0].failure = "stopped";
+  EXPECT_EQ(pick_most_accurate_full(rec, runs, {"qdot"}), -1);
+  const auto b = calc_baselines(rec, record("full", 4.0, {}), {record("full", 0.9, {})}, 0, false);
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(b[1].what, "most accurate full run (less accurate)");
+}
+
 TEST(Verdicts, BaselinesAreCostRatios) {
   const RunRecord rec = record("reduced", 0.01, {{"qdot", 1e-4}});
   const RunRecord ref = record("full", 4.0, {{"qdot", 0.0}});

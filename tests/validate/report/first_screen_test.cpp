@@ -76,26 +76,46 @@ TEST(FirstScreen, FailingThresholdIsNamedWithItsGrid) {
   EXPECT_EQ(headline(s).rfind("FAIL: threshold F. ", 0), 0u) << headline(s);
 }
 
-// None as accurate among the full runs: the reference stands in and says so; no recommended
-// setting: no speedup anywhere on the screen.
-TEST(FirstScreen, ReferenceStandsInAndNoSettingClaimsNothing) {
+// None as accurate among the full runs: the speedup is a floor, against the ladder's most
+// accurate run (not the reference's ratio, which flattered a --quick coarse grid 7×), said so on
+// the screen, in the headline and in the baselines; without any completed full run the reference
+// stands in; no recommended setting: no speedup anywhere on the screen.
+TEST(FirstScreen, FloorWhenNoneAsAccurateReferenceStandsInNoSettingClaimsNothing) {
   auto v = distinct_runs();
   v.runs[0].errors.signals = {{"qdot", 1.0, 1e-3, 1e-3}, {"F", 1.0, 1e-3, 1e-3}};
+  calc_first_screen(v);
+  // 1e-10 run: ratios 5 and 2.5 to the recommended (2e-4, 4e-4); 1e-4 run (5e-4, 6e-4): 2.5, 1.5.
+  ASSERT_EQ(v.recommended_full, 1);
+  EXPECT_FALSE(v.recommended_full_as_accurate);
+  ASSERT_TRUE(v.recommended_speedup);
+  EXPECT_DOUBLE_EQ(*v.recommended_speedup, 0.3 / 0.003);
+  auto s = summary_json(v);
+  EXPECT_FALSE(s["recommended_full_as_accurate"].get<bool>());
+  std::string first = first_screen_of(render_html(s, {}));
+  EXPECT_NE(first.find("No run of the full-model ladder was as accurate"), std::string::npos) << first;
+  EXPECT_NE(first.find("<b>100× faster</b> than it: at least"), std::string::npos) << first;
+  EXPECT_NE(first.find("most accurate full run (less accurate)"), std::string::npos) << first;
+  EXPECT_NE(headline(s).find("at least 100× faster at equal error"), std::string::npos) << headline(s);
+  EXPECT_EQ(headline(s).find("1e+03×"), std::string::npos) << headline(s);
+
+  for (auto& r : v.runs)
+    if (r.model == "full") r.failure = "stopped";
   calc_first_screen(v);
   ASSERT_EQ(v.recommended_full, -1);
   ASSERT_TRUE(v.recommended_speedup);
   EXPECT_DOUBLE_EQ(*v.recommended_speedup, 3.0 / 0.003);  // the reference's 3 s
-  std::string first = first_screen_of(render_html(summary_json(v), {}));
+  first = first_screen_of(render_html(summary_json(v), {}));
   EXPECT_NE(first.find("against the reference"), std::string::npos) << first;
   EXPECT_NE(first.find("1e+03× faster"), std::string::npos) << first;
 
   v.recommended = -1;
   calc_first_screen(v);
   EXPECT_FALSE(v.recommended_speedup);
-  const auto s = summary_json(v);
+  s = summary_json(v);
   first = first_screen_of(render_html(s, {}));
   EXPECT_NE(first.find("No reduced run reached the target"), std::string::npos) << first;
   EXPECT_EQ(first.find("faster"), std::string::npos) << first;
+  EXPECT_EQ(first.find("at the recommended setting"), std::string::npos) << first;
   EXPECT_NE(headline(s).find("no setting is recommended"), std::string::npos);
 }
 
