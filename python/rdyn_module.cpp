@@ -101,11 +101,11 @@ PyObject* g_output_error = nullptr;
 void raise(PyObject* cls, const char* message) { PyErr_SetString(cls, message); }
 
 // Runtime statuses: argument faults (1–4) are ArgumentError, the others NumericalError.
-void raise_status(rr::Status s) {
+void raise_status(rr::Status s, const rr::RuntimeWorkspace& ws) {
   if (s == rr::Status::Ok) return;
   const int code = static_cast<int>(s);
-  if (code <= 4) throw rv::ArgumentError(rr::status_message(s));
-  throw rm::NumericalError(rr::status_message(s));
+  if (code <= 4) throw rv::ArgumentError(ws.describe(s));
+  throw rm::NumericalError(ws.describe(s));
 }
 
 struct Runtime {
@@ -320,18 +320,18 @@ PYBIND11_MODULE(_rdyn, m) {
                py::gil_scoped_release free;  // step is noexcept and allocation-free
                s = rr::step(r.model, r.ws, dt, d);
              }
-             raise_status(s);
+             raise_status(s, r.ws);
            },
            py::arg("dt"), py::arg("torque").none(true) = py::none(), py::arg("scale").none(true) = py::none())
       .def("reset",
            [](Runtime& r, double q, double qdot, std::optional<double> torque, std::optional<double> scale) {
-             raise_status(rr::reset(r.model, r.ws, q, qdot, drive_of(torque, scale)));
+             raise_status(rr::reset(r.model, r.ws, q, qdot, drive_of(torque, scale)), r.ws);
            },
            py::arg("q"), py::arg("qdot"), py::arg("torque").none(true) = py::none(), py::arg("scale").none(true) = py::none())
       .def("drive_torque",
            [](Runtime& r, double q, double qdot, double qddot) {
              double d = 0.0;
-             raise_status(rr::calc_drive_torque(r.model, r.ws, q, qdot, qddot, d));
+             raise_status(rr::calc_drive_torque(r.model, r.ws, q, qdot, qddot, d), r.ws);
              return d;
            },
            py::arg("q"), py::arg("qdot"), py::arg("qddot"))

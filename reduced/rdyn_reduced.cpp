@@ -194,6 +194,11 @@ rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int
   return RDYN_OK;
 }
 
+const char* rdyn_workspace_message(const rdyn_workspace* workspace, int status) {
+  if (workspace && status == RDYN_BAD_DRIVE) return workspace->ws.describe(Status::BadDrive);
+  return rdyn_status_string(status);
+}
+
 rdyn_status rdyn_get_joint_outputs(const rdyn_workspace* workspace, double* out, int n) {
   if (!workspace || n < 0 || (n > 0 && !out)) return RDYN_BAD_ARGUMENT;
   const auto& v = workspace->ws.get_joint_outputs();

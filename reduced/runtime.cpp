@@ -37,6 +37,10 @@ const char* status_message(Status s) {
   return "unknown status";
 }
 
+const char* RuntimeWorkspace::describe(Status s) const {
+  return s == Status::BadDrive && drive_refusal_ ? drive_refusal_ : status_message(s);
+}
+
 RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& scene,
                                 const RuntimeOptions& options) {
   const Interpolation interp = options.interpolation.value_or(
@@ -118,12 +122,18 @@ Status RuntimeWorkspace::apply_drive(const RuntimeModel& model, const Drive& dri
     return drive.mode == Drive::Mode::Scale ? drive.value * nominal
                                             : (nominal < 0 ? -1.0 : 1.0) * drive.value;
   };
-  if (!std::isfinite(drive.value)) return Status::BadDrive;
+  auto refuse = [&](const char* why) {
+    drive_refusal_ = why;
+    return Status::BadDrive;
+  };
+  if (!std::isfinite(drive.value)) return refuse("the drive's value is not finite (or its mode is unknown)");
   // A scene without joint torques has nothing to command: a torque (or a scale other than the
   // scene's own) would be ignored in silence, and the caller's controller would run open loop.
-  if (torques.empty() && !(drive.mode == Drive::Mode::Scale && drive.value == 1.0)) return Status::BadDrive;
+  if (torques.empty() && !(drive.mode == Drive::Mode::Scale && drive.value == 1.0))
+    return refuse("the scene has no joint torque for the drive to command (only a scale of 1 is accepted)");
   for (size_t i = 0; i < torques.size(); ++i)
-    if (!(std::abs(commanded(i)) <= models::limits::kMaxForce)) return Status::BadDrive;
+    if (!(std::abs(commanded(i)) <= models::limits::kMaxForce))
+      return refuse("a joint torque the drive commands exceeds 1e6 N·m (N)");
   for (size_t i = 0; i < torques.size(); ++i) state_.torque_value[i] = commanded(i);
   return Status::Ok;
 }

@@ -109,6 +109,10 @@ class RuntimeWorkspace {
   long get_steps() const { return steps_; }        // steps since the last reset
   long get_switches() const { return switches_; }  // steps in which a load gate switched
   const ReducedWorkspace& get_state() const { return state_; }
+  // What `s`, just returned by a call on this workspace, means: for BadDrive the one cause of the
+  // last refused drive (not finite, no joint torque to command, a torque beyond the limit), else
+  // status_message(s). A static string: nothing is allocated.
+  const char* describe(Status s) const;
 
  private:
   friend Status reset(const RuntimeModel&, RuntimeWorkspace&, double, double,
@@ -128,6 +132,7 @@ class RuntimeWorkspace {
   std::vector<double> joint_out_;  // the scene's joint outputs
   std::optional<JointOutputWorkspace> joint_ws_;
   long steps_ = 0, switches_ = 0;
+  const char* drive_refusal_ = nullptr;  // the last refused drive's cause (apply_drive)
   // Scratch for rolling back a failed step.
   ReducedWorkspace saved_;
   std::vector<double> forces_saved_, joint_out_saved_;

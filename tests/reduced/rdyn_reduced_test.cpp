@@ -129,7 +129,10 @@ TEST_F(CApi, StepsLikeTheCxxRuntimeFieldByField) {
   // Refusals are the C++ statuses, and change nothing.
   EXPECT_EQ(rdyn_step(m, ws, NAN, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_STEP);
   EXPECT_EQ(rdyn_step(m, ws, 1e-3, {RDYN_DRIVE_TORQUE, 2e6}), RDYN_BAD_DRIVE);
+  EXPECT_NE(std::string(rdyn_workspace_message(ws, RDYN_BAD_DRIVE)).find("exceeds 1e6"), std::string::npos);
   EXPECT_EQ(rdyn_step(m, ws, 1e-3, {7, 1.0}), RDYN_BAD_DRIVE);
+  EXPECT_NE(std::string(rdyn_workspace_message(ws, RDYN_BAD_DRIVE)).find("mode is unknown"), std::string::npos);
+  EXPECT_STREQ(rdyn_workspace_message(nullptr, RDYN_BAD_STEP), rdyn_status_string(RDYN_BAD_STEP));
   EXPECT_EQ(rdyn_reset(m, ws, NAN, 0.0, {RDYN_DRIVE_SCALE, 1.0}), RDYN_BAD_STATE);
   rdyn_state again;
   ASSERT_EQ(rdyn_get_state(ws, &again), RDYN_OK);

@@ -202,6 +202,11 @@ TEST(Runtime, BadArgumentsAreRefusedAndChangeNothing) {
     EXPECT_EQ(snapshot(ws), after_min_step) << d.value;
   }
   EXPECT_EQ(reset(model, ws, 0.3, 10.0, Drive::torque(1.5e6)), Status::BadDrive);
+  // Each refusal names its one cause (one message once covered all three).
+  EXPECT_NE(std::string(ws.describe(Status::BadDrive)).find("exceeds 1e6"), std::string::npos);
+  EXPECT_EQ(step(model, ws, 1e-3, Drive::torque(NAN)), Status::BadDrive);
+  EXPECT_NE(std::string(ws.describe(Status::BadDrive)).find("not finite"), std::string::npos);
+  EXPECT_STREQ(ws.describe(Status::BadStep), status_message(Status::BadStep));
   // States that are not finite or out of range (|q̇| ≤ 1e4, models::limits::kMaxRate).
   for (auto [q, qd] : std::initializer_list<std::pair<double, double>>{
            {NAN, 1.0}, {0.0, INFINITY}, {0.0, 1.1e4}, {2e6, 0.0}}) {
@@ -228,7 +233,8 @@ TEST(Runtime, ADriveForASceneWithoutJointTorquesIsRefused) {
   }
   EXPECT_EQ(reset(model, ws, 0.3, 10.0, Drive::torque(5.0)), Status::BadDrive);
   EXPECT_EQ(step(model, ws, 1e-3, Drive{}), Status::Ok);
-  EXPECT_NE(std::string(status_message(Status::BadDrive)).find("no joint torque"), std::string::npos);
+  EXPECT_NE(std::string(ws.describe(Status::BadDrive)).find("no joint torque"), std::string::npos);
+  EXPECT_EQ(std::string(ws.describe(Status::BadDrive)).find("not finite"), std::string::npos);
 }
 
 TEST(Runtime, AWorkspaceOfAnotherModelIsRefused) {
