@@ -74,6 +74,48 @@ std::string table_csv(const json& t) {
   return s;
 }
 
+namespace {
+
+// Keys whose values `rdyn validate` writes as numbers, arrays of numbers or null, wherever they
+// stand in summary.json (validate/harness/summary.cpp); scene-named keys (force names) excluded.
+bool numeric_key(const std::string& k) {
+  static const char* const kKeys[] = {
+      "speedup", "recommended_speedup", "speedup_at_matched_error", "extraction_ms", "matched_error_target",
+      "duration_s", "wall_s", "wall_s_per_simulated_s", "compared_run_wall_s", "grid_deg", "tolerance",
+      "error", "target", "max_error", "max_rel", "rms_rel", "peak", "floor", "total", "integration",
+      "output_interpolation", "steps", "rejected_steps", "smallest_step_s", "fixed_step_s", "fixed_steps_s",
+      "timed_steps", "samples", "cycles", "revolutions", "rows", "repeats", "ms", "kinetostatic_calls",
+      "energy_balance_residual_rel", "energy_drift_per_cycle_J", "constraint_violation_m", "period_s",
+      "t_start_s", "output_interval_s", "timed_output_interval_s", "fx_N", "fy_N", "order", "points"};
+  for (const char* key : kKeys)
+    if (k == key) return true;
+  return false;
+}
+
+std::string find_non_number_in(const json& j, const std::string& path, bool numeric) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      std::string found = find_non_number_in(it.value(), path.empty() ? it.key() : path + "." + it.key(),
+                                             numeric_key(it.key()));
+      if (!found.empty()) return found;
+    }
+  } else if (j.is_array()) {
+    for (size_t i = 0; i < j.size(); ++i) {
+      std::string found = find_non_number_in(j[i], fmt::format("{}[{}]", path, i), numeric);
+      if (!found.empty()) return found;
+    }
+  } else if (numeric && (j.is_string() || j.is_boolean())) {
+    std::string v = j.dump();
+    if (v.size() > 40) v = v.substr(0, 40) + "…";
+    return path + ": " + v;
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string find_non_number(const json& s) { return find_non_number_in(s, "", false); }
+
 bool is_joint_output(const json& s, const json& q) {
   for (const auto& j : s.value("joint_output_quantities", json::array()))
     if (j == q) return true;

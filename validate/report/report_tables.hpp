@@ -35,6 +35,11 @@ std::string compared_over(const json& s);
 std::string table_csv(const json& t);
 // Whether q is one of the summary's joint outputs (reactions, shaking, joint motion).
 bool is_joint_output(const json& s, const json& q);
+// The first value of a hand-edited summary that `rdyn validate` writes as a number (or null)
+// but is text or true/false, as "path: value" ("recommended_speedup: \"fast\"",
+// "runs[3].wall_s: …"); empty when there is none. The report reads such a value as "not
+// measured" and would render a report without it, exit 0.
+std::string find_non_number(const json& s);
 }  // namespace report_format
 
 // <!DOCTYPE html> … <body>: the title naming the scene and the page's style.

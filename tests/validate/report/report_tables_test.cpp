@@ -7,6 +7,9 @@
 #include <cmath>
 #include <string>
 
+#include "tests/validate/harness/validation_fixture.hpp"
+#include "validate/harness/summary.hpp"
+
 namespace rdyn::validate {
 namespace {
 
@@ -56,6 +59,23 @@ TEST(ReportTables, ScenesTextIsEscapedAndVerdictsAreClassed) {
   EXPECT_NE(r.find("3.00e-05"), std::string::npos) << r;
   EXPECT_NE(extraction_table(s).find("<td>36</td><td>40</td><td>3.3 ms</td>"), std::string::npos);
   EXPECT_NE(html_head("a<b").find("<title>rdyn validation: a&lt;b</title>"), std::string::npos);
+}
+
+// `rdyn report` of a hand-edited summary: a number turned into text is named by its path (it was
+// read as "not measured" and rendered, exit 0); a summary as validate writes it has none, and
+// scene-named keys (a force called "error_label") holding text are not numbers' keys.
+TEST(ReportTables, ANumberEditedIntoTextIsFoundByItsPath) {
+  json s = summary_json(test::synthetic_validation());
+  EXPECT_EQ(find_non_number(s), "");
+  json edited = s;
+  edited["recommended_speedup"] = "fast";
+  EXPECT_EQ(find_non_number(edited), "recommended_speedup: \"fast\"");
+  edited = s;
+  ASSERT_TRUE(edited["runs"].size() > 1);
+  edited["runs"][1]["wall_s"] = true;
+  EXPECT_EQ(find_non_number(edited), "runs[1].wall_s: true");
+  EXPECT_EQ(find_non_number(json{{"scene", "x"}, {"labels", {{"error_label", "text"}}}}), "");
+  EXPECT_EQ(find_non_number(json{{"extractions", {{{"points", {1, "2"}}}}}}), "extractions[0].points[1]: \"2\"");
 }
 
 }  // namespace
