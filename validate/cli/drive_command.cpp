@@ -159,11 +159,17 @@ DriveMotion calc_drive_motion(const DriveArgs& a, const models::Scene& scene, bo
            fmt::format("the motion needs {:.3g} rows of at most 1° each; at most {:g}",
                        static_cast<double>(k) * static_cast<double>(coarse.t.size()), cli_limits::kMaxOutputRows));
   DriveMotion d{k == 1 ? coarse : calc_motion_at(a, scene, revolute, dt, dt / static_cast<double>(k)), k};
+  // One projection per row and per 5° of motion: without --duration the run is one revolution,
+  // so its length is the cadence's; name the option the user gave (was "--duration" when none was).
   if (a.model == "full" && calc_drive_moves(d.motion) > kMaxDriveMoves)
-    refuse(scene, a.cadence_hz ? "--duration" : "--profile",
-           fmt::format("the full model would follow {:.3g} continuation moves of 5° (at most {:g}, about a minute): "
-                       "shorten the run or use --model reduced",
-                       calc_drive_moves(d.motion), kMaxDriveMoves));
+    refuse(scene, !a.cadence_hz ? "--profile" : a.duration ? "--duration" : "--cadence-hz",
+           fmt::format("the full model would make {:.3g} projections, one per computed row ({} over {:g} s: the --dt-out "
+                       "{:g} s grid refined to ≤ 1° of motion) and one per 5° (at most {:g}, about a minute): {} or use "
+                       "--model reduced",
+                       calc_drive_moves(d.motion), d.motion.t.size(), d.motion.t.back(), dt, kMaxDriveMoves,
+                       !a.cadence_hz ? "raise --dt-out, shorten the profile"
+                       : a.duration  ? "raise --dt-out, shorten --duration"
+                                     : "raise --dt-out or the cadence"));
   return d;
 }
 

@@ -80,6 +80,16 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
   r = run({"drive", "fourbar", "--cadence-hz", "1e-9", "--out", "o2"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("field '--cadence-hz': one revolution at 1e-09 rev/s (1e+09 s)"), std::string::npos) << r.err;
+  // One slow revolution within the row limit but too many projections for the full model: the
+  // cadence is named (was "--duration", which was not given), with the rows that cost them.
+  r = run({"drive", "fourbar", "--cadence-hz", "1e-3", "--out", "o2"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("field '--cadence-hz': the full model would make 5e+05 projections, one per computed row "
+                       "(500001 over 1000 s"),
+            std::string::npos)
+      << r.err;
+  r = run({"drive", "fourbar", "--cadence-hz", "1e-3", "--duration", "900", "--out", "o2"});
+  EXPECT_NE(r.err.find("field '--duration': the full model would make"), std::string::npos) << r.err;
   {
     std::ofstream p(dir / "tiny.csv");
     p << "t,q_deg\n0,0\n1e-300,1\n2e-300,2\n3e-300,3\n";
