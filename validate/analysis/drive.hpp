@@ -83,6 +83,8 @@ DriveRecord calc_drive_reduced(const models::Scene& scene, const reduced::Reduce
 
 struct DriveStats {
   double rms = 0.0, peak = 0.0, mean = 0.0;  // of the drive (peak: largest |drive|)
+  // peak_power_W: the largest power the drive delivers (max of drive·q̇, 0 when it only absorbs):
+  // what a motor must supply; the braking peak is not in it.
   double mean_power_W = 0.0, peak_power_W = 0.0;
   std::vector<double> force_peaks;  // largest |F_E| per constraint force
 };
