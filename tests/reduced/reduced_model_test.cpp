@@ -439,6 +439,15 @@ TEST(ReducedModel, CliRefusesAFourbarTableForTheBicycle) {
   const auto [st_ok, msg_ok] =
       run_rdyn("simulate fourbar --model reduced --table " + table + " --duration 0.1 --out " + (dir / "fb").string());
   EXPECT_EQ(st_ok, 0) << msg_ok;
+  // The same mechanism asking for reactions needs their lines: said so (was only "a different
+  // scene", which sent a user who had added `reactions: all` hunting for a change in the mechanism).
+  const auto [st_r, msg_r] = run_rdyn("simulate fourbar --model reduced --table " + table +
+                                      " --set outputs.reactions=all --duration 0.1 --out " + (dir / "r").string());
+  EXPECT_EQ(st_r, 2) << msg_r;
+  EXPECT_NE(msg_r.find("table " + table + " was extracted from a different scene: it has constraint lines for rocker_axial "
+                       "where scene 'fourbar' asks for rocker_axial, R_crank_cx"),
+            std::string::npos)
+      << msg_r;
   fs::remove_all(dir);
 }
 
