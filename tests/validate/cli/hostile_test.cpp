@@ -853,10 +853,10 @@ void issue23(std::vector<Case>& cs) {
                     {{"s.yaml", fb2}}, nullptr, "o"});
     const std::string reserved = edit(fb, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
                                       "    - {name: rocker_axial, joint: rocker, direction: C}\n"
-                                      "    - {name: R_crank_cx, joint: crank, direction: [1, 0]}\n");
-    const int reserved_line = line_of(reserved, "R_crank_cx");
+                                      "    - {name: R_crank_gx, joint: crank, direction: [1, 0]}\n");
+    const int reserved_line = line_of(reserved, "R_crank_gx");
     cs.push_back({"reserved_reaction_line_name", {"simulate", "s.yaml", "--model", "reduced", "--out", "o"}, 2,
-                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_cx' is reserved",
+                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_gx' is reserved",
                               reserved_line),
                   {{"s.yaml", reserved}}, nullptr, "o"});
     // A force named like the speed took the speed's verdict in validate.
