@@ -200,8 +200,8 @@ void check_profile(const Checker& c, const std::string& f, const LoadProfile& p,
 // Names that become reduced-table columns (reduced/extract.cpp) must give each column one
 // meaning; found here so the refusal names the scene's field and line, not a bare "duplicate
 // column" from the extraction (issue #23).
-// - The reduced model's own reaction lines are constraint forces named R_<joint>_cx and
-//   R_<joint>_cy (reduced/joint_outputs.hpp, internal_request_name): a scene's force may not
+// - The reduced model's own reaction lines are constraint forces named R_<joint>_gx and
+//   R_<joint>_gy (reduced/joint_outputs.hpp, internal_request_name): a scene's force may not
 //   take such a name.
 // - Columns named from two names, rx_<force>_<joint>, wx_<force>_<body> and
 //   Qxpf_<force>_<point force>, meet when underscores shift between the two: force 'a_b' with
@@ -219,16 +219,16 @@ void check_table_column_names(const Checker& c, const Scene& s) {
                                   "choose another name",
                                   q));
     for (const auto& j : s.joints)
-      for (const char* axis : {"_cx", "_cy"})
+      for (const char* axis : {"_gx", "_gy"})
         if (cf[i].name == "R_" + j.name + axis)
-          c.fail(field, fmt::format("'{}' is reserved: the reduced model names its own reaction lines R_<joint>_cx "
-                                    "and R_<joint>_cy; choose another name",
+          c.fail(field, fmt::format("'{}' is reserved: the reduced model names its own reaction lines R_<joint>_gx "
+                                    "and R_<joint>_gy; choose another name",
                                     printable(cf[i].name)));
     forces.push_back({cf[i].name, field});
   }
   if (!s.outputs.reactions.empty())  // the reaction lines the reduced model adds (a superset)
     for (const auto& j : s.joints)
-      for (const char* axis : {"_cx", "_cy"}) forces.push_back({"R_" + j.name + axis, "outputs.reactions"});
+      for (const char* axis : {"_gx", "_gy"}) forces.push_back({"R_" + j.name + axis, "outputs.reactions"});
   std::map<std::string, std::string> made;  // column → what makes it
   auto add = [&](const std::string& prefix, const std::pair<std::string, std::string>& force, const char* kind,
                  const std::string& other) {

@@ -209,6 +209,7 @@ void read_mechanism(const Fields& top, Scene& s) {
     s.gears.push_back({f.name("name"), f.str("driver"), f.str("driven"), f.num("ratio")});
   });
   s.independent = top.str("independent");
+  note_key(s, top.ctx(), "independent", top.raw("independent"));  // calibrate's and optimize's refusals name it
 }
 
 // independent_range: [min, max] in rad or m (as initial.q), or independent_range_deg for a

@@ -118,6 +118,7 @@ struct AdaptiveIntegrator::Impl {
   Point start{}, end{};
   IntegratorLimits limits;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  double window_t0 = 0.0;  // time at the start of the current window of kWindow accepted steps
 
   Impl(const ReducedModel& model, double tol, const std::string& method, IntegratorLimits lim)
       : m(model), ws(model), ctx{&m, &ws}, limits(lim) {
@@ -328,6 +329,7 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
   std::fill(d.pending.begin(), d.pending.end(), 0);
   d.flipped = true;  // recompute the start point and switching values
   d.start = d.end = d.point(t, d.y);
+  d.window_t0 = t;
   gsl_odeiv2_evolve_reset(d.evolve.get());
 }
 
@@ -341,6 +343,24 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
         "reduced integration stopped at t = {:.6g} s: it used its budget of {} steps (the run needs more; "
         "loosen the tolerance or shorten the duration)",
         d.ws.t, d.limits.max_steps));
+  // Hopeless runs fail early, as the full model's (engine/forward_dynamics.cpp, check_budgets):
+  // every kWindow accepted steps, the steps still needed to reach t_end at the window's mean step;
+  // more than kHopeless budgets will not finish. A motor stalled against a rate-gated load
+  // chatters at the gate's switch with steps of ~1e-13 s: the full model stopped in 5 s, the
+  // reduced one ran for minutes (issue #23's shaper).
+  constexpr long kWindow = 1000;
+  constexpr double kHopeless = 100.0;
+  if (d.steps > 0 && d.steps % kWindow == 0 && d.ws.t != d.window_t0) {
+    const double mean_h = (d.ws.t - d.window_t0) / kWindow;
+    const double needed = static_cast<double>(attempted) + (t_end - d.ws.t) / std::max(mean_h, 1e-300);
+    d.window_t0 = d.ws.t;
+    if (needed > kHopeless * static_cast<double>(d.limits.max_steps))
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) "
+          "it would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or too fast "
+          "(a load switching back and forth at a standstill, a stalled drive)",
+          d.ws.t, t_end, kWindow, mean_h, needed, kHopeless, d.limits.max_steps));
+  }
   if (d.steps % 64 == 0) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.started).count();
     if (wall > d.limits.max_wall_s)

@@ -692,6 +692,7 @@ Samples extract_samples(KinetostaticSource& src, const models::Scene& scene, con
     for (int j = 0; j < g.nj; ++j) s.add("rx_" + forces[k].name + "_" + scene.joints[j].name, c.rx[k][j]);
   if (!c.p.empty()) add_joint_position_columns(scene, s.q, g.h, c.r, c.p, s);
   add_load_columns(scene, g, c, s);
+  if (!c.p.empty()) turn_reaction_lines_to_ground(scene, s);  // joint_outputs.hpp: ground-frame lines
   check_finite_table(scene, s);
   return s;
 }

@@ -90,6 +90,57 @@ void add_joint_position_columns(const models::Scene& scene, const std::vector<do
   }
 }
 
+void turn_reaction_lines_to_ground(const models::Scene& scene, Samples& s) {
+  const size_t n = s.q.size();
+  for (const auto& jt : scene.joints) {
+    const std::string fx = internal_request_name(jt.name, 'x'), fy = internal_request_name(jt.name, 'y');
+    if (s.column("me1_" + fx) < 0 || s.column("me1_" + fy) < 0) continue;
+    // The child's angle in ground: the sum over the revolute joints from ground to it.
+    std::vector<double> th(n, 0.0);
+    std::string body = jt.child;
+    for (size_t hops = 0; body != models::kGround && hops <= scene.joints.size(); ++hops) {
+      const auto it = std::find_if(scene.joints.begin(), scene.joints.end(),
+                                   [&](const models::Joint& x) { return x.child == body; });
+      if (it == scene.joints.end()) break;
+      if (it->type == models::JointType::Revolute) {
+        const auto& p = s.columns[s.require("p_" + it->name)];
+        const auto& k = s.columns[s.require("k_" + it->name)];
+        for (size_t i = 0; i < n; ++i) th[i] += it->offset_rad + p[i] + k[i] * s.q[i];
+      }
+      body = it->parent;
+    }
+    std::vector<std::string> parts{"me1_", "me2_", "Qx_cons_"};  // prefix + force (+ "_" + other)
+    std::vector<std::pair<std::string, std::string>> cols;
+    for (const auto& pre : parts) cols.emplace_back(pre + fx, pre + fy);
+    for (const auto& o : scene.joints) cols.emplace_back("rx_" + fx + "_" + o.name, "rx_" + fy + "_" + o.name);
+    for (const auto& r : scene.resistances) cols.emplace_back("wx_" + fx + "_" + r.body, "wx_" + fy + "_" + r.body);
+    for (const auto& pf : scene.point_forces)
+      cols.emplace_back("Qxpf_" + fx + "_" + pf.name, "Qxpf_" + fy + "_" + pf.name);
+    for (const auto& [nx, ny] : cols) {
+      const int cx = s.column(nx), cy = s.column(ny);
+      if (cx < 0 || cy < 0) continue;
+      auto& X = s.columns[cx];
+      auto& Y = s.columns[cy];
+      for (size_t i = 0; i < n; ++i) {
+        const double c = std::cos(th[i]), sn = std::sin(th[i]), x = X[i], y = Y[i];
+        X[i] = c * x - sn * y, Y[i] = sn * x + c * y;
+      }
+    }
+    // A pole of either child-frame line is in both ground-frame lines.
+    std::vector<double> poles;
+    for (const auto& [name, q] : s.poles)
+      if (name == fx || name == fy) poles.insert(poles.end(), q.begin(), q.end());
+    if (poles.empty()) continue;
+    std::sort(poles.begin(), poles.end());
+    poles.erase(std::unique(poles.begin(), poles.end()), poles.end());
+    s.poles.erase(std::remove_if(s.poles.begin(), s.poles.end(),
+                                 [&](const auto& pr) { return pr.first == fx || pr.first == fy; }),
+                  s.poles.end());
+    s.poles.emplace_back(fx, poles);
+    s.poles.emplace_back(fy, poles);
+  }
+}
+
 std::vector<std::string> reaction_line_joints(const models::Scene& scene) {
   std::vector<std::string> joints;  // revolute joints whose reaction lines are needed
   auto need = [&](const std::string& j) {
@@ -209,12 +260,9 @@ struct StateReactions {
   const JointOutputWorkspace& k;
   const double* forces;  // the run's constraint forces, in the order make_joint_output_model was given
 
-  // A revolute joint's reaction: the child-frame reaction lines turned into ground by the child's angle.
+  // A revolute joint's reaction: its two ground-frame reaction lines (turned at extraction).
   void revolute(int j, double& Rx, double& Ry) const {
-    const double fx = forces[m.line_x[j]], fy = forces[m.line_y[j]];
-    const double th = k.body[m.child[j]].th;
-    Rx = std::cos(th) * fx - std::sin(th) * fy;
-    Ry = std::sin(th) * fx + std::cos(th) * fy;
+    Rx = forces[m.line_x[j]], Ry = forces[m.line_y[j]];
   }
   // Force of loop l's body_a on its body_b: Newton–Euler of the body B that balances it,
   // R_parent + Σ(−R_children) + F_loop + m g = m a_c.

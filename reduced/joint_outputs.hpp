@@ -34,12 +34,24 @@ void add_joint_position_columns(const models::Scene& scene, const std::vector<do
                                 Samples& samples);
 
 // Internal constraint-force requests the reduced model needs for the reactions: one line per
-// reaction component, R_<joint>_cx and R_<joint>_cy (the joint's force on its child along the
-// child frame's x and y axes), for each revolute joint whose reaction is output and for the
-// joints Newton–Euler of a loop's body uses (below).
+// reaction component, R_<joint>_gx and R_<joint>_gy (the joint's force on its child along the
+// ground's x and y axes), for each revolute joint whose reaction is output and for the joints
+// Newton–Euler of a loop's body uses (below). The kinetostatic calls give them along the child
+// frame's axes; extract_samples turns each pair into ground at every grid point
+// (turn_reaction_lines_to_ground), so the table interpolates the ground-frame reaction that is
+// output. In the child frame a body geared 30:1 to q turns its weight 30 times per turn of q:
+// 36 grid points alias that harmonic (issue #23, a quick-return's motor joint was off by 2 m g).
 inline std::string internal_request_name(const std::string& joint, char axis) {
-  return std::string("R_") + joint + "_c" + axis;
+  return std::string("R_") + joint + "_g" + axis;
 }
+// Turns each pair of reaction lines (internal requests R_<j>_gx, _gy, sampled along the child
+// frame's x and y) into the ground frame at every grid point: every column of the line —
+// me1_, me2_, Qx_cons_, rx_, wx_, Qxpf_ — by the child's angle there (Σ offset + p_ + k_·q of
+// the revolute joints from ground to the child; the p_/k_ columns must be present). The lines
+// are linear in q̈, q̇² and the loads, so the turned lines are exact at the grid points. A
+// pair's poles become the union of both. Called by extract_samples.
+void turn_reaction_lines_to_ground(const models::Scene& scene, Samples& samples);
+
 // The revolute joints whose reaction lines the scene's requested reactions read: each revolute
 // joint in outputs.reactions, and the joints Newton–Euler of a loop's body or a prismatic
 // joint's child uses. Throws TableError for reactions the reduced model cannot give (below).

@@ -294,7 +294,8 @@ void check_energy_balance(const models::TimeSeries& ts, double tolerance, const 
   throw models::NumericalError(fmt::format(
       "reduced model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
       "energy scale {:.3g} J (largest |E|, |W| or range of E; limit {:g} %): the integration lost or invented energy "
-      "({}; try a shorter fixed step or an adaptive integrator)",
+      "({}; a fixed step too long, or a table too coarse for the motion — its interpolated m2 is then not "
+      "½ dm1/dq of its m1: try a shorter fixed step, an adaptive integrator, or a finer --grid-deg)",
       eb.max_residual_J, eb.worst_time_s, 100 * eb.max_residual_J / std::max(scale_J, 1e-300), scale_J,
       100 * tolerance, how));
 }

@@ -126,6 +126,10 @@ TEST(SimulateReduced, AnEnergyBalanceOffByMoreThanOnePercentFailsTheRun) {
     EXPECT_NE(std::string(e.what()).find("4.76 % of the energy scale 10.5 J"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("at t = 1 s"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("rk4-fixed at 0.2 s steps"), std::string::npos) << e.what();
+    // An adaptive run at 1e-8 failed this way on a table too coarse for the motion (a five-bar
+    // geared 2:1 at 10°, issue #23): the message names the grid, not only the step.
+    EXPECT_NE(std::string(e.what()).find("a table too coarse for the motion"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a finer --grid-deg"), std::string::npos) << e.what();
   }
   EXPECT_NO_THROW(check_energy_balance(ts_of({10.0, 10.05}, {0.0, 0.0}), 0.01, ""));
   EXPECT_NO_THROW(check_energy_balance(ts_of({10.0, 8.0}, {0.0, -2.0}), 0.01, ""));  // braked: W balances

@@ -170,7 +170,7 @@ namespace {
 // without a range.
 void check_calibration_input(const models::Scene& scene, const CalibrationOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
   };
   if (!(opt.cadence_hz > 0)) fail("--cadence-hz", "must be positive");
   if (!(opt.power_w >= 0)) fail("--power-w", "must be positive");
@@ -209,7 +209,7 @@ void check_calibration_input(const models::Scene& scene, const CalibrationOption
 }
 
 void fail_dead_points(const models::Scene& scene) {
-  throw models::SceneError(scene.source_file, 0, "independent",
+  throw models::SceneError(scene.source_file, scene.line_of("independent"), scene.field_of("independent"),
                            fmt::format("calibration holds a mean rate in rev/s, so '{}' must turn fully; it cannot "
                                        "(it meets dead points: see rdyn inspect)",
                                        scene.independent));

@@ -68,13 +68,16 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
       opt.power_w > 0 ? fmt::format("{:.17g}", opt.power_w * r.resistance_coefficient /
                                                    calc_resistance_coefficient(scene, opt))
                       : std::string();
+  bool nominal = false;  // the power went in as a nominal power_W (else as the coefficient itself)
   if (opt.power_w > 0) {
     if (models::scene_yaml_has(text, "bicycle_leg")) {
+      nominal = true;
       o.push_back({"bicycle_leg.resistance.power_W", nominal_w});
       o.push_back({"bicycle_leg.resistance.cadence_Hz", num(opt.cadence_hz)});
     } else {
       const auto& res = scene.resistances[0];
       if (models::scene_yaml_has(text, "loads." + res.name + ".dissipates")) {
+        nominal = true;
         o.push_back({"loads." + res.name + ".dissipates.power_W", nominal_w});
         o.push_back({"loads." + res.name + ".dissipates.cadence_Hz", num(opt.cadence_hz)});
       } else {
@@ -90,11 +93,16 @@ std::string calibrated_scene_yaml(const std::string& source, const std::string& 
   // with a newline must not add keys to the scene).
   std::string from;
   for (char c : source) from += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
-  const std::string point =
-      opt.power_w > 0 ? fmt::format("with the resistance dissipating {:.6g} W on the steady cycle at {:.6g} Hz (its\n"
-                                    "# power_W is nominal: the power of its coefficient at a constant {:.6g} Hz)",
-                                    opt.power_w, opt.cadence_hz, opt.cadence_hz)
-                      : std::string("with the resistances as given");
+  // The nominal-power remark only where the scene holds a power_W: a scene that gives the
+  // coefficient gets the coefficient, and a remark about a power_W it has not would mislead.
+  std::string point = "with the resistances as given";
+  if (opt.power_w > 0)
+    point = nominal ? fmt::format("with the resistance dissipating {:.6g} W on the steady cycle at {:.6g} Hz (its\n"
+                                  "# power_W is nominal: the power of its coefficient at a constant {:.6g} Hz)",
+                                  opt.power_w, opt.cadence_hz, opt.cadence_hz)
+                    : fmt::format("with the resistance dissipating {:.6g} W on the steady cycle at {:.6g} Hz (its\n"
+                                  "# coefficient set to {:.6g})",
+                                  opt.power_w, opt.cadence_hz, r.resistance_coefficient);
   // An unconfirmed result (written with --force) says so in its first comment, on one line each.
   std::string warning;
   if (!r.unconfirmed.empty()) {

@@ -298,7 +298,7 @@ models::Scene scene_with_added_torques(const models::Scene& scene, const Optimiz
 
 void check_optimize_options(const models::Scene& scene, const OptimizeOptions& opt) {
   auto fail = [&](const std::string& field, const std::string& msg) {
-    throw models::SceneError(scene.source_file, 0, field, msg);
+    throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
   };
   if (opt.harmonics != 0 && (opt.harmonics < 1 || opt.harmonics > models::kMaxOptimizeHarmonics))
     fail("--harmonics", fmt::format("must be a whole number in [1, {}] (got {})", models::kMaxOptimizeHarmonics,

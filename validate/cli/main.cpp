@@ -285,6 +285,7 @@ void add_optimize_command(CLI::App& app, OptimizeArgs& opz) {
   optimize->add_option("--max-evaluations", opz.max_evaluations, "Optimiser evaluations, 1..100000 (default 400)");
   optimize->add_option("--rel-tolerance", opz.rel_tolerance, "Optimiser relative tolerance (default 1e-4)");
   add_reduced_table_options(*optimize, opz.grid_deg, opz.interpolation);
+  optimize->get_option("--grid-deg")->each([&opz](const std::string&) { opz.grid_given = true; });
   optimize->add_option("--full-duration", opz.full_duration_s, "Each full-model confirmation run [s], 4..600 (default 20)");
   add_scene_overrides(*optimize, opz.sets);
   add_output_folder(*optimize, opz.out, opz.force);

@@ -22,10 +22,7 @@
 
 namespace rdyn::validate {
 
-int run_optimize(const OptimizeArgs& a) {
-  std::vector<models::Override> overrides;
-  for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
-  const models::Scene scene = models::load_scene(a.scene, overrides);
+OptimizeOptions optimize_options_of(const models::Scene& scene, const OptimizeArgs& a) {
   auto bad = [&](const std::string& option, const std::string& msg) {
     throw models::SceneError(scene.source_file, 0, option, msg);
   };
@@ -59,18 +56,29 @@ int run_optimize(const OptimizeArgs& a) {
   opt.add_torque_max = a.add_torque_max;
   opt.max_evaluations = a.max_evaluations;
   opt.rel_tolerance = a.rel_tolerance;
-  opt.grid_deg = a.grid_deg;
+  // The operating point's table: --grid-deg, else the scene's validation.calibrate.grid_deg (as
+  // calibrate; a scene whose 10° table is too coarse there declares a finer one), else 10°.
+  opt.grid_deg = a.grid_given || !(copt.grid_deg > 0) ? a.grid_deg : copt.grid_deg;
   opt.interpolation = a.interpolation;
   opt.full_duration_s = a.full_duration_s;
   opt.full_skip_s = std::min(2.0, 0.5 * a.full_duration_s);
   check_optimize_options(scene_with_added_torques(scene, opt), opt);
+  return opt;
+}
+
+int run_optimize(const OptimizeArgs& a) {
+  std::vector<models::Override> overrides;
+  for (const auto& s : a.sets) overrides.push_back(models::parse_override(s));
+  const models::Scene scene = models::load_scene(a.scene, overrides);
+  const OptimizeOptions opt = optimize_options_of(scene, a);
   OutputDir dir(a.out, a.force);  // fails early on an unusable destination
   Progress progress;
   const auto r = optimize(scene, opt, progress);
   const std::string failure = optimize_failure_message(r);
   if (!failure.empty()) throw models::NumericalError(failure);
   auto summary = optimize_summary(r);
-  summary["nonnegative_repair"] = r.nonnegative_repair;  // the lift of a nonnegative shape after the search
+  summary["nonnegative_repair"] = r.nonnegative_repair;
+  summary["grid_deg"] = opt.grid_deg;  // the table's grid (--grid-deg or the scene's validation.calibrate)  // the lift of a nonnegative shape after the search
   // The mechanism drawn, and both strategies over one steady cycle of the full model from their
   // steady points (analysis/cycle_run.hpp), which the report shows side by side.
   summary["mechanism_svg"] =

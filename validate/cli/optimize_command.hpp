@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "models/scene.hpp"
+#include "validate/analysis/optimize.hpp"
+
 namespace rdyn::validate {
 
 struct OptimizeArgs {
@@ -24,11 +27,16 @@ struct OptimizeArgs {
   int max_evaluations = 400;
   double rel_tolerance = 1e-4;
   double grid_deg = 10.0;
+  bool grid_given = false;  // else the scene's validation.calibrate.grid_deg (default 10)
   std::string interpolation = "fourier";
   double full_duration_s = 20.0;
   std::string out;
   bool force = false;
 };
+
+// The options of a run from the arguments and the scene (its optimize and validation.calibrate
+// blocks), every number checked first: throws models::SceneError naming the option or field.
+OptimizeOptions optimize_options_of(const models::Scene& scene, const OptimizeArgs& args);
 
 int run_optimize(const OptimizeArgs& args);
 

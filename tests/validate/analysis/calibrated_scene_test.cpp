@@ -57,6 +57,36 @@ TEST(CalibratedScene, WrittenSceneScalesPointForcesNamedTogether) {
   EXPECT_EQ(again.initial.qdot, 6.0);
 }
 
+// With a power, the header says how the resistance was written: a scene that gives its
+// coefficient gets the calibrated coefficient (and no remark about a nominal power_W it does not
+// have: the Jansen leg's header said "its power_W is nominal"); a `dissipates` block gets a
+// nominal power_W, and the remark says so.
+TEST(CalibratedScene, HeaderNamesTheNominalPowerOnlyWhereTheSceneHoldsOne) {
+  // The Jansen leg of issue #23: a drive torque and a viscous load given by its coefficient.
+  std::ifstream in(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  CalibrationOptions opt;
+  opt.cadence_hz = 1.0, opt.power_w = 2.0;
+  CalibrationResult r;
+  r.load_value = r.torque_Nm = 0.5, r.resistance_coefficient = 0.0481, r.steady_qdot = 6.0;
+  r.mean_cadence_hz_reduced = r.mean_cadence_hz_full = 1.0;
+  const auto scene = models::parse_scene(text.str(), "jansen-leg.yaml");
+  const std::string coef = calibrated_scene_yaml("jansen-leg.yaml", text.str(), {}, scene, opt, r);
+  EXPECT_EQ(coef.find("nominal"), std::string::npos) << coef.substr(0, 400);
+  EXPECT_NE(coef.find("coefficient set to 0.0481"), std::string::npos) << coef.substr(0, 400);
+  EXPECT_EQ(models::parse_scene(coef, "w.yaml").resistances.at(0).coefficient, 0.0481);
+  // The same bearing given by what it dissipates: the header explains the nominal power_W.
+  std::string dis = text.str();
+  const std::string from = "law: viscous, coefficient: 0.5}";
+  ASSERT_NE(dis.find(from), std::string::npos);
+  dis.replace(dis.find(from), from.size(), "law: viscous, dissipates: {power_W: 1.0, cadence_Hz: 1.0}}");
+  const auto dscene = models::parse_scene(dis, "jansen-leg.yaml");
+  const std::string nom = calibrated_scene_yaml("jansen-leg.yaml", dis, {}, dscene, opt, r);
+  EXPECT_NE(nom.find("power_W is nominal"), std::string::npos) << nom.substr(0, 400);
+  EXPECT_NEAR(models::parse_scene(nom, "w.yaml").resistances.at(0).coefficient, 0.0481, 1e-12);
+}
+
 TEST(CalibratedScene, AGeneratedLoadNamedAloneCannotBeWrittenTheWholeDriveCan) {
   // The bicycle's hip torques are made by its generator (bicycle_leg): no YAML key holds one of
   // them, only the generator's hip_torque_Nm (every joint torque together).

@@ -853,10 +853,10 @@ void issue23(std::vector<Case>& cs) {
                     {{"s.yaml", fb2}}, nullptr, "o"});
     const std::string reserved = edit(fb, "    - {name: rocker_axial, joint: rocker, direction: C}\n",
                                       "    - {name: rocker_axial, joint: rocker, direction: C}\n"
-                                      "    - {name: R_crank_cx, joint: crank, direction: [1, 0]}\n");
-    const int reserved_line = line_of(reserved, "R_crank_cx");
+                                      "    - {name: R_crank_gx, joint: crank, direction: [1, 0]}\n");
+    const int reserved_line = line_of(reserved, "R_crank_gx");
     cs.push_back({"reserved_reaction_line_name", {"simulate", "s.yaml", "--model", "reduced", "--out", "o"}, 2,
-                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_cx' is reserved",
+                  fmt::format("s.yaml:{}: field 'outputs.constraint_forces[1].name': 'R_crank_gx' is reserved",
                               reserved_line),
                   {{"s.yaml", reserved}}, nullptr, "o"});
     // A force named like the speed took the speed's verdict in validate.
@@ -866,6 +866,16 @@ void issue23(std::vector<Case>& cs) {
                   fmt::format("s.yaml:{}: field 'outputs.constraint_forces[0].name': 'qdot' is reserved",
                               line_of(as_speed, "name: qdot")),
                   {{"s.yaml", as_speed}}, nullptr, "o"});
+    // Calibrate and optimize need a coordinate that turns: a stroke is refused naming the line of
+    // `independent` (the message named the field alone; issue #23's excavator bucket).
+    const std::string sl = scene_text("slider-crank-slider");
+    const int indep_line = line_of(sl, "independent: slider");
+    cs.push_back({"calibrate_a_stroke", {"calibrate", "s.yaml", "--cadence-hz", "0.5"}, 2,
+                  fmt::format("s.yaml:{}: field 'independent': calibration holds a mean rate in rev/s", indep_line),
+                  {{"s.yaml", sl}}});
+    cs.push_back({"optimize_a_stroke", {"optimize", "s.yaml", "--cadence-hz", "0.5", "--out", "o"}, 2,
+                  fmt::format("s.yaml:{}: field 'independent': optimize shapes loads over a revolute", indep_line),
+                  {{"s.yaml", sl}}, nullptr, "o"});
   }
   // A table file edited by hand: a negative m1, a missing column. Each names the table's line.
   // An extracted table, edited. Its content checksum is dropped (keep_checksum false) so that the
