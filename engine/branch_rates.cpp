@@ -78,12 +78,12 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   std::vector<int> q_of(J.free_cols.size());
   for (size_t c = 0; c < J.free_cols.size(); ++c)
     if ((q_of[c] = q_of_u[J.free_cols[c]]) < 0) return false;
-  FactorSVD svd(J.G_free);
+  const LeastSquares chord(J.G_free);  // one decomposition for every iteration
   Vector dx, rhs;
   for (int it = 0; it < kMaxIterations; ++it) {
     rhs = s.getQErr();
     rhs *= -1.0;
-    svd.solve(rhs, dx);
+    chord.solve(rhs, dx);
     Vector& q = s.updQ();
     for (size_t c = 0; c < q_of.size(); ++c) q[q_of[c]] += dx[static_cast<int>(c)];
     m.system.realize(s, Stage::Position);
@@ -162,7 +162,10 @@ void polish_projection(const FullModel::Impl& m, State& s) {
 void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
   m.system.realize(s, Stage::Position);
   out.J = calc_split_jacobian(m, s);
-  if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) out.svd.emplace(out.J.G_free);
+  if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) {
+    out.svd.emplace(out.J.G_free);
+    out.ls.emplace(out.J.G_free);
+  }
   const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
   out.r = Vector(nu, 0.0);
   out.r[ind] = 1.0;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/full_model_impl.hpp"
+#include "engine/least_squares.hpp"
 
 namespace rdyn::engine {
 
@@ -50,13 +51,14 @@ void polish_projection(const FullModel::Impl& m, SimTK::State& s);
 // solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
 struct BranchRates {
   SplitJacobian J;
-  std::optional<SimTK::FactorSVD> svd;  // of J.G_free, when there are rows and free columns
+  std::optional<SimTK::FactorSVD> svd;  // of J.G_free, when there are rows and free columns: its conditioning
+  std::optional<LeastSquares> ls;       // the same, for the solves (one decomposition for all)
   SimTK::Vector r, b;                   // [mobilities]
   // v: prescribed entries set; the free ones solved from G_free v_free = rhs.
   void complete(SimTK::Vector& v, const SimTK::Vector& rhs) {
-    if (!svd) return;
+    if (!ls) return;
     SimTK::Vector x;
-    svd->solve(rhs, x);
+    ls->solve(rhs, x);
     for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
   }
   // −(column col of G): the right-hand side for a unit rate of prescribed mobility col.

@@ -11,7 +11,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "models/scene_hash.hpp"
+#include "models/yaml_fields.hpp"
 #include "scene_yaml_checks.hpp"
 
 namespace rdyn::models {
@@ -631,6 +634,32 @@ TEST(SceneYaml, NormaliseTextEncodingDropsTheMarkAndEndsCrOnlyLines) {
   EXPECT_EQ(normalise_text_encoding("t,q\r0,1\r"), "t,q\n0,1\n");
   EXPECT_EQ(normalise_text_encoding("t,q\r\n0,1\r\n"), "t,q\r\n0,1\r\n");
   EXPECT_EQ(normalise_text_encoding(""), "");
+}
+
+// read_scene_text reads in chunks of 16 kB: a scene longer than several chunks comes back byte
+// for byte and loads as the short one; a file larger than a scene may be is cut one byte past
+// the limit, so parse_scene refuses it by its size (and /dev/zero cannot exhaust memory).
+TEST(SceneYaml, ReadSceneTextKeepsLongScenesWholeAndCutsOversizedOnesPastTheLimit) {
+  const std::string base = read_scene_text("fourbar");
+  const std::string padded = base + "\n# " + std::string(70000, 'x') + "\n";  // 4+ chunks
+  const auto dir = std::filesystem::temp_directory_path() / fmt::format("rdyn_read_{}", ::getpid());
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "long.yaml").string();
+  std::ofstream(path, std::ios::binary) << padded;
+  EXPECT_EQ(read_scene_text(path), padded);
+  EXPECT_EQ(scene_hash(load_scene(path)), scene_hash(load_scene("fourbar")));
+  const std::string huge_path = (dir / "huge.yaml").string();
+  std::ofstream(huge_path, std::ios::binary) << base << "# " << std::string(yaml::kMaxSceneBytes, 'y') << "\n";
+  const std::string cut = read_scene_text(huge_path);
+  EXPECT_EQ(cut.size(), yaml::kMaxSceneBytes + 1);
+  EXPECT_EQ(cut.compare(0, base.size(), base), 0);
+  try {
+    load_scene(huge_path);
+    ADD_FAILURE() << "an oversized scene loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("too large for a scene"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "reduced/reduced_model.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/analysis/calibrate_on_table.hpp"
 #include "validate/analysis/drive.hpp"
 #include "validate/analysis/sweep_peaks.hpp"
 #include "validate/io/escape.hpp"
@@ -140,9 +141,14 @@ std::string calibrated_fields(const SweepPlan& plan, const models::Scene& case_s
   // calibrate()'s reduced part on the model of the table's scene, checked on the case's own (its
   // reaction lines' reserved names are the reduced model's, not the user's).
   Progress quiet(false);
-  const CalibrationTable& table = cache.calibration->second;
-  const auto model = reduced::make_reduced_model(table.samples, with_unit_load(scene, plan.calibration), table.table);
-  const auto r = calibrate_reduced(model, case_scene, plan.calibration, quiet);
+  CalibrationTable& table = cache.calibration->second;
+  CalibrationResult r;
+  try {
+    r = calibrate_on_table(table, scene, case_scene, plan.calibration, quiet);  // lent, not copied
+  } catch (...) {
+    if (table.table.coef.empty()) cache.calibration.reset();  // the model was not built: the table is gone
+    throw;
+  }
   // No constraint force requested: an empty field, never NaN.
   const std::string peak = plan.force.empty() ? std::string() : fmt::format("{:.10g}", r.peak_force_N);
   const auto peaks = plan.opt.peaks.empty() ? std::vector<double>()
