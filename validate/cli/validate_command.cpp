@@ -243,8 +243,7 @@ int run_report(const ReportArgs& a) {
   if (!summary.is_object() || !summary.contains("scene") || !summary.contains("runs"))
     throw ArgumentError(a.summary + ": not a summary of `rdyn validate` (no 'scene' and 'runs')");
   if (const std::string bad = report_format::find_non_number(summary); !bad.empty())
-    throw ArgumentError(fmt::format("{}: field {} is not a number (rdyn validate writes a number or null there)",
-                                    a.summary, bad));
+    throw ArgumentError(fmt::format("{}: field {} (not what rdyn validate writes there)", a.summary, bad));
   OutputDir out(a.out, a.force);
   try {
     render_report(summary, out.file(""));

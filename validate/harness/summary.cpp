@@ -238,7 +238,8 @@ void add_first_screen_json(const ValidationResult& v, nlohmann::json& j) {
       v.recommended_full >= 0 ? run_json(v.runs[v.recommended_full]) : nlohmann::json(nullptr);
   // false: no ladder run was as accurate; recommended_full is the most accurate one and
   // recommended_speedup a floor ("at least").
-  j["recommended_full_as_accurate"] = v.recommended_full_as_accurate;
+  j["recommended_full_as_accurate"] =
+      v.recommended_full >= 0 ? nlohmann::json(v.recommended_full_as_accurate) : nlohmann::json(nullptr);
   j["recommended_speedup"] = v.recommended_speedup ? num(*v.recommended_speedup) : nullptr;
   nlohmann::json verdicts = nlohmann::json::array();
   for (const auto& d : v.verdicts)

@@ -76,45 +76,97 @@ std::string table_csv(const json& t) {
 
 namespace {
 
-// Keys whose values `rdyn validate` writes as numbers, arrays of numbers or null, wherever they
-// stand in summary.json (validate/harness/summary.cpp); scene-named keys (force names) excluded.
-bool numeric_key(const std::string& k) {
-  static const char* const kKeys[] = {
+// What `rdyn validate` writes under a key of summary.json (validate/harness/summary.cpp),
+// wherever it stands; scene-named keys (force names) are not listed, the containers that hold
+// them are (every leaf below them is a number).
+// CountOrData: a count where it is one number (extractions' "points"), figure data where it is an
+// array (convergence points, a figure's rows).
+// NumericMap: an object every leaf of which is a non-negative number (errors of named forces).
+enum class Kind { Any, Signed, NonNegative, Count, CountOrData, NumericMap };
+
+Kind kind_of(const std::string& k, Kind inherited) {
+  static const char* const kSigned[] = {"fx_N", "fy_N", "order", "energy_drift_per_cycle_J",
+                                        "energy_balance_residual_rel"};
+  static const char* const kCounts[] = {"steps", "rejected_steps", "timed_steps", "samples", "rows", "repeats",
+                                        "kinetostatic_calls", "events", "excluded_between_switches"};
+  static const char* const kNonNegative[] = {
       "speedup", "recommended_speedup", "speedup_at_matched_error", "extraction_ms", "matched_error_target",
       "duration_s", "wall_s", "wall_s_per_simulated_s", "compared_run_wall_s", "grid_deg", "tolerance",
       "error", "target", "max_error", "max_rel", "rms_rel", "peak", "floor", "total", "integration",
-      "output_interpolation", "steps", "rejected_steps", "smallest_step_s", "fixed_step_s", "fixed_steps_s",
-      "timed_steps", "samples", "cycles", "revolutions", "rows", "repeats", "ms", "kinetostatic_calls",
-      "energy_balance_residual_rel", "energy_drift_per_cycle_J", "constraint_violation_m", "period_s",
-      "t_start_s", "output_interval_s", "timed_output_interval_s", "fx_N", "fy_N", "order", "points"};
-  for (const char* key : kKeys)
-    if (k == key) return true;
-  return false;
+      "output_interpolation", "reference", "table", "smallest_step_s", "fixed_step_s", "fixed_steps_s", "cycles",
+      "revolutions", "ms", "constraint_violation_m", "period_s", "t_start_s", "output_interval_s",
+      "timed_output_interval_s"};
+  for (const char* key : kSigned)
+    if (k == key) return Kind::Signed;
+  if (k == "points" || k == "rows") return Kind::CountOrData;
+  if (k == "extraction_stages_ms" || k == "output_interpolation_max_rel") return Kind::NumericMap;
+  for (const char* key : kCounts)
+    if (k == key) return Kind::Count;
+  for (const char* key : kNonNegative)
+    if (k == key) return Kind::NonNegative;
+  return inherited;
 }
 
-std::string find_non_number_in(const json& j, const std::string& path, bool numeric) {
+// Beyond this a summary's number is no measurement (the report's percentages would print inf;
+// a count would overflow the integer it is read into).
+constexpr double kMaxSummaryNumber = 1e100;
+constexpr double kMaxSummaryCount = 1e15;
+
+std::string bad_number_in(const json& j, const std::string& path, Kind kind) {
+  auto shown = [&](const char* why) {
+    std::string v = j.dump();
+    if (v.size() > 40) v = v.substr(0, 40) + "…";
+    return fmt::format("{}: {} {}", path, v, why);
+  };
   if (j.is_object()) {
     for (auto it = j.begin(); it != j.end(); ++it) {
-      std::string found = find_non_number_in(it.value(), path.empty() ? it.key() : path + "." + it.key(),
-                                             numeric_key(it.key()));
+      // Only a numeric map's kind passes to its children (errors of named forces).
+      const Kind parent = kind == Kind::NumericMap ? Kind::NonNegative : Kind::Any;
+      std::string found =
+          bad_number_in(it.value(), path.empty() ? it.key() : path + "." + it.key(), kind_of(it.key(), parent));
       if (!found.empty()) return found;
     }
   } else if (j.is_array()) {
     for (size_t i = 0; i < j.size(); ++i) {
-      std::string found = find_non_number_in(j[i], fmt::format("{}[{}]", path, i), numeric);
+      std::string found =
+          bad_number_in(j[i], fmt::format("{}[{}]", path, i), kind == Kind::CountOrData ? Kind::Signed : kind);
       if (!found.empty()) return found;
     }
-  } else if (numeric && (j.is_string() || j.is_boolean())) {
-    std::string v = j.dump();
-    if (v.size() > 40) v = v.substr(0, 40) + "…";
-    return path + ": " + v;
+  } else if (j.is_number()) {
+    const double x = j.get<double>();
+    if (!(std::abs(x) <= kMaxSummaryNumber)) return shown("is beyond ±1e100");
+    const bool count = kind == Kind::Count || kind == Kind::CountOrData;
+    if ((kind == Kind::NonNegative || kind == Kind::NumericMap || count) && x < 0) return shown("is negative");
+    if (count && (x != std::floor(x) || x > kMaxSummaryCount)) return shown("is not a count");
+  } else if (kind != Kind::Any && (j.is_string() || j.is_boolean())) {
+    return shown("is not a number");
+  }
+  return "";
+}
+
+// A threshold's verdict must be what its numbers say: the report prints both.
+std::string contradicted_threshold(const json& s) {
+  const json& th = s.value("thresholds", json::array());
+  if (!th.is_array()) return "";
+  for (size_t i = 0; i < th.size(); ++i) {
+    const json& t = th[i];
+    if (!t.is_object() || !t.contains("pass") || !t["pass"].is_boolean()) continue;
+    const double e = d(t, "error"), limit = d(t, "max_error");
+    if (std::isnan(limit)) continue;
+    if (t["pass"].get<bool>() != (e <= limit))
+      return fmt::format("thresholds[{}].pass: {} contradicts its error {} and max_error {}", i,
+                         t["pass"].get<bool>(), std::isnan(e) ? std::string("null") : fmt::format("{:g}", e),
+                         fmt::format("{:g}", limit));
   }
   return "";
 }
 
 }  // namespace
 
-std::string find_non_number(const json& s) { return find_non_number_in(s, "", false); }
+std::string find_non_number(const json& s) {
+  std::string found = bad_number_in(s, "", Kind::Any);
+  return found.empty() ? contradicted_threshold(s) : found;
+}
 
 bool is_joint_output(const json& s, const json& q) {
   for (const auto& j : s.value("joint_output_quantities", json::array()))

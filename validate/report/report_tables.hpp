@@ -35,10 +35,11 @@ std::string compared_over(const json& s);
 std::string table_csv(const json& t);
 // Whether q is one of the summary's joint outputs (reactions, shaking, joint motion).
 bool is_joint_output(const json& s, const json& q);
-// The first value of a hand-edited summary that `rdyn validate` writes as a number (or null)
-// but is text or true/false, as "path: value" ("recommended_speedup: \"fast\"",
-// "runs[3].wall_s: …"); empty when there is none. The report reads such a value as "not
-// measured" and would render a report without it, exit 0.
+// The first value of a hand-edited summary that `rdyn validate` could not have written, as
+// "path: value why" ("recommended_speedup: \"fast\" is not a number", "runs[3].steps: 1e+300 is
+// not a count", "duration_s: -3 is negative", a number beyond ±1e100, a threshold whose pass
+// contradicts its error and limit); empty when there is none. The report would render such a
+// value as "not measured", "inf", "-5× faster" or a wrong verdict, exit 0.
 std::string find_non_number(const json& s);
 }  // namespace report_format
 

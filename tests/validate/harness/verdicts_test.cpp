@@ -62,9 +62,15 @@ TEST(Verdicts, MostAccurateFullRunIsTheSmallestWorstRatio) {
   runs.resize(1);
   runs[0].failure = "stopped";
   EXPECT_EQ(pick_most_accurate_full(rec, runs, {"qdot"}), -1);
-  const auto b = calc_baselines(rec, record("full", 4.0, {}), {record("full", 0.9, {})}, 0, false);
+  const std::vector<RunRecord> two{record("full", 0.9, {}), record("full", 0.5, {})};
+  auto b = calc_baselines(rec, record("full", 4.0, {}), two, 0, false);
   ASSERT_EQ(b.size(), 3u);
   EXPECT_EQ(b[1].what, "most accurate full run (less accurate)");
+  EXPECT_EQ(b[2].what, "cheapest full run");
+  // The compared run is the cheapest too: one row that says both (it was listed twice).
+  b = calc_baselines(rec, record("full", 4.0, {}), two, 1, false);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[1].what, "most accurate full run (less accurate), also the cheapest full run");
 }
 
 TEST(Verdicts, BaselinesAreCostRatios) {

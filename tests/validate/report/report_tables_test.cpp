@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "tests/validate/harness/validation_fixture.hpp"
 #include "validate/harness/summary.hpp"
@@ -69,13 +71,34 @@ TEST(ReportTables, ANumberEditedIntoTextIsFoundByItsPath) {
   EXPECT_EQ(find_non_number(s), "");
   json edited = s;
   edited["recommended_speedup"] = "fast";
-  EXPECT_EQ(find_non_number(edited), "recommended_speedup: \"fast\"");
+  EXPECT_EQ(find_non_number(edited), "recommended_speedup: \"fast\" is not a number");
   edited = s;
   ASSERT_TRUE(edited["runs"].size() > 1);
   edited["runs"][1]["wall_s"] = true;
-  EXPECT_EQ(find_non_number(edited), "runs[1].wall_s: true");
+  EXPECT_EQ(find_non_number(edited), "runs[1].wall_s: true is not a number");
   EXPECT_EQ(find_non_number(json{{"scene", "x"}, {"labels", {{"error_label", "text"}}}}), "");
-  EXPECT_EQ(find_non_number(json{{"extractions", {{{"points", {1, "2"}}}}}}), "extractions[0].points[1]: \"2\"");
+  EXPECT_EQ(find_non_number(json{{"extractions", {{{"points", {1, "2"}}}}}}),
+            "extractions[0].points[1]: \"2\" is not a number");
+  // Numbers validate cannot have written: a count beyond what it is read into (runs.csv printed
+  // -9223372036854775808), a negative duration or speedup, 1e308 (the report printed inf), a
+  // named force's interpolation error as text, and a verdict its own numbers contradict.
+  for (const auto& [path, value, why] : std::vector<std::tuple<json::json_pointer, json, std::string>>{
+           {json::json_pointer("/runs/1/steps"), 1e18, "runs[1].steps: 1e+18 is not a count"},
+           {json::json_pointer("/runs/1/steps"), 2.5, "runs[1].steps: 2.5 is not a count"},
+           {json::json_pointer("/duration_s"), -3, "duration_s: -3 is negative"},
+           {json::json_pointer("/recommended_speedup"), -5, "recommended_speedup: -5 is negative"},
+           {json::json_pointer("/matched_error_target"), 1e308, "matched_error_target: 1e+308 is beyond ±1e100"},
+           {json::json_pointer("/runs/0/output_interpolation_max_rel/F"), "x",
+            "runs[0].output_interpolation_max_rel.F: \"x\" is not a number"}}) {
+    edited = s;
+    edited[path] = value;
+    EXPECT_EQ(find_non_number(edited), why);
+  }
+  edited = s;
+  edited["thresholds"] = json::array({{{"quantity", "F"}, {"error", 1.0}, {"max_error", 0.005}, {"pass", true}}});
+  EXPECT_EQ(find_non_number(edited), "thresholds[0].pass: true contradicts its error 1 and max_error 0.005");
+  edited["thresholds"][0]["pass"] = false;
+  EXPECT_EQ(find_non_number(edited), "");
 }
 
 }  // namespace
