@@ -213,6 +213,17 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
     }
     const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
                                                    a.energy_consistent);
+    // A table of the same mechanism extracted without joint outputs (its hash does not cover
+    // outputs.joints or shaking, which add no constraint line): named with its file before the run (after
+    // make_reduced_model, whose scene check comes first).
+    if (reduced::wants_joint_outputs(oscene) && !samples.file.empty())
+      for (const auto& j : oscene.joints)
+        if (samples.column("p_" + j.name) < 0)
+          throw reduced::TableError(fmt::format(
+              "table {} has no column 'p_{}', which the scene's joint outputs (outputs.joints, reactions or shaking) "
+              "need: it was extracted from the scene without them; extract it again with `rdyn extract` for this "
+              "scene and its outputs",
+              samples.file, j.name));
     warn_coarse_table(samples, run);
     reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
     ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);

@@ -119,11 +119,17 @@ PrescribedMotion calc_motion_at(const DriveArgs& a, const models::Scene& scene, 
     const std::string run = a.duration ? fmt::format("the {:g} s run", duration)
                                        : fmt::format("one revolution at {:g} rev/s ({:g} s)", *a.cadence_hz, duration);
     if (dt > duration * (1 + 1e-12)) refuse(scene, "--dt-out", fmt::format("{:g} s is longer than {}", dt, run));
+    // Rows refined to ≤ 1° of motion (step < dt) grow with the motion, not with --dt-out: raising
+    // it does not help there (the advice once said "shorten --dt-out", which adds rows).
+    const bool refined = step < dt * (1 - 1e-12);
     if (duration / step > cli_limits::kMaxOutputRows)
       refuse(scene, whose,
-             fmt::format("{} at --dt-out {:g} s makes {:.3g} rows, more than {:g}: {} or --dt-out", run, dt,
-                         duration / step, cli_limits::kMaxOutputRows,
-                         a.duration ? "shorten --duration" : "raise the cadence"));
+             refined ? fmt::format("{} needs {:.3g} rows at most 1° of motion apart, more than {:g}: {}", run,
+                                   duration / step, cli_limits::kMaxOutputRows,
+                                   a.duration ? "shorten --duration" : "lower the cadence")
+                     : fmt::format("{} at --dt-out {:g} s makes {:.3g} rows, more than {:g}: {} or raise --dt-out",
+                                   run, dt, duration / step, cli_limits::kMaxOutputRows,
+                                   a.duration ? "shorten --duration" : "raise the cadence"));
     m = constant_rate_motion(scene.initial.q, 2 * M_PI * *a.cadence_hz, duration, step);
     m.how = fmt::format("constant rate {:g} rev/s from q = {:g}°", *a.cadence_hz, scene.initial.q * 180 / M_PI);
   } else {

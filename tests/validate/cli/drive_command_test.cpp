@@ -88,6 +88,10 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
                        "(500001 over 1000 s"),
             std::string::npos)
       << r.err;
+  // Too many rows at the output interval: raising --dt-out helps (the advice said "shorten").
+  r = run({"drive", "fourbar", "--cadence-hz", "1", "--duration", "1e5", "--out", "o2"});
+  EXPECT_NE(r.err.find("makes 5e+07 rows, more than 1e+07: shorten --duration or raise --dt-out"), std::string::npos)
+      << r.err;
   r = run({"drive", "fourbar", "--cadence-hz", "1e-3", "--duration", "900", "--out", "o2"});
   EXPECT_NE(r.err.find("field '--duration': the full model would make"), std::string::npos) << r.err;
   {
