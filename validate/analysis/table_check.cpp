@@ -58,7 +58,10 @@ void check_table_against_scene(const reduced::Samples& t, const models::Scene& s
   const Extraction fresh = extract_from_full(scene, extraction_grid_deg(t), reduced::parse_method(t.method));
   const reduced::Samples& f = fresh.samples;
   const double q_tol = 1e-9 * std::max(1.0, std::abs(t.q0) + t.step * static_cast<double>(t.q.size()));
-  if (f.periodic != t.periodic || f.q.size() != t.q.size() || !same_points(f.q, t.q, q_tol))
+  if (f.periodic != t.periodic)
+    refuse(t, 1, fmt::format("its header says periodic={} where the scene's table is {}", t.periodic ? 1 : 0,
+                             f.periodic ? "periodic (periodic=1: a full turn)" : "a range (periodic=0)"));
+  if (f.q.size() != t.q.size() || !same_points(f.q, t.q, q_tol))
     refuse(t, 1,
            fmt::format("its grid ({} points from {}) is not the one the scene gives ({} points from {})", t.q.size(),
                        q_text(t, t.q.empty() ? 0.0 : t.q.front()), f.q.size(), q_text(f, f.q.empty() ? 0.0 : f.q.front())));
@@ -78,6 +81,10 @@ void check_table_against_scene(const reduced::Samples& t, const models::Scene& s
   if (t.names.size() != f.names.size())
     refuse(t, t.header_line, fmt::format("it has {} columns, the scene gives {}", t.names.size(), f.names.size()));
   if (!same_points(f.singular_q, t.singular_q, q_tol)) {
+    if (t.singular_q.empty())  // line 2 is where it belongs
+      refuse(t, 2, fmt::format("it has no '# singular' line where the scene has {} singular configuration(s), the "
+                               "first at q = {}",
+                               f.singular_q.size(), q_text(f, f.singular_q.front())));
     if (f.singular_q.size() != t.singular_q.size())
       refuse(t, 2, fmt::format("its '# singular' line lists {} configuration(s) where the scene has {}", t.singular_q.size(),
                                f.singular_q.size()));
@@ -86,14 +93,17 @@ void check_table_against_scene(const reduced::Samples& t, const models::Scene& s
     refuse(t, 2, fmt::format("its '# singular' line lists q = {} where the scene's singular configuration is at q = {}",
                              q_text(t, t.singular_q[i]), q_text(f, f.singular_q[i])));
   }
+  // `rdyn extract` writes the '# singular' line on line 2, then one '# pole' line per force.
+  const long first_pole_line = t.singular_q.empty() ? 2 : 3;
   for (const auto& [force, qs] : f.poles) {
     const auto it = std::find_if(t.poles.begin(), t.poles.end(), [&](const auto& p) { return p.first == force; });
+    const long line = first_pole_line + (it == t.poles.end() ? 0 : static_cast<long>(it - t.poles.begin()));
     if (it == t.poles.end() || !same_points(it->second, qs, q_tol))
-      refuse(t, 2, fmt::format("its '# pole {}' line is missing or changed: the scene's force '{}' grows without bound "
+      refuse(t, line, fmt::format("its '# pole {}' line is missing or changed: the scene's force '{}' grows without bound "
                                "at q = {}",
                                force, force, q_text(t, qs.front())));
   }
-  if (t.poles.size() != f.poles.size()) refuse(t, 2, "it lists a '# pole' line the scene does not give");
+  if (t.poles.size() != f.poles.size()) refuse(t, first_pole_line, "it lists a '# pole' line the scene does not give");
 }
 
 }  // namespace rdyn::validate

@@ -62,7 +62,29 @@ TEST(TableCheck, ADeletedPoleLineIsRefused) {
   EXPECT_EQ(message_of(reduced::parse_samples_csv(text, "t.csv"), scene), "");
   text.erase(pole, text.find('\n', pole) + 1 - pole);
   const std::string m = message_of(reduced::parse_samples_csv(text, "t.csv"), scene);
+  EXPECT_NE(m.find("t.csv:3: "), std::string::npos) << m;  // where the line was (after '# singular')
   EXPECT_NE(m.find("'# pole rod_axial' line is missing"), std::string::npos) << m;
+  // Without its '# singular' line either: that is named first, at line 2 where it belongs (the
+  // message said it "lists 0 configuration(s)", of a line that was not there).
+  const size_t singular = text.find("# singular:");
+  ASSERT_NE(singular, std::string::npos);
+  text.erase(singular, text.find('\n', singular) + 1 - singular);
+  const std::string m2 = message_of(reduced::parse_samples_csv(text, "t.csv"), scene);
+  EXPECT_NE(m2.find("t.csv:2: "), std::string::npos) << m2;
+  EXPECT_NE(m2.find("it has no '# singular' line where the scene has 1 singular configuration(s)"), std::string::npos)
+      << m2;
+}
+
+// A header edited from periodic=1 to 0 is named as such (it was reported as a grid of 36 points
+// against the scene's 35).
+TEST(TableCheck, AnEditedPeriodicFlagIsNamed) {
+  const auto scene = models::load_scene("fourbar");
+  auto t = reduced::parse_samples_csv(unchecked_text(scene, 30), "t.csv");
+  ASSERT_TRUE(t.periodic);
+  t.periodic = false;
+  const std::string m = message_of(t, scene);
+  EXPECT_NE(m.find("t.csv:1: "), std::string::npos) << m;
+  EXPECT_NE(m.find("its header says periodic=0 where the scene's table is periodic"), std::string::npos) << m;
 }
 
 // A `# singular` line with as many configurations as the scene's, one moved by 1 mm: the message
