@@ -185,7 +185,7 @@ std::string reference_sentence(const json& s) {
   const auto& w = s.at("steady_window");
   // A range-limited coordinate oscillates or moves within its range: cycles are not its words.
   const bool in_range = w.value("how", std::string()).find("within a range") != std::string::npos;
-  out += !w.value("whole_run", false) ? "Errors are maxima " + compared_over(s) + " (after the start-up transient)."
+  out += !w.value("whole_run", false) ? "Errors are maxima " + compared_over(s) + "."
          : in_range                   ? "The coordinate moves within a range: errors are maxima over the whole run."
                                       : "The run has no steady cycles: errors are maxima over the whole run.";
   return out;

@@ -57,7 +57,13 @@ std::string quantity_words(const std::string& q) {
 std::string compared_over(const json& s) {
   const auto& w = s.at("steady_window");
   if (w.value("whole_run", false)) return "over the whole run";
-  return fmt::format("over the {} steady revolutions from t = {} s", w.value("revolutions", 0),
+  // Fewer than two revolutions is what a run that never settles has (validate then fails for
+  // it): those are not "steady" revolutions.
+  const int n = w.value("revolutions", 0);
+  if (n < 2)
+    return fmt::format("over the {} revolution(s) after the start-up transient, from t = {} s (not a steady cycle)", n,
+                       num(d(w, "t_start_s"), "{:.3g}"));
+  return fmt::format("over the {} steady revolutions from t = {} s (after the start-up transient)", n,
                      num(d(w, "t_start_s"), "{:.3g}"));
 }
 

@@ -101,5 +101,15 @@ TEST(ReportTables, ANumberEditedIntoTextIsFoundByItsPath) {
   EXPECT_EQ(find_non_number(edited), "");
 }
 
+// A window of fewer than two revolutions (a run that never settles, which fails validate) is not
+// called steady (the report said "the 1 steady revolutions" under a failure saying it never settles).
+TEST(ReportTables, AWindowOfOneRevolutionIsNotCalledSteady) {
+  json s{{"steady_window", {{"whole_run", false}, {"revolutions", 1}, {"t_start_s", 2.66}}}};
+  EXPECT_EQ(compared_over(s), "over the 1 revolution(s) after the start-up transient, from t = 2.66 s (not a steady "
+                              "cycle)");
+  s["steady_window"]["revolutions"] = 4;
+  EXPECT_EQ(compared_over(s), "over the 4 steady revolutions from t = 2.66 s (after the start-up transient)");
+}
+
 }  // namespace
 }  // namespace rdyn::validate
