@@ -307,6 +307,15 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
   }
   if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
   if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
+  // The same quantity in another angle unit (q / q_deg / q_rad): the override replaces it, as the
+  // user means (`--set initial.q_deg=179` on a scene giving initial.q was refused with "give q or
+  // q_deg, not both", blaming the file's line).
+  auto ends_with = [&](const std::string& suffix) {
+    return last.size() > suffix.size() && last.compare(last.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  const std::string base = ends_with("_deg") || ends_with("_rad") ? last.substr(0, last.size() - 4) : last;
+  for (const std::string& other : {base, base + "_deg", base + "_rad"})
+    if (other != last && cur[other] && cur[other].IsScalar()) cur.remove(other);
   cur[last] = o.value;
   if (touched) touched->push_back({cur[last], o.path});
 }

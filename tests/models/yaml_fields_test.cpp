@@ -79,6 +79,12 @@ TEST(YamlFields, OverridesReachScalarsByPathAndName) {
   EXPECT_NE(error_of(kFourbar, {parse_override("loads.nosuch.coefficient=1")}).find("no list item"),
             std::string::npos);
   EXPECT_THROW(parse_override("novalue"), SceneError);
+  // The same angle in another unit is replaced, not refused as "q or q_deg, not both" (the
+  // crane gives initial.q in radians).
+  const Scene c = load_scene("crane-luffing", {parse_override("initial.q_deg=75")});
+  EXPECT_NEAR(c.initial.q, 75 * M_PI / 180, 1e-15);
+  const Scene back = load_scene("crane-luffing", {parse_override("initial.q_deg=75"), parse_override("initial.q=1.5")});
+  EXPECT_DOUBLE_EQ(back.initial.q, 1.5);
 }
 
 TEST(YamlFields, MalformedEmptyAndBinaryInputsAreRefused) {
