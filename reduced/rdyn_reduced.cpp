@@ -195,7 +195,8 @@ rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int
 }
 
 const char* rdyn_workspace_message(const rdyn_workspace* workspace, int status) {
-  if (workspace && status == RDYN_BAD_DRIVE) return workspace->ws.describe(Status::BadDrive);
+  if (workspace && (status == RDYN_BAD_DRIVE || status == RDYN_BAD_STATE))
+    return workspace->ws.describe(static_cast<Status>(status));
   return rdyn_status_string(status);
 }
 

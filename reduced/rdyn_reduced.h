@@ -120,9 +120,10 @@ rdyn_status rdyn_get_forces(const rdyn_workspace* workspace, double* forces, int
  * at the same state. Computed with every step; allocates nothing. */
 rdyn_status rdyn_get_joint_outputs(const rdyn_workspace* workspace, double* out, int n);
 
-/* What `status`, just returned by a call on this workspace, means — for RDYN_BAD_DRIVE the one
- * cause of that refusal (value not finite, no joint torque to command, a torque beyond 1e6),
- * else rdyn_status_string(status). A static string; allocates nothing. */
+/* What `status`, just returned by a call on this workspace, means — for RDYN_BAD_DRIVE and
+ * RDYN_BAD_STATE the one cause of that refusal (a value not finite, no joint torque to command, a
+ * torque beyond 1e6, |q̇| beyond 1e4, q outside the table, ...), else rdyn_status_string(status).
+ * A static string; allocates nothing. */
 const char* rdyn_workspace_message(const rdyn_workspace* workspace, int status);
 
 #ifdef __cplusplus

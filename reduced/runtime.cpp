@@ -38,7 +38,9 @@ const char* status_message(Status s) {
 }
 
 const char* RuntimeWorkspace::describe(Status s) const {
-  return s == Status::BadDrive && drive_refusal_ ? drive_refusal_ : status_message(s);
+  if (s == Status::BadDrive && drive_refusal_) return drive_refusal_;
+  if (s == Status::BadState && state_refusal_) return state_refusal_;
+  return status_message(s);
 }
 
 RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& scene,
@@ -166,16 +168,27 @@ void copy_state(const ReducedWorkspace& from, ReducedWorkspace& to) {
   std::copy(from.torque_value.begin(), from.torque_value.end(), to.torque_value.begin());
 }
 
+// The one cause of a refused state (q, q̇, q̈; q̈ = 0 where there is none), nullptr when it is
+// accepted: a static text for RuntimeWorkspace::describe.
+const char* state_refusal(const RuntimeModel& model, double q, double qdot, double qddot) {
+  const double q_max = model.revolute ? models::limits::kMaxAngle_rad : models::limits::kMaxCoordinate_m;
+  if (!std::isfinite(q) || !std::isfinite(qdot) || !std::isfinite(qddot)) return "the state is not finite";
+  if (!(std::abs(q) <= q_max)) return "q is beyond the coordinate's limit (1e6 rad or m)";
+  if (!(std::abs(qdot) <= models::limits::kMaxRate)) return "|q̇| exceeds 1e4 rad/s (m/s)";
+  if (!(std::abs(qddot) <= kMaxDriveAcceleration)) return "|q̈| exceeds 1e8 rad/s² (m/s²)";
+  if (!model.reduced.table.in_range(q)) return "q lies outside the table's range";
+  return nullptr;
+}
+
 }  // namespace
 
 Status reset(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double qdot,
              const Drive& drive) noexcept {
   if (!ws.fits(model)) return Status::WrongWorkspace;
-  const double q_max =
-      model.revolute ? models::limits::kMaxAngle_rad : models::limits::kMaxCoordinate_m;
-  if (!(std::abs(q) <= q_max) || !(std::abs(qdot) <= models::limits::kMaxRate) ||
-      !model.reduced.table.in_range(q))
+  if (const char* why = state_refusal(model, q, qdot, 0.0)) {
+    ws.state_refusal_ = why;
     return Status::BadState;
+  }
   copy_state(ws.state_, ws.saved_);
   std::copy(ws.forces_.begin(), ws.forces_.end(), ws.forces_saved_.begin());
   std::copy(ws.joint_out_.begin(), ws.joint_out_.end(), ws.joint_out_saved_.begin());
@@ -232,11 +245,10 @@ Status step(const RuntimeModel& model, RuntimeWorkspace& ws, double dt,
 Status calc_drive_torque(const RuntimeModel& model, RuntimeWorkspace& ws, double q, double qdot,
                          double qddot, double& drive) noexcept {
   if (!ws.fits(model)) return Status::WrongWorkspace;
-  const double q_max =
-      model.revolute ? models::limits::kMaxAngle_rad : models::limits::kMaxCoordinate_m;
-  if (!(std::abs(q) <= q_max) || !(std::abs(qdot) <= models::limits::kMaxRate) ||
-      !(std::abs(qddot) <= kMaxDriveAcceleration) || !model.reduced.table.in_range(q))
+  if (const char* why = state_refusal(model, q, qdot, qddot)) {
+    ws.state_refusal_ = why;
     return Status::BadState;
+  }
   // The joint torques as commanded now; gates of its own (calc_drive sets them from q̇, q̈).
   std::copy(ws.state_.torque_value.begin(), ws.state_.torque_value.end(),
             ws.inverse_.torque_value.begin());

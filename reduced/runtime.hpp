@@ -110,8 +110,9 @@ class RuntimeWorkspace {
   long get_switches() const { return switches_; }  // steps in which a load gate switched
   const ReducedWorkspace& get_state() const { return state_; }
   // What `s`, just returned by a call on this workspace, means: for BadDrive the one cause of the
-  // last refused drive (not finite, no joint torque to command, a torque beyond the limit), else
-  // status_message(s). A static string: nothing is allocated.
+  // last refused drive (not finite, no joint torque to command, a torque beyond the limit), for
+  // BadState that of the last refused state, else status_message(s). A static string: nothing is
+  // allocated.
   const char* describe(Status s) const;
 
  private:
@@ -133,6 +134,7 @@ class RuntimeWorkspace {
   std::optional<JointOutputWorkspace> joint_ws_;
   long steps_ = 0, switches_ = 0;
   const char* drive_refusal_ = nullptr;  // the last refused drive's cause (apply_drive)
+  const char* state_refusal_ = nullptr;  // the last refused state's cause (reset, calc_drive_torque)
   // Scratch for rolling back a failed step.
   ReducedWorkspace saved_;
   std::vector<double> forces_saved_, joint_out_saved_;

@@ -100,6 +100,17 @@ def load_scene(name_or_path, overrides=None):
     return Scene(name_or_path, sets, _rdyn.load_scene(str(name_or_path), sets))
 
 
+def _as_scene(scene, who):
+    """A Scene, or a scene name or path (read with load_scene); anything else is a TypeError that
+    says what to give (``extract("fourbar")`` raised AttributeError from inside)."""
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, _os.PathLike)):
+        return load_scene(scene)
+    raise TypeError(f"{who}: scene must be an rdyn.Scene (rdyn.load_scene) or a scene name or path, "
+                    f"not {type(scene).__name__}")
+
+
 class Table(_Columns):
     """A reduced table (``rdyn extract``): mapping column → numpy array, q_deg (or q_m) first."""
 
@@ -118,6 +129,7 @@ class Table(_Columns):
 
 def extract(scene, grid_deg=10, method="kinetostatic"):
     """``rdyn extract``: the reduced table of a scene on a grid of ``grid_deg`` degrees."""
+    scene = _as_scene(scene, "extract")
     samples, calls, ms = _rdyn.extract(scene._scene, float(grid_deg), method)
     return Table(samples, scene, calls, ms)
 
@@ -127,6 +139,7 @@ def load_table(path, scene):
     TableError (file, line and field in the message). The table is checked against the scene
     when it is used (simulate, Runtime); a table without a content checksum (written before rdyn
     recorded one, or edited) is compared here with a fresh extraction of ``scene``."""
+    scene = _as_scene(scene, "load_table")
     samples = _rdyn.read_table(_os.fspath(path))
     _rdyn.check_table(samples, scene._scene)
     return Table(samples, scene)
@@ -156,6 +169,7 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
     ``table`` a Table (None: extract now); options as the CLI's long options with
     underscores: dt_out, tolerance, integrator, route, grid_deg, method, interpolation,
     energy_consistent, reduced_integrator, reduced_tolerance, fixed_step."""
+    scene = _as_scene(scene, "simulate")
     if model not in ("reduced", "full"):
         raise ArgumentError(f"model: must be reduced or full (got {model!r})")
     args = _rdyn.SimulateArgs()
@@ -174,6 +188,7 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
 def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=10, interpolation="fourier"):
     """``rdyn calibrate``: the drive (or ``load``) for a mean cadence [Hz] and, optionally, a
     mean power [W]; returns the CLI's JSON as a dict (e.g. "drive_torque_Nm")."""
+    scene = _as_scene(scene, "calibrate")
     return _json.loads(_rdyn.calibrate(scene._scene, cadence_hz, power_w, load or "", float(grid_deg),
                                        interpolation))
 
@@ -186,6 +201,7 @@ def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, 
     F_<force>…) and whose ``info`` is run.json (drive_rms, drive_peak, mean_power_W, …).
     ``model`` "reduced" or "full"; ``table`` a Table for the reduced model (None: extract at
     ``grid_deg``); ``motor`` (stall, no_load_speed) checks a torque–speed line (info["motor_check"])."""
+    scene = _as_scene(scene, "drive")
     if model not in ("reduced", "full"):
         raise ArgumentError(f"model: must be reduced or full (got {model!r})")
     args = _rdyn.DriveArgs()
@@ -212,6 +228,7 @@ def validate(scene, out, quick=False, force=False, peers=()):
     (atomically; a folder holding files rdyn did not write needs force=True) and returns
     summary.json's content as a dict. ``summary["status"]`` is "pass" or "fail" (the CLI's exit
     0 or 1; the report is written either way)."""
+    scene = _as_scene(scene, "validate")
     return _json.loads(_rdyn.validate(scene._scene, _os.fspath(out), bool(quick), bool(force), list(peers)))
 
 
@@ -274,6 +291,7 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
     a dask client's map followed by gather, …) over the cases; the work item is a small tuple
     and the worker ``rdyn.sweep_case``. None: the C++ sweep in ``threads`` threads (None: the
     hardware's), reusing a thread's table between cases as the CLI does."""
+    scene = _as_scene(scene, "sweep")
     if isinstance(peaks, str):  # one column name, not its characters
         peaks = (peaks,)
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
@@ -305,8 +323,8 @@ class Runtime:
     def __init__(self, table, scene=None, interpolation=None, energy_consistent=False):
         # A path is read for its scene (load_table); anything else but a Table is a TypeError
         # that says what to give, not an AttributeError from inside.
-        if scene is not None and not isinstance(scene, Scene):
-            raise TypeError(f"Runtime: scene must be an rdyn.Scene (rdyn.load_scene), not {type(scene).__name__}")
+        if scene is not None:
+            scene = _as_scene(scene, "Runtime")
         if isinstance(table, (str, bytes, _os.PathLike)) and scene is None:
             raise TypeError("Runtime(path, scene): a table file needs the scene it was extracted from")
         if table is None:

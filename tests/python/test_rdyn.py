@@ -184,8 +184,13 @@ def test_runtime_refuses_a_drive_it_cannot_apply_and_wrong_types(tmp_path):
         rdyn.Runtime(str(tmp_path / "t.csv"))
     with pytest.raises(TypeError, match="must be an rdyn.Table"):
         rdyn.Runtime(42, scene)
+    # A scene name stands for its scene everywhere (extract("fourbar") raised AttributeError).
+    assert rdyn.Runtime(tmp_path / "t.csv", "fourbar").q == pytest.approx(rdyn.Runtime(tmp_path / "t.csv", scene).q)
+    assert rdyn.extract("fourbar", grid_deg=30)["m1"].size == rdyn.extract(scene, grid_deg=30)["m1"].size
     with pytest.raises(TypeError, match="must be an rdyn.Scene"):
-        rdyn.Runtime(tmp_path / "t.csv", "fourbar")
+        rdyn.Runtime(tmp_path / "t.csv", 42)
+    with pytest.raises(TypeError, match="extract: scene must be an rdyn.Scene"):
+        rdyn.extract(None)
     # The same for simulate and drive; one peak column by name is one column.
     with pytest.raises(TypeError, match="simulate: table must be an rdyn.Table"):
         rdyn.simulate(scene, table=5)

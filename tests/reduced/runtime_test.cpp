@@ -213,6 +213,10 @@ TEST(Runtime, BadArgumentsAreRefusedAndChangeNothing) {
     EXPECT_EQ(reset(model, ws, q, qd), Status::BadState) << q << " " << qd;
     EXPECT_EQ(snapshot(ws), after_min_step);
   }
+  EXPECT_EQ(reset(model, ws, 0.0, 1.1e4), Status::BadState);
+  EXPECT_STREQ(ws.describe(Status::BadState), "|q̇| exceeds 1e4 rad/s (m/s)");
+  EXPECT_EQ(reset(model, ws, NAN, 0.0), Status::BadState);
+  EXPECT_STREQ(ws.describe(Status::BadState), "the state is not finite");
   EXPECT_EQ(reset(model, ws, 0.0, -1e4), Status::Ok);
 }
 
