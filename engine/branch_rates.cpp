@@ -78,7 +78,7 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   std::vector<int> q_of(J.free_cols.size());
   for (size_t c = 0; c < J.free_cols.size(); ++c)
     if ((q_of[c] = q_of_u[J.free_cols[c]]) < 0) return false;
-  const LeastSquares chord(J.G_free);  // one decomposition for every iteration
+  LeastSquares chord(J.G_free);  // one decomposition for every iteration
   Vector dx, rhs;
   for (int it = 0; it < kMaxIterations; ++it) {
     rhs = s.getQErr();

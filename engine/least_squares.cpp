@@ -64,7 +64,7 @@ LeastSquares::LeastSquares(const Matrix& A) : m_(A.nrow()), n_(A.ncol()) {
   svd_.emplace(A);
 }
 
-void LeastSquares::solve(const Vector& b, Vector& x) const {
+void LeastSquares::solve(const Vector& b, Vector& x) {
   if (svd_) {
     if (m_ == 0 || n_ == 0) {  // FactorSVD gives an empty x here
       x.resize(n_);

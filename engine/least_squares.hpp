@@ -25,7 +25,8 @@ class LeastSquares {
   static constexpr double kQrMinRatio = 1e-3;
   explicit LeastSquares(const SimTK::Matrix& A);
   // b: A.nrow() entries; x is resized to A.ncol().
-  void solve(const SimTK::Vector& b, SimTK::Vector& x) const;
+  // Not const: the SVD fallback's solve is not (Simbody 3.7).
+  void solve(const SimTK::Vector& b, SimTK::Vector& x);
   bool by_qr() const { return !svd_; }
 
  private:
@@ -33,7 +34,7 @@ class LeastSquares {
   std::vector<double> qr_;    // column-major m × n: R above the diagonal, Householder vectors below
   std::vector<double> beta_;  // reflector k: I − beta_k v_k v_kᵀ, v_k = (1, qr_[k+1.., k])
   std::vector<int> perm_;     // column k of R is column perm_[k] of A
-  mutable std::optional<SimTK::FactorSVD> svd_;  // the fallback (its solve is not const)
+  std::optional<SimTK::FactorSVD> svd_;  // the fallback
 };
 
 }  // namespace rdyn::engine

@@ -38,7 +38,7 @@ double max_abs(const Vector& v) {
 
 // Both routes on A for a few right-hand sides: equal to 1e-12 of the solution's size.
 void expect_as_factor_svd(const Matrix& A, std::mt19937& rng) {
-  const LeastSquares ls(A);
+  LeastSquares ls(A);
   SimTK::FactorSVD svd(A);
   for (int k = 0; k < 4; ++k) {
     const Vector b = random_vector(A.nrow(), rng);
@@ -75,7 +75,7 @@ TEST(LeastSquares, RankLossAndNearRankLossGoToTheSvdWithItsMinimumNorm) {
   std::mt19937 rng(11);
   Matrix A = random_matrix(6, 5, rng);
   for (int i = 0; i < 6; ++i) A(i, 4) = 0.0;  // a mobility no constraint touches
-  const LeastSquares ls(A);
+  LeastSquares ls(A);
   EXPECT_FALSE(ls.by_qr());
   Vector x;
   const Vector b = random_vector(6, rng);
@@ -95,7 +95,7 @@ TEST(LeastSquares, AnUnderdeterminedSystemGetsTheClosedFormMinimumNorm) {
   const Matrix A = random_matrix(3, 6, rng);
   const Vector b = random_vector(3, rng);
   Vector x;
-  const LeastSquares ls(A);
+  LeastSquares ls(A);
   EXPECT_FALSE(ls.by_qr());
   ls.solve(b, x);
   // x = Aᵀ (A Aᵀ)⁻¹ b, by Simbody's LU of the 3 × 3 Gram matrix.
