@@ -18,6 +18,7 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/runtime.hpp"
 #include "reduced/samples.hpp"
+#include "reduced/samples_fit.hpp"
 #include "reduced/joint_outputs.hpp"
 #include "validate/analysis/sweep.hpp"
 #include "validate/analysis/table_check.hpp"
@@ -228,9 +229,15 @@ PYBIND11_MODULE(_rdyn, m) {
   // A table file without a content checksum against a fresh extraction of its scene, as the CLI
   // checks it (validate/analysis/table_check.hpp): load_table runs it, so Runtime(path) does too.
   m.def("check_table", [](const rr::Samples& s, const rm::Scene& scene) {
+    // The scene the table must come from, as simulate and the runtime build it (`reactions: all`
+    // those the reduced model can give, their reaction lines): a table of another scene is refused
+    // here, when it is loaded, not at its first use.
+    const rm::Scene oscene = scene.outputs.reactions_all ? rr::split_reduced_reactions(scene).scene : scene;
+    const rm::Scene rscene = rr::wants_joint_outputs(oscene) ? rr::with_reaction_requests(oscene) : oscene;
+    rr::check_samples_fit(s, rscene);
     if (s.content_checked || s.file.empty()) return;
     py::gil_scoped_release free;
-    rv::check_table_against_scene(s, rr::wants_joint_outputs(scene) ? rr::with_reaction_requests(scene) : scene);
+    rv::check_table_against_scene(s, rscene);
   });
 
   m.def("calibrate", [](const rm::Scene& scene, std::optional<double> cadence_hz, std::optional<double> power_w,

@@ -136,8 +136,8 @@ def extract(scene, grid_deg=10, method="kinetostatic"):
 
 def load_table(path, scene):
     """Reads a table written by ``rdyn extract`` (or Table.save) for ``scene``. Raises
-    TableError (file, line and field in the message). The table is checked against the scene
-    when it is used (simulate, Runtime); a table without a content checksum (written before rdyn
+    TableError (file, line and field in the message), also when the table was extracted from
+    another scene (or for other outputs); a table without a content checksum (written before rdyn
     recorded one, or edited) is compared here with a fresh extraction of ``scene``."""
     scene = _as_scene(scene, "load_table")
     samples = _rdyn.read_table(_os.fspath(path))

@@ -51,6 +51,9 @@ def test_extract_table_and_round_trip(rdyn_cli, tmp_path):
     assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
     back = rdyn.load_table(tmp_path / "cli.csv", scene)
     assert np.array_equal(back["m2"], table["m2"])
+    # Another scene's table is refused when loaded, not at its first use.
+    with pytest.raises(rdyn.TableError, match="different scene"):
+        rdyn.load_table(tmp_path / "cli.csv", rdyn.load_scene("slider-crank"))
     # A table given to simulate: the same run as extracting there.
     a = rdyn.simulate(scene, model="reduced", duration=0.5, table=back)
     b = rdyn.simulate(scene, model="reduced", duration=0.5)
