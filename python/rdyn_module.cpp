@@ -191,6 +191,7 @@ PYBIND11_MODULE(_rdyn, m) {
       .def_readwrite("route", &rv::SimulateArgs::route)
       .def_readwrite("table", &rv::SimulateArgs::table)
       .def_readwrite("grid_deg", &rv::SimulateArgs::grid_deg)
+      .def_readwrite("grid_given", &rv::SimulateArgs::grid_given)
       .def_readwrite("method", &rv::SimulateArgs::method)
       .def_readwrite("interpolation", &rv::SimulateArgs::interpolation)
       .def_readwrite("energy_consistent", &rv::SimulateArgs::energy_consistent)

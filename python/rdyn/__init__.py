@@ -180,6 +180,7 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
         if key in ("model", "duration", "table") or not hasattr(args, key):
             raise TypeError(f"simulate() got an unknown option {key!r}")
         setattr(args, key, value)
+    args.grid_given = "grid_deg" in options  # else refined where 10° does not resolve the mechanism
     table = _as_table(table, scene, "simulate")
     columns, info = _rdyn.simulate(scene._scene, args, None if table is None else table._samples)
     return Run(columns, _json.loads(info))

@@ -38,6 +38,9 @@ struct SimulateArgs {
   // reduced model
   std::string table;  // CSV from `rdyn extract`; empty: extract now
   double grid_deg = 10.0;
+  // Not given: a periodic table whose m1 the grid does not resolve (reduced::calc_half_grid_miss
+  // above kAutoRefineMiss) is extracted again at half the step, down to kMinAutoGrid_deg.
+  bool grid_given = false;
   std::string method = "kinetostatic";
   std::string interpolation = "fourier";  // measured more accurate than cubic (docs/theory.md)
   bool energy_consistent = false;
