@@ -266,6 +266,7 @@ PYBIND11_MODULE(_rdyn, m) {
       .def_readwrite("duration", &rv::DriveArgs::duration)
       .def_readwrite("dt_out", &rv::DriveArgs::dt_out)
       .def_readwrite("grid_deg", &rv::DriveArgs::grid_deg)
+      .def_readwrite("grid_given", &rv::DriveArgs::grid_given)
       .def_readwrite("interpolation", &rv::DriveArgs::interpolation)
       .def_readwrite("motor", &rv::DriveArgs::motor);
   m.def("drive", [](const rm::Scene& scene, const rv::DriveArgs& a, const rr::Samples* table) {

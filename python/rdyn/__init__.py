@@ -195,13 +195,14 @@ def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=10, inte
 
 
 def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, table=None, dt_out=None,
-          grid_deg=10, interpolation="fourier", motor=None):
+          grid_deg=None, interpolation="fourier", motor=None):
     """``rdyn drive``: the independent coordinate follows a constant rate ``cadence_hz`` [rev/s]
     or a ``profile`` (a CSV t,q_deg or t,q_m), every other load of the scene applied; returns a
     Run whose columns are timeseries.csv's (t, q, qdot, qddot, drive_Nm or drive_N, drive_W,
     F_<force>…) and whose ``info`` is run.json (drive_rms, drive_peak, mean_power_W, …).
     ``model`` "reduced" or "full"; ``table`` a Table for the reduced model (None: extract at
-    ``grid_deg``); ``motor`` (stall, no_load_speed) checks a torque–speed line (info["motor_check"])."""
+    ``grid_deg``, None: 10°, halved while it does not resolve the mechanism); ``motor`` (stall, no_load_speed)
+    checks a torque–speed line (info["motor_check"])."""
     scene = _as_scene(scene, "drive")
     if model not in ("reduced", "full"):
         raise ArgumentError(f"model: must be reduced or full (got {model!r})")
@@ -215,7 +216,9 @@ def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, 
         args.duration = float(duration)
     if dt_out is not None:
         args.dt_out = float(dt_out)
-    args.grid_deg = float(grid_deg)
+    if grid_deg is not None:  # None: 10°, refined where it does not resolve the mechanism (as the CLI)
+        args.grid_deg = float(grid_deg)
+        args.grid_given = True
     args.interpolation = interpolation
     if motor is not None:
         args.motor = motor if isinstance(motor, str) else ",".join(repr(float(v)) for v in motor)

@@ -1,5 +1,10 @@
 #include "validate/analysis/build_reduced.hpp"
 
+#include <cmath>
+#include <cstdio>
+
+#include "reduced/table_resolution.hpp"
+
 #include <chrono>
 #include <cmath>
 
@@ -95,6 +100,25 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
   e.stages.assembly_ms = ms(t, clock::now());  // a failed full-turn attempt counts as kinetostatics
   e.samples = reduced::extract_samples(source, scene, opt);
   return finish(source);
+}
+
+Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool grid_given, reduced::Method method,
+                             double& grid_deg_used) {
+  double grid = grid_deg;
+  Extraction e = extract_from_full(scene, grid, method);
+  while (!grid_given && e.samples.periodic && grid / 2 >= kMinAutoGrid_deg - 1e-9) {
+    const int c = e.samples.column("m1");
+    const double miss = c < 0 ? NAN : reduced::calc_half_grid_miss(e.samples.columns[c]);
+    if (!(miss > kAutoRefineMiss)) break;
+    std::fprintf(stderr,
+                 "rdyn: the %g° table does not resolve this mechanism (m1 from every other grid point misses the "
+                 "others by %.2g %% of its peak): extracting at %g°\n",
+                 grid, 100 * miss, grid / 2);
+    grid /= 2;
+    e = extract_from_full(scene, grid, method);
+  }
+  grid_deg_used = grid;
+  return e;
 }
 
 }  // namespace rdyn::validate

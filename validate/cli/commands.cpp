@@ -120,32 +120,6 @@ void warn_coarse_table(const reduced::Samples& s, nlohmann::json& run) {
                step_deg, 100 * miss, 100 * reduced::kCoarseTableMiss);
 }
 
-// The table simulate extracts: at --grid-deg; when the user gave none, a periodic table whose
-// m1 its grid does not resolve — m1 interpolated from every other grid point misses the others by
-// more than kAutoRefineMiss of its peak (reduced::calc_half_grid_miss) — again at half the step,
-// down to kMinAutoGrid_deg (a Jansen leg at 10°: miss 0.10, q̈ off by 6 % with exit 0; at 2°
-// every column within 1.1e-4). Measured misses at 10°: slider-crank 1.7e-7, bicycle 8e-5, fourbar
-// 1.4e-4 (q̈ within 1e-5): unchanged; the light-flywheel bicycle 9.8e-3 (q̈ 1.1e-2): refined.
-constexpr double kAutoRefineMiss = 1e-3;
-constexpr double kMinAutoGrid_deg = 1.25;
-
-Extraction extract_refined(const models::Scene& rscene, const SimulateArgs& a, nlohmann::json& run) {
-  double grid = a.grid_deg;
-  Extraction e = extract_from_full(rscene, grid, reduced::parse_method(a.method));
-  while (!a.grid_given && e.samples.periodic && grid / 2 >= kMinAutoGrid_deg - 1e-9) {
-    const int c = e.samples.column("m1");
-    const double miss = c < 0 ? NAN : reduced::calc_half_grid_miss(e.samples.columns[c]);
-    if (!(miss > kAutoRefineMiss)) break;
-    std::fprintf(stderr, "rdyn: the %g° table does not resolve this mechanism (m1 from every other grid point misses "
-                 "the others by %.2g %% of its peak): extracting at %g°\n", grid, 100 * miss, grid / 2);
-    run["grid_refined_from_deg"] = run.value("grid_refined_from_deg", grid);
-    grid /= 2;
-    e = extract_from_full(rscene, grid, reduced::parse_method(a.method));
-  }
-  run["grid_deg"] = grid;
-  return e;
-}
-
 }  // namespace
 
 void check_simulate_args(const models::Scene& scene, const SimulateArgs& a) {
@@ -216,10 +190,12 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
       samples = reduced::read_samples_csv(a.table);
       run["table"] = a.table;
     } else {
-      auto e = extract_refined(rscene, a, run);
+      double grid = a.grid_deg;
+      auto e = extract_resolving(rscene, a.grid_deg, a.grid_given, reduced::parse_method(a.method), grid);
       samples = std::move(e.samples);
       extraction_ms = e.extraction_ms;
-      run.update({{"method", a.method}, {"kinetostatic_calls", e.calls}});
+      run.update({{"grid_deg", grid}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
+      if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;
       if (e.range) {  // range table: its span [rad or m] and what ends it
         run["independent_range"] = {{"min", e.range->min}, {"max", e.range->max}, {"min_edge", e.range->min_edge},
                                     {"max_edge", e.range->max_edge}};

@@ -193,10 +193,12 @@ DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, co
                 {"interpolation", model.table.fit}});
     return calc_drive_reduced(oscene, model, motion);
   }
-  auto e = extract_from_full(rscene, a.grid_deg, reduced::Method::Kinetostatic);
+  double grid = a.grid_deg;  // a default grid refined where it does not resolve the mechanism
+  auto e = extract_resolving(rscene, a.grid_deg, a.grid_given, reduced::Method::Kinetostatic, grid);
   const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
   DriveRecord r = calc_drive_reduced(oscene, model, motion);
-  run.update({{"grid_deg", a.grid_deg}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
+  run.update({{"grid_deg", grid}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
+  if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;
   return r;
 }
 

@@ -22,6 +22,7 @@ struct DriveArgs {
   std::optional<double> duration;    // default: one revolution (cadence), the profile's span
   std::optional<double> dt_out;      // default: the scene's output interval
   double grid_deg = 10.0;
+  bool grid_given = false;  // else a default, refined where it does not resolve m1 (extract_resolving)
   std::string interpolation = "fourier";
   std::vector<std::string> sets;
   std::string motor;  // "STALL,NO_LOAD": check a torque–speed line against the drive (empty: none)

@@ -316,6 +316,7 @@ void add_drive_command(CLI::App& app, DriveArgs& drv) {
                     "STALL,NO_LOAD: check that a motor on the independent coordinate with this torque-speed line "
                     "(N*m,rad/s; N,m/s on a slider) covers the drive at every angle; run.json gets motor_check");
   add_reduced_table_options(*drive, drv.grid_deg, drv.interpolation);
+  drive->get_option("--grid-deg")->each([&drv](const std::string&) { drv.grid_given = true; });
   add_scene_overrides(*drive, drv.sets);
   add_output_folder(*drive, drv.out, drv.force);
 }
