@@ -7,6 +7,7 @@
 #include <string>
 
 #include "models/scene_yaml.hpp"
+#include "reduced/table_resolution.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -127,6 +128,25 @@ TEST(BuildReduced, AMechanismGearedToRepeatEveryTwoTurnsIsToldAndTheSlowJointWor
   const auto e = extract_from_full(scene, 5, reduced::Method::Kinetostatic);
   EXPECT_TRUE(e.samples.periodic);
   EXPECT_EQ(e.samples.q.size(), 72u);
+}
+
+// A default grid is halved while it does not resolve m1 (half-grid miss above kAutoRefineMiss);
+// one the user gave is kept. The light-flywheel bicycle's 10° table misses 9.8e-3 (its q̈ was
+// 1.1e-2 off): 5°, where it misses below the bound; the fourbar's (1.4e-4) stays at 10°.
+TEST(BuildReduced, ADefaultGridIsRefinedUntilItResolvesM1AGivenOneIsKept) {
+  const auto flywheel = models::load_scene(RDYN_SCENES "/hard/light-flywheel.yaml");
+  double grid = 0;
+  const auto e = extract_resolving(flywheel, 10, false, reduced::Method::Kinetostatic, grid);
+  EXPECT_EQ(grid, 5.0);
+  EXPECT_EQ(e.samples.q.size(), 72u);
+  const int c = e.samples.column("m1");
+  ASSERT_GE(c, 0);
+  EXPECT_LE(reduced::calc_half_grid_miss(e.samples.columns[c]), kAutoRefineMiss);
+  const auto coarse = extract_resolving(flywheel, 10, true, reduced::Method::Kinetostatic, grid);
+  EXPECT_EQ(grid, 10.0);
+  EXPECT_GT(reduced::calc_half_grid_miss(coarse.samples.columns[c]), kAutoRefineMiss);
+  extract_resolving(models::load_scene("fourbar"), 10, false, reduced::Method::Kinetostatic, grid);
+  EXPECT_EQ(grid, 10.0);
 }
 
 }  // namespace
