@@ -176,6 +176,8 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
     args.model = model
     if duration is not None:
         args.duration = float(duration)
+    if options.get("grid_deg", 0) is None:  # None: the default grid, refined as in drive()
+        del options["grid_deg"]
     for key, value in options.items():
         if key in ("model", "duration", "table") or not hasattr(args, key):
             raise TypeError(f"simulate() got an unknown option {key!r}")

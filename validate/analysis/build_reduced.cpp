@@ -105,7 +105,20 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
 Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool grid_given, reduced::Method method,
                              double& grid_deg_used) {
   double grid = grid_deg;
-  Extraction e = extract_from_full(scene, grid, method);
+  // A default grid whose full-turn sweep did not close (it changed assembly between two grid
+  // points: a 1:20 gear turns its joint 200° per 10° step) is halved too: a given one is the
+  // user's, and its refusal stands.
+  Extraction e;
+  for (;;) {
+    try {
+      e = extract_from_full(scene, grid, method);
+      break;
+    } catch (const reduced::SweepNotClosed& err) {
+      if (grid_given || grid / 2 < kMinAutoGrid_deg - 1e-9) throw;
+      std::fprintf(stderr, "rdyn: the %g° sweep did not close its turn: extracting at %g°\n", grid, grid / 2);
+      grid /= 2;
+    }
+  }
   while (!grid_given && e.samples.periodic && grid / 2 >= kMinAutoGrid_deg - 1e-9) {
     const int c = e.samples.column("m1");
     const double miss = c < 0 ? NAN : reduced::calc_half_grid_miss(e.samples.columns[c]);

@@ -100,6 +100,8 @@ bool is_rdyn_sweep(const std::string& head) {
          (first.find(",ok,") != std::string::npos || first.find(",error,") != std::string::npos);
 }
 
+}  // namespace
+
 // A periodic table too coarse for its mechanism gives wrong accelerations and forces with exit 0
 // (issue #23: a Jansen leg's 10° table missed q̈ by 6 % and a reaction by 60 %, a five-bar geared
 // 2:1 missed q̈ by 40 %): the half-grid miss of m1 (reduced/table_resolution.hpp) flags it on
@@ -119,8 +121,6 @@ void warn_coarse_table(const reduced::Samples& s, nlohmann::json& run) {
                "the errors)\n",
                step_deg, 100 * miss, 100 * reduced::kCoarseTableMiss);
 }
-
-}  // namespace
 
 void check_simulate_args(const models::Scene& scene, const SimulateArgs& a) {
   const double duration = a.duration.value_or(scene.simulation.duration_s);

@@ -49,6 +49,9 @@ struct SimulateArgs {
   double fixed_step = 1e-3;
 };
 int run_simulate(const SimulateArgs& args);
+// A periodic table whose m1 its grid does not resolve: run.json's `table_m1_half_grid_miss`, and
+// above reduced::kCoarseTableMiss a warning on standard error (simulate and drive).
+void warn_coarse_table(const reduced::Samples& s, nlohmann::json& run);
 // What `rdyn simulate` computes, without writing it (the Python module's simulate): the
 // arguments checked as the CLI checks them (ArgumentError names the option), the run, and
 // run.json's content. args.scene, sets, out and force are not read.

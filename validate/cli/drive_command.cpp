@@ -189,6 +189,7 @@ DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, co
   const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
   if (table) {  // a table in memory (the Python module's Table)
     const auto model = reduced::make_reduced_model(*table, rscene, reduced::parse_interpolation(a.interpolation));
+    warn_coarse_table(*table, run);
     run.update({{"table", table->file.empty() ? std::string("(in memory)") : table->file},
                 {"interpolation", model.table.fit}});
     return calc_drive_reduced(oscene, model, motion);
@@ -196,6 +197,7 @@ DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, co
   double grid = a.grid_deg;  // a default grid refined where it does not resolve the mechanism
   auto e = extract_resolving(rscene, a.grid_deg, a.grid_given, reduced::Method::Kinetostatic, grid);
   const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
+  warn_coarse_table(e.samples, run);
   DriveRecord r = calc_drive_reduced(oscene, model, motion);
   run.update({{"grid_deg", grid}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
   if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;

@@ -147,6 +147,13 @@ TEST(BuildReduced, ADefaultGridIsRefinedUntilItResolvesM1AGivenOneIsKept) {
   EXPECT_GT(reduced::calc_half_grid_miss(coarse.samples.columns[c]), kAutoRefineMiss);
   extract_resolving(models::load_scene("fourbar"), 10, false, reduced::Method::Kinetostatic, grid);
   EXPECT_EQ(grid, 10.0);
+  // A default grid whose sweep does not close (a 1:20 gear turns its joint 200° per 10° step) is
+  // halved too; a given one is refused as before.
+  const auto geared = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/fivebar-2to1.yaml",
+                                         {models::parse_override("gears.pair.ratio=20")});
+  EXPECT_THROW(extract_resolving(geared, 10, true, reduced::Method::Kinetostatic, grid), reduced::SweepNotClosed);
+  EXPECT_NO_THROW(extract_resolving(geared, 10, false, reduced::Method::Kinetostatic, grid));
+  EXPECT_LT(grid, 10.0);
 }
 
 }  // namespace

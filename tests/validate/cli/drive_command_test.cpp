@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -88,6 +89,17 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
                        "(500001 over 1000 s"),
             std::string::npos)
       << r.err;
+  // A given grid too coarse for the mechanism is warned in drive as in simulate (it was silent:
+  // the Jansen leg's reactions 29 % off), and run.json has the table's half-grid miss.
+  r = run({"drive", std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml", "--model", "reduced",
+           "--cadence-hz", "1", "--grid-deg", "10", "--duration", "0.2", "--out", "jd"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the 10° table looks too coarse for this mechanism"), std::string::npos) << r.err;
+  {
+    std::ifstream j(dir / "jd" / "run.json");
+    const std::string json((std::istreambuf_iterator<char>(j)), std::istreambuf_iterator<char>());
+    EXPECT_NE(json.find("\"table_m1_half_grid_miss\""), std::string::npos) << json;
+  }
   // Too many rows at the output interval: raising --dt-out helps (the advice said "shorten").
   r = run({"drive", "fourbar", "--cadence-hz", "1", "--duration", "1e5", "--out", "o2"});
   EXPECT_NE(r.err.find("makes 5e+07 rows, more than 1e+07: shorten --duration or raise --dt-out"), std::string::npos)
