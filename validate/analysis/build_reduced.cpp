@@ -1,16 +1,13 @@
 #include "validate/analysis/build_reduced.hpp"
 
-#include <cmath>
-#include <cstdio>
-
-#include "reduced/table_resolution.hpp"
-
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "engine/full_model.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/reduced_source.hpp"
+#include "reduced/table_resolution.hpp"
 
 namespace rdyn::validate {
 
@@ -113,7 +110,7 @@ Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool g
     try {
       e = extract_from_full(scene, grid, method);
       break;
-    } catch (const reduced::SweepNotClosed& err) {
+    } catch (const reduced::SweepNotClosed&) {
       if (grid_given || grid / 2 < kMinAutoGrid_deg - 1e-9) throw;
       std::fprintf(stderr, "rdyn: the %g° sweep did not close its turn: extracting at %g°\n", grid, grid / 2);
       grid /= 2;
