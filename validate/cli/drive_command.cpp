@@ -79,8 +79,11 @@ void check_drive_arguments(const DriveArgs& a, const models::Scene& scene, bool 
   if (!(std::isfinite(dt) && dt >= cli_limits::kMinOutputInterval_s && dt <= cli_limits::kMaxDuration_s))
     refuse(scene, "--dt-out", fmt::format("must be in [{:g}, {:g}] s (got {:g})", cli_limits::kMinOutputInterval_s,
                                           cli_limits::kMaxDuration_s, dt));
-  if (!(a.grid_deg >= 0.05 && a.grid_deg <= 90) || std::abs(360 / a.grid_deg - std::round(360 / a.grid_deg)) > 1e-9 * 360 / a.grid_deg)
-    refuse(scene, "--grid-deg", fmt::format("must be in [0.05, 90] deg and divide 360° (got {:g})", a.grid_deg));
+  // The range simulate and extract accept (cli_limits), not a second one.
+  if (!(a.grid_deg >= cli_limits::kMinGrid_deg && a.grid_deg <= cli_limits::kMaxGrid_deg) ||
+      std::abs(360 / a.grid_deg - std::round(360 / a.grid_deg)) > 1e-9 * 360 / a.grid_deg)
+    refuse(scene, "--grid-deg", fmt::format("must be in [{:g}, {:g}] deg and divide 360° into whole steps (got {:g})",
+                                            cli_limits::kMinGrid_deg, cli_limits::kMaxGrid_deg, a.grid_deg));
   if (a.model != "full" && a.model != "reduced") refuse(scene, "--model", "full or reduced");
 }
 
