@@ -131,6 +131,9 @@ void check_simulate_args(const models::Scene& scene, const SimulateArgs& a) {
   require_in("--tolerance", tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
   require_in("--reduced-tolerance", a.reduced_tolerance, cli_limits::kMinTolerance, cli_limits::kMaxTolerance, "");
   require_grid("--grid-deg", a.grid_deg);
+  // A table has its grid: a --grid-deg beside it would be ignored in silence.
+  if (!a.table.empty() && a.grid_given)
+    throw ArgumentError("--grid-deg: the --table has its own grid; give one or the other");
   require_in("--fixed-step", a.fixed_step, cli_limits::kMinFixedStep_s, cli_limits::kMaxFixedStep_s, " s");
   if (a.model == "reduced" && a.reduced_integrator == "rk4-fixed" &&
       duration / a.fixed_step > cli_limits::kMaxFixedSteps)

@@ -752,6 +752,10 @@ void found_later(std::vector<Case>& cs) {
     args.insert(args.end(), {"--out", "o"});
     cs.push_back({"simulate_other_model_option_checked" + std::to_string(k), args, 2, other_model[k][2], {}, nullptr, "o"});
   }
+  // A table has its grid: a --grid-deg beside it was ignored in silence.
+  cs.push_back({"simulate_table_and_grid_deg",
+                {"simulate", "fourbar", "--model", "reduced", "--table", "t.csv", "--grid-deg", "5", "--out", "o"}, 2,
+                "--grid-deg: the --table has its own grid", {}, nullptr, "o"});
 }
 
 // Leftovers of issue #23: each refused with file, line and field (or the option), or written
