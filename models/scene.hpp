@@ -304,6 +304,9 @@ struct Validation {
   // mechanism whose 10° table is too coarse at its operating point (a gear above ~18:1 turns its
   // geared joint 180° per 10° step) is validated there on a finer one.
   double calibrate_grid_deg = 10.0;
+  // grid_deg written in the scene (or set): used as it is. Absent: 10°, halved by calibrate,
+  // optimize and sweep while the table does not resolve m1 (validate/analysis/build_reduced.hpp).
+  bool calibrate_grid_given = false;
   std::string note;  // why the scene is hard / what it shows (reports quote it)
   std::vector<CompareValue> compare;  // needs calibrate: the values are calibration results
 };

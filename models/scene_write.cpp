@@ -363,7 +363,7 @@ void write_validation(Writer& w, const Scene& s) {
     if (v.calibrate_power_W != 0.0)
       w.line("    power_W: " + w.num(v.calibrate_power_W, "validation.calibrate.power_W"));
     if (!v.calibrate_load.empty()) w.line("    load: " + w.text(v.calibrate_load));
-    if (v.calibrate_grid_deg != 10.0)
+    if (v.calibrate_grid_given || v.calibrate_grid_deg != 10.0)
       w.line("    grid_deg: " + w.num(v.calibrate_grid_deg, "validation.calibrate.grid_deg"));
   }
   if (!v.compare.empty()) w.line("  compare:");

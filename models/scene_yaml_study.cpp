@@ -193,6 +193,7 @@ void read_calibrate(const Fields& f, const Context& ctx, Scene& s) {
   s.validation.calibrate_power_W = c.num_or("power_W", 0.0);
   s.validation.calibrate_load = c.str_or("load", "");  // checked against the loads by calibrate
   s.validation.calibrate_grid_deg = c.num_or("grid_deg", 10.0);  // range: check_scene
+  s.validation.calibrate_grid_given = c.has("grid_deg");
   if (c.has("load")) note_key(s, ctx, "validation.calibrate.load", c.raw("load"));
   if (c.has("load") && s.validation.calibrate_load.empty())
     c.fail("load", "an empty name names no load: give a joint_torque or motor, or leave the key out");

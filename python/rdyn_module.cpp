@@ -242,13 +242,12 @@ PYBIND11_MODULE(_rdyn, m) {
   });
 
   m.def("calibrate", [](const rm::Scene& scene, std::optional<double> cadence_hz, std::optional<double> power_w,
-                        const std::string& load, double grid_deg, const std::string& interpolation) {
+                        const std::string& load, std::optional<double> grid_deg, const std::string& interpolation) {
     rv::CalibrateArgs a;
     if (cadence_hz) a.cadence_hz = *cadence_hz, a.cadence_given = true;
     if (power_w) a.power_w = *power_w, a.power_given = true;
     a.load = load;
-    a.grid_deg = grid_deg;
-    a.grid_given = true;
+    if (grid_deg) a.grid_deg = *grid_deg, a.grid_given = true;  // else as the CLI without --grid-deg
     a.interpolation = interpolation;
     const rv::CalibrationOptions opt = rv::check_calibrate_args(scene, a);
     py::gil_scoped_release free;
@@ -294,12 +293,13 @@ PYBIND11_MODULE(_rdyn, m) {
       .def_property_readonly("cases", [](const rv::SweepPlan& p) { return p.id.total; });
   m.def("plan_sweep", [](const std::string& scene, const std::vector<std::string>& sets,
                          const std::vector<std::string>& vary, std::optional<double> cadence_hz,
-                         std::optional<double> power_w, const std::string& load, double grid_deg,
+                         std::optional<double> power_w, const std::string& load, std::optional<double> grid_deg,
                          std::optional<double> drive_cadence_hz, const std::vector<std::string>& peaks,
                          std::optional<int> threads) {
     rv::SweepArgs a;  // checked as `rdyn sweep` checks its options (ArgumentError names them)
     a.inputs = {scene}, a.sets = sets, a.vary = vary, a.cadence_hz = cadence_hz, a.power_w = power_w;
-    a.load = load, a.grid_deg = grid_deg, a.drive_cadence_hz = drive_cadence_hz, a.threads = threads;
+    a.load = load, a.drive_cadence_hz = drive_cadence_hz, a.threads = threads;
+    if (grid_deg) a.grid_deg = *grid_deg, a.grid_given = true;
     a.peaks = peaks;
     return rv::plan_sweep(rv::check_sweep_args(a));
   });

@@ -159,9 +159,9 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Ta
       const double q = m.table.q0 + (iv + k / 16.0) * m.table.step;
       const double m1 = m.table.eval(m.c_m1, q);
       if (!(m1 > 0))
-        throw TableError(fmt::format("the interpolated reduced inertia m1 = {:.3g} is not positive at q = {:.4g} "
+        throw TableError(fmt::format("the interpolated reduced inertia m1 = {:.3g} is not positive at {} "
                                      "(outside the validity domain): use a finer grid or another interpolation",
-                                     m1, q));
+                                     m1, describe_q(m.revolute, q, 4)));
     }
   m.record_cols = m.rhs_cols;
   m.record_cols.insert(m.record_cols.end(), m.out_cols.begin(), m.out_cols.end());
@@ -669,6 +669,10 @@ double step_fixed_rk4(const ReducedModel& m, ReducedWorkspace& ws, double h, con
   if (agreed_at_end && all_predictable) mark_ahead(m, ws, ng);
   else ws.ahead_q = NAN;
   return t_first;
+}
+
+std::string describe_q(bool revolute, double q, int digits) {
+  return revolute ? fmt::format("q = {:.{}g}°", q * 180 / M_PI, digits) : fmt::format("q = {:.{}g} m", q, digits);
 }
 
 }  // namespace rdyn::reduced

@@ -197,6 +197,9 @@ struct DivergenceGuard {
 };
 // Lowest potential over the table's grid points (the interpolant's nodes).
 double calc_potential_min(const ReducedModel& m);
+
+// "q = 12.5°" or "q = 0.031 m" (`digits` significant): messages give q in the unit users type.
+std::string describe_q(bool revolute, double q_rad_or_m, int digits = 9);
 DivergenceGuard start_divergence_guard(double energy0, double potential_min, double work0);
 // Updates the largest |W| and returns true when |E − E0 − W| exceeds half the scale.
 inline bool divergence_guard_fires(DivergenceGuard& g, double E, double work) {

@@ -61,8 +61,8 @@ RuntimeModel make_runtime_model(const Samples& samples, const models::Scene& sce
   for (size_t k = 0; k < m.reduced.force_poles.size(); ++k)
     if (!m.reduced.force_poles[k].empty())
       throw TableError(fmt::format("the runtime cannot give constraint force '{}': its table parameters have a "
-                                   "pole at a singular configuration (q = {:.9g}); leave it out of the scene's outputs",
-                                   m.reduced.force_names[k], m.reduced.force_poles[k][0]));
+                                   "pole at a singular configuration ({}); leave it out of the scene's outputs",
+                                   m.reduced.force_names[k], describe_q(m.reduced.revolute, m.reduced.force_poles[k][0])));
   m.potential_min = calc_potential_min(m.reduced);
   m.scene_name = scene.name;
   m.revolute = samples.revolute;

@@ -89,9 +89,9 @@ void check_simulation_start(const ReducedModel& m, double q0, double qdot0) {
   if (!std::isfinite(q0) || !std::isfinite(qdot0))
     throw TableError(fmt::format("reduced simulation start (q, q̇) = ({}, {}) is not finite", q0, qdot0));
   if (!m.table.in_range(q0))
-    throw TableError(fmt::format("reduced simulation start q = {:.9g} lies outside the range [{:.9g}, {:.9g}] of its "
-                                 "table (rad or m)",
-                                 q0, m.table.q0, m.table.q0 + m.table.intervals * m.table.step));
+    throw TableError(fmt::format("reduced simulation start {} lies outside its table's range, from {} to {}",
+                                 describe_q(m.revolute, q0), describe_q(m.revolute, m.table.q0),
+                                 describe_q(m.revolute, m.table.q0 + m.table.intervals * m.table.step)));
 }
 
 // The output rows of a run: n + 1 of them, the last at t = duration.

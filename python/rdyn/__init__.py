@@ -188,12 +188,14 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
     return Run(columns, _json.loads(info))
 
 
-def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=10, interpolation="fourier"):
+def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=None, interpolation="fourier"):
     """``rdyn calibrate``: the drive (or ``load``) for a mean cadence [Hz] and, optionally, a
-    mean power [W]; returns the CLI's JSON as a dict (e.g. "drive_torque_Nm")."""
+    mean power [W]; returns the CLI's JSON as a dict (e.g. "drive_torque_Nm"). ``grid_deg``
+    None: the scene's validation.calibrate.grid_deg, else 10° halved while it does not resolve
+    the mechanism (the JSON's "grid_deg" is the grid used)."""
     scene = _as_scene(scene, "calibrate")
-    return _json.loads(_rdyn.calibrate(scene._scene, cadence_hz, power_w, load or "", float(grid_deg),
-                                       interpolation))
+    return _json.loads(_rdyn.calibrate(scene._scene, cadence_hz, power_w, load or "",
+                                       None if grid_deg is None else float(grid_deg), interpolation))
 
 
 def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, table=None, dt_out=None,
@@ -284,7 +286,7 @@ def sweep_case(case):
     return _rdyn.sweep_case(_plan(spec), int(index))
 
 
-def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_deg=10, drive_cadence_hz=None,
+def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_deg=None, drive_cadence_hz=None,
           threads=None, peaks=()):
     """``rdyn sweep``: every combination of the ``vary`` axes ({scene key: (a, b, n)} or
     {key: "a:b:n"}), each case calibrated on the reduced model (or, with ``drive_cadence_hz``,
@@ -303,7 +305,8 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
             tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
             None if cadence_hz is None else float(cadence_hz), None if power_w is None else float(power_w),
-            load or "", float(grid_deg), None if drive_cadence_hz is None else float(drive_cadence_hz),
+            load or "", None if grid_deg is None else float(grid_deg),
+            None if drive_cadence_hz is None else float(drive_cadence_hz),
             tuple(peaks))
     plan = _plan(spec)  # checked here, before any case runs: bad input raises at once
     header = _csv_rows(plan.header)[0]

@@ -99,8 +99,12 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
   return finish(source);
 }
 
-Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool grid_given, reduced::Method method,
-                             double& grid_deg_used) {
+namespace {
+
+// extract_resolving's halving, over any way of extracting at a grid (a scene's new system, or
+// one already built). `say`: each step on standard error.
+template <class Extract>
+Extraction resolve(const Extract& extract, double grid_deg, bool grid_given, bool say, double& grid_deg_used) {
   double grid = grid_deg;
   // A default grid whose full-turn sweep did not close (it changed assembly between two grid
   // points: a 1:20 gear turns its joint 200° per 10° step) is halved too: a given one is the
@@ -108,11 +112,11 @@ Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool g
   Extraction e;
   for (;;) {
     try {
-      e = extract_from_full(scene, grid, method);
+      e = extract(grid);
       break;
     } catch (const reduced::SweepNotClosed&) {
       if (grid_given || grid / 2 < kMinAutoGrid_deg - 1e-9) throw;
-      std::fprintf(stderr, "rdyn: the %g° sweep did not close its turn: extracting at %g°\n", grid, grid / 2);
+      if (say) std::fprintf(stderr, "rdyn: the %g° sweep did not close its turn: extracting at %g°\n", grid, grid / 2);
       grid /= 2;
     }
   }
@@ -120,15 +124,30 @@ Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool g
     const int c = e.samples.column("m1");
     const double miss = c < 0 ? NAN : reduced::calc_half_grid_miss(e.samples.columns[c]);
     if (!(miss > kAutoRefineMiss)) break;
-    std::fprintf(stderr,
-                 "rdyn: the %g° table does not resolve this mechanism (m1 from every other grid point misses the "
-                 "others by %.2g %% of its peak): extracting at %g°\n",
-                 grid, 100 * miss, grid / 2);
+    if (say)
+      std::fprintf(stderr,
+                   "rdyn: the %g° table does not resolve this mechanism (m1 from every other grid point misses the "
+                   "others by %.2g %% of its peak): extracting at %g°\n",
+                   grid, 100 * miss, grid / 2);
     grid /= 2;
-    e = extract_from_full(scene, grid, method);
+    e = extract(grid);
   }
   grid_deg_used = grid;
   return e;
+}
+
+}  // namespace
+
+Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool grid_given, reduced::Method method,
+                             double& grid_deg_used) {
+  return resolve([&](double g) { return extract_from_full(scene, g, method); }, grid_deg, grid_given, true,
+                 grid_deg_used);
+}
+
+Extraction extract_resolving(const engine::FullModel& model, double grid_deg, bool grid_given, reduced::Method method,
+                             bool say, double& grid_deg_used) {
+  return resolve([&](double g) { return extract_from_full(model, g, method); }, grid_deg, grid_given, say,
+                 grid_deg_used);
 }
 
 }  // namespace rdyn::validate

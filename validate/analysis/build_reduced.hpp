@@ -57,5 +57,9 @@ inline constexpr double kMinAutoGrid_deg = 1.25;
 // off, exit 0): 2.5°, then every column within 4.5e-5 of the full model's peak.
 Extraction extract_resolving(const models::Scene& scene, double grid_deg, bool grid_given, reduced::Method method,
                              double& grid_deg_used);
+// The same on a full model already built (calibration's walk and extraction share one system);
+// `say` false keeps the steps off standard error (a sweep's cases).
+Extraction extract_resolving(const engine::FullModel& model, double grid_deg, bool grid_given, reduced::Method method,
+                             bool say, double& grid_deg_used);
 
 }  // namespace rdyn::validate

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 
@@ -153,6 +154,7 @@ CalibrationOptions calibration_options_of(const models::Scene& scene, double cad
   o.load = !load.empty() ? load : v.calibrate_load;
   o.load_field = !load.empty() ? "--load" : "validation.calibrate.load";
   o.grid_deg = v.calibrate_grid_deg;
+  o.grid_given = v.calibrate_grid_given;
   return o;
 }
 
@@ -215,16 +217,21 @@ void fail_dead_points(const models::Scene& scene) {
                                        scene.independent));
 }
 
-}  // namespace
-
-namespace {
-
 // check_calibratable's full-model part on a built system.
 void check_full_turn(const models::Scene& scene, const engine::FullModel& model) {
   const engine::FullWorkspace assembled(model);  // throws EngineError naming a loop that cannot close
   // The walk alone: a turn is full or not whatever singular points it holds (the scan for them
   // was 90 % of a sweep case over the rider's height).
   if (!engine::calc_independent_domain_edges(model).periodic) fail_dead_points(scene);
+}
+
+CalibrationTable table_of(Extraction e, const CalibrationOptions& opt, bool walked, double grid_deg) {
+  CalibrationTable t;
+  t.grid_deg = grid_deg;
+  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
+  t.samples = std::move(e.samples);
+  t.walked = walked;
+  return t;
 }
 
 }  // namespace
@@ -604,20 +611,12 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel&& m, const models::Sce
   return r;
 }
 
-namespace {
-
-CalibrationTable table_of(Extraction e, const CalibrationOptions& opt, bool walked) {
-  CalibrationTable t;
-  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
-  t.samples = std::move(e.samples);
-  t.walked = walked;
-  return t;
-}
-
-}  // namespace
-
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
-  return extract_calibration_table(scene, opt, std::nullopt);
+  CalibrationTable t = extract_calibration_table(scene, opt, std::nullopt);
+  if (t.grid_deg != opt.grid_deg)
+    std::fprintf(stderr, "rdyn: the %g° table does not resolve this mechanism (m1's half-grid miss above %g): "
+                 "calibrating on a %g° table\n", opt.grid_deg, kAutoRefineMiss, t.grid_deg);
+  return t;
 }
 
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt,
@@ -631,11 +630,12 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
   const engine::FullModel model(scene);
   const bool continued = neighbour && neighbour->min_conditioning >= kWalkSkipConditioning &&
                          neighbour->topology == topology_key(scene);
+  double grid = opt.grid_deg;  // refined quietly: a sweep's cases
   if (!continued) {
     check_full_turn(scene, model);
-    auto e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+    auto e = extract_resolving(model, opt.grid_deg, opt.grid_given, reduced::Method::Kinetostatic, false, grid);
     if (e.range || !e.samples.periodic) fail_dead_points(scene);
-    return table_of(std::move(e), opt, true);
+    return table_of(std::move(e), opt, true, grid);
   }
   // Continuation from a neighbour far from dead points: the extraction first, the walk only
   // where this case's own sweep gives a reason (a failure, a dead point, a grid sample nearer
@@ -643,7 +643,7 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
   // come after the walk's, as in the cold route.
   Extraction e;
   try {
-    e = extract_from_full(model, opt.grid_deg, reduced::Method::Kinetostatic);
+    e = extract_resolving(model, opt.grid_deg, opt.grid_given, reduced::Method::Kinetostatic, false, grid);
   } catch (...) {
     check_full_turn(scene, model);
     throw;
@@ -653,7 +653,7 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
                     !(c >= kWalkSkipDrop * neighbour->min_conditioning);
   if (walk) check_full_turn(scene, model);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
-  return table_of(std::move(e), opt, walk);
+  return table_of(std::move(e), opt, walk, grid);
 }
 
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {
@@ -672,6 +672,7 @@ CalibrationResult calibrate(const models::Scene& scene, const CalibrationTable& 
   const Selection sel = select_load(scene, opt);
   CalibrationResult r = calibrate_reduced(
       reduced::make_reduced_model(table.samples, with_unit_load(scene, opt), table.table), scene, opt, progress);
+  r.grid_deg = table.grid_deg > 0 ? table.grid_deg : opt.grid_deg;
 
   // Confirmation with the full model from the same point of the steady cycle.
   r.mean_cadence_hz_full = r.speed_fluctuation_full = r.peak_force_full_N = NAN;

@@ -30,6 +30,9 @@ struct CalibrationOptions {
   std::string load;         // a joint_torque, point_force or motor name, or names joined by '+'; empty: every joint torque together
   std::string load_field = "--load";  // where `load` came from (named in refusals)
   double grid_deg = 10.0;
+  // false: grid_deg is a default, halved while the table does not resolve m1 (extract_resolving,
+  // validate/analysis/build_reduced.hpp); true: the user's (--grid-deg, the scene's grid_deg).
+  bool grid_given = true;
   std::string interpolation = "fourier";
   double tolerance = 1e-10;    // reduced integrator
   // Full-model confirmation from the reduced steady cycle's point: run until the mean cadence
@@ -80,6 +83,7 @@ struct CalibrationResult {
   // in m), ∫ (1 − r q̇/ω0) r dq (motors).
   double work_per_rev_per_unit = 0.0;
   double steady_q = 0.0, steady_qdot = 0.0;  // a point of the steady cycle (initial conditions)
+  double grid_deg = NAN;                // the table's grid [deg] (opt.grid_deg, or finer when refined)
   int evaluations = 0;                  // steady cycles computed
   int load_searches = 0;                // Brent searches of the load value (power mode: one per coefficient tried)
   double wall_time_s = 0.0;
@@ -139,6 +143,7 @@ struct CalibrationTable {
   reduced::Samples samples;
   reduced::Table table;
   bool walked = true;  // the dead-point walk ran (false: its neighbour's continuation stood in for it)
+  double grid_deg = 0.0;  // its grid [deg]: opt.grid_deg, or finer when a default grid was refined
 };
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt);
 

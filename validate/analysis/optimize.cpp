@@ -405,13 +405,14 @@ CalibrationOptions calibration_options_for(const OptimizeOptions& opt) {
 
 // Stage 2: the one extraction; the shape's angle is q itself or the joint-position column of `of`.
 reduced::Samples extract_for_design(const models::Scene& s0, const Design& design, const models::Scene& scene,
-                                    const OptimizeOptions& opt) {
+                                    const OptimizeOptions& opt, double& grid_deg_used) {
   models::Scene s_extract = s0;
   if (design.of != scene.independent &&
       std::find(s_extract.outputs.joints.begin(), s_extract.outputs.joints.end(), design.of) ==
           s_extract.outputs.joints.end())
     s_extract.outputs.joints.push_back(design.of);
-  return extract_from_full(s_extract, opt.grid_deg, reduced::Method::Kinetostatic).samples;
+  return extract_resolving(s_extract, opt.grid_deg, opt.grid_given, reduced::Method::Kinetostatic, grid_deg_used)
+      .samples;
 }
 
 // The design with every group's bound set: the documented default is 5× the constant strategy's
@@ -535,7 +536,8 @@ OptimizeResult optimize(const models::Scene& scene_in, const OptimizeOptions& op
   w.design = &design;
   w.copt = copt;
   w.interp = reduced::parse_interpolation(opt.interpolation);
-  const reduced::Samples samples = extract_for_design(s0, design, scene, opt);
+  const reduced::Samples samples = extract_for_design(s0, design, scene, opt, r.grid_deg);
+  w.copt.grid_deg = r.grid_deg;
   const reduced::ReducedModel base = reduced::make_reduced_model(samples, with_unit_load(s0, copt), w.interp);
   w.samples = &samples;
   w.base = &base;

@@ -40,6 +40,7 @@ struct OptimizeOptions {
   int max_evaluations = 400;   // objective evaluations by the optimiser, [1, kMaxOptimizeEvaluations]
   double rel_tolerance = 1e-4; // NLopt's relative tolerance on the parameters and the objective
   double grid_deg = 10.0;
+  bool grid_given = true;  // false: a default, halved while it does not resolve m1 (extract_resolving)
   std::string interpolation = "fourier";
   double full_duration_s = 20.0;  // each full-model confirmation run [s]
   double full_skip_s = 2.0;       // the window starts after this [s] (whole revolutions from there)
@@ -81,6 +82,7 @@ struct OptimizeResult {
   double p = 0.0;
   int harmonics = 0;
   double max_load = 0.0, resistance_coefficient = 0.0, cadence_hz = 0.0, power_w = 0.0;
+  double grid_deg = 0.0;                  // the table's grid (OptimizeOptions::grid_deg, or finer when refined)
   std::vector<std::string> design_loads;  // names, in scene order of the optimised scene
   std::vector<std::string> same_as;       // per design load: the load it is tied to ("" none)
   std::vector<double> shift_deg;

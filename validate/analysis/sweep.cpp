@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "engine/full_model.hpp"
 #include "models/scene_hash.hpp"
 #include "models/scene_write.hpp"
 #include "models/scene_yaml.hpp"
@@ -41,7 +42,8 @@ std::string sweep_defining_text(const models::Scene& base, const SweepPlan& p) {
     t += "\n";
   }
   const CalibrationOptions& c = p.calibration;
-  t += fmt::format("cadence {:a} power {:a} grid {:a}\n", c.cadence_hz, c.power_w, c.grid_deg);
+  t += fmt::format("cadence {:a} power {:a} grid {:a}{}\n", c.cadence_hz, c.power_w, c.grid_deg,
+                   c.grid_given ? "" : " refined");
   if (p.opt.drive_cadence_hz != 0) t += fmt::format("drive {:a}\n", p.opt.drive_cadence_hz);
   str(p.opt.load);
   str(p.header);
@@ -165,7 +167,10 @@ std::string driven_fields(const SweepPlan& plan, const models::Scene& case_scene
   if (!cache.drive || cache.drive->first != key) {
     cache.drive.reset();
     ++cache.extracted;
-    cache.drive.emplace(key, extract_from_full(scene, plan.opt.grid_deg, reduced::Method::Kinetostatic).samples);
+    double grid = 0;  // a default grid refined quietly, as a calibrated case's
+    cache.drive.emplace(key, extract_resolving(engine::FullModel(scene), plan.calibration.grid_deg,
+                                               plan.calibration.grid_given, reduced::Method::Kinetostatic, false, grid)
+                                 .samples);
   }
   const auto model = reduced::make_reduced_model(cache.drive->second, scene, reduced::Interpolation::Fourier);
   const auto motion = revolution_motion(scene.initial.q, plan.opt.drive_cadence_hz);
@@ -245,12 +250,16 @@ SweepPlan plan_sweep(const SweepOptions& opt) {
     if (base.find_joint(base.independent)->type != models::JointType::Revolute)
       throw models::SceneError(base.source_file, 0, "--drive-cadence-hz",
                                "a constant rate needs a revolute independent coordinate");
-    copt.grid_deg = opt.grid_deg;
+    copt.grid_deg = opt.grid_given ? opt.grid_deg : base.validation.calibrate_grid_deg;
+    copt.grid_given = opt.grid_given || base.validation.calibrate_grid_given;
     copt.cadence_hz = 0.0;
   } else {
     // The same options as `rdyn calibrate`: the command line, else the scene's validation.calibrate.
     copt = calibration_options_of(base, opt.cadence_hz, opt.power_w, opt.load);
-    copt.grid_deg = opt.grid_deg;
+    if (opt.grid_given) {  // else the scene's grid_deg, or 10° refined where it does not resolve m1
+      copt.grid_deg = opt.grid_deg;
+      copt.grid_given = true;
+    }
     copt.full_max_s = 0.0;  // reduced model only: this is what sweeps are for
     if (!(copt.cadence_hz > 0))
       throw models::SceneError(base.source_file, 0, "--cadence-hz",

@@ -31,6 +31,9 @@ struct SweepOptions {
   int shard = 0, shards = 1;
   int threads = 0;          // 0: hardware threads
   double grid_deg = 10.0;
+  // false: the scene's validation.calibrate.grid_deg, else 10° halved per case while its table
+  // does not resolve m1 (extract_resolving, validate/analysis/build_reduced.hpp).
+  bool grid_given = false;
   // Non-zero: a drive sweep — each case is driven at this constant rate [rev/s] for one
   // revolution (reduced model, revolution_motion in drive.hpp) instead of calibrated, and its
   // row gives the drive's RMS, peak and mean, the mean and peak power and the peak constraint

@@ -357,6 +357,7 @@ CalibrationOptions check_calibrate_args(const models::Scene& scene, const Calibr
                                                   a.power_given ? a.power_w : 0.0, a.load);
   if (!a.cadence_given && !(scene.validation.calibrate_cadence_Hz > 0)) opt.cadence_hz = a.cadence_hz;
   if (a.grid_given) opt.grid_deg = a.grid_deg;
+  opt.grid_given = a.grid_given || opt.grid_given;
   opt.interpolation = a.interpolation;
   return opt;
 }
@@ -374,6 +375,7 @@ nlohmann::json calibration_json(const models::Scene& scene, const CalibrationOpt
       {"load_value", r.load_value},
       {"load_unit", r.load_unit},
       {"initial_guess", r.initial_guess},
+      {"grid_deg", number_or_null(r.grid_deg)},
       {"resistance_coefficient", number_or_null(r.resistance_coefficient)},
       {"mean_cadence_hz_reduced", r.mean_cadence_hz_reduced},
       {"mean_cadence_hz_full", number_or_null(r.mean_cadence_hz_full)},
@@ -398,6 +400,7 @@ nlohmann::json calibration_json(const models::Scene& scene, const CalibrationOpt
     j["initial_guess_Nm"] = r.initial_guess;
     j["drive_work_per_rev_per_Nm"] = r.work_per_rev_per_unit;
   }
+  if (std::isfinite(r.grid_deg) && r.grid_deg != opt.grid_deg) j["grid_refined_from_deg"] = opt.grid_deg;
   return j;
 }
 
@@ -475,6 +478,7 @@ SweepOptions check_sweep_args(const SweepArgs& a) {
   o.load = a.load;
   o.threads = a.threads.value_or(0);  // 0: the hardware's threads
   o.grid_deg = a.grid_deg;
+  o.grid_given = a.grid_given;
   o.peaks = a.peaks;  // checked against the scene by plan_sweep
   require_grid("--grid-deg", a.grid_deg);
   if (a.drive_cadence_hz) {  // a typed 0 is refused, not "no drive sweep"

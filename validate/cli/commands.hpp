@@ -137,6 +137,7 @@ struct SweepArgs {
   std::string load;  // --load, as for calibrate
   std::optional<double> drive_cadence_hz;      // a drive sweep at this rate [rev/s] (no calibration)
   double grid_deg = 10.0;
+  bool grid_given = false;  // else the scene's validation.calibrate.grid_deg, else 10 (refined)
   std::vector<std::string> peaks;  // --peak COLUMN (repeatable): a peak_<COLUMN> column each
   bool force = false;
   bool resume = false;  // skip when --out already holds this shard complete

@@ -180,7 +180,10 @@ void add_sweep_command(CLI::App& app, SweepArgs& sw) {
       "Calibration power [W] (default: the scene's validation.calibrate; none: the resistances stay as given)");
   auto* load = sweep->add_option("--load", sw.load, "The drive load to calibrate, as for calibrate --load")
                    ->check(names_a_load());
-  auto* grid = sweep->add_option("--grid-deg", sw.grid_deg, "Reduced table grid [deg] (default 10)");
+  auto* grid = sweep->add_option("--grid-deg", sw.grid_deg,
+                                 "Reduced table grid [deg] (default: the scene's validation.calibrate.grid_deg, else "
+                                 "10, halved per case while it does not resolve the mechanism)")
+                   ->each([&sw](const std::string&) { sw.grid_given = true; });
   auto* drive = sweep->add_option_function<double>(
       "--drive-cadence-hz", [&sw](const double& v) { sw.drive_cadence_hz = v; },
       "Drive each case at this constant rate [rev/s] for one revolution (reduced model, as rdyn drive) instead of "

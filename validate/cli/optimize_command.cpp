@@ -59,6 +59,7 @@ OptimizeOptions optimize_options_of(const models::Scene& scene, const OptimizeAr
   // The operating point's table: --grid-deg, else the scene's validation.calibrate.grid_deg (as
   // calibrate; a scene whose 10° table is too coarse there declares a finer one), else 10°.
   opt.grid_deg = a.grid_given || !(copt.grid_deg > 0) ? a.grid_deg : copt.grid_deg;
+  opt.grid_given = a.grid_given || copt.grid_given;  // else 10°, halved while it does not resolve m1
   opt.interpolation = a.interpolation;
   opt.full_duration_s = a.full_duration_s;
   opt.full_skip_s = std::min(2.0, 0.5 * a.full_duration_s);
@@ -78,7 +79,8 @@ int run_optimize(const OptimizeArgs& a) {
   if (!failure.empty()) throw models::NumericalError(failure);
   auto summary = optimize_summary(r);
   summary["nonnegative_repair"] = r.nonnegative_repair;
-  summary["grid_deg"] = opt.grid_deg;  // the table's grid (--grid-deg or the scene's validation.calibrate)  // the lift of a nonnegative shape after the search
+  summary["grid_deg"] = r.grid_deg;  // the table's grid (--grid-deg, the scene's validation.calibrate, or refined)
+  if (r.grid_deg != opt.grid_deg) summary["grid_refined_from_deg"] = opt.grid_deg;
   // The mechanism drawn, and both strategies over one steady cycle of the full model from their
   // steady points (analysis/cycle_run.hpp), which the report shows side by side.
   summary["mechanism_svg"] =

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <cctype>
@@ -185,6 +186,7 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
   for (size_t i = 0; i < files.size(); ++i) {
     const std::string stem = fs::path(files[i]).stem().string();
     progress.note(fmt::format("[{}/{}] {}", i + 1, files.size(), files[i]));
+    const auto started = std::chrono::steady_clock::now();
     nlohmann::json entry;
     try {
       const auto scene = models::load_scene(files[i], overrides);
@@ -199,6 +201,11 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
       all_pass = false;
     }
     entry["report"] = stem + "/report.html";
+    // One line a scene whatever standard error is (a suite runs for minutes, often into a log):
+    // the progress above is drawn on a terminal only.
+    std::fprintf(stderr, "rdyn: suite [%zu/%zu] %s: %s (%.0f s)\n", i + 1, files.size(), stem.c_str(),
+                 entry.value("status", std::string("?")).c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
     rows += suite_row(stem, entry);
     scenes.push_back(entry);
   }

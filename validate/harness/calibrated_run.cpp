@@ -47,10 +47,10 @@ std::optional<CalibratedRun> calc_calibrated_run(const models::Scene& scene, con
   fo.output_interval_s = dt_s;
   fo.tolerance = 1e-10;
   c.full = engine::simulate_full(engine::FullModel(sc), fo);
-  c.grid_deg = opt.grid_deg;
-  const bool same_grid = std::abs(samples10.step * 180 / M_PI - opt.grid_deg) < 1e-9 * opt.grid_deg;
+  c.grid_deg = std::isfinite(r.grid_deg) ? r.grid_deg : opt.grid_deg;  // the calibration's (refined) grid
+  const bool same_grid = std::abs(samples10.step * 180 / M_PI - c.grid_deg) < 1e-9 * c.grid_deg;
   const reduced::Samples table =
-      same_grid ? samples10 : extract_from_full(extraction_scene(sc), opt.grid_deg, reduced::Method::Kinetostatic).samples;
+      same_grid ? samples10 : extract_from_full(extraction_scene(sc), c.grid_deg, reduced::Method::Kinetostatic).samples;
   const auto model = reduced::make_reduced_model(table, extraction_scene(sc), reduced::Interpolation::Fourier);
   reduced::ReducedOptions ro;
   ro.duration_s = duration;

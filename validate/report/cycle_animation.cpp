@@ -29,32 +29,59 @@ nlohmann::json animation_record(const models::Scene& scene, const CycleStart& st
            {{"t_s", f.t_s}, {"q", f.q}, {"q_joint", f.q_joint}, {"arrows", arrows}, {"traces", f.traces}}}};
 }
 
-AnimationRecord read_animation_record(const nlohmann::json& r) {
+namespace {
+
+// A field of a record in a summary.json (perhaps edited by hand), named by its JSON path when it
+// is missing or not of the type rdyn writes there.
+const nlohmann::json& field(const nlohmann::json& j, const std::string& key, const std::string& path) {
+  if (!j.is_object() || !j.contains(key)) throw std::invalid_argument("summary.json: " + path + "." + key + " is missing");
+  return j.at(key);
+}
+
+template <class T>
+T field_as(const nlohmann::json& j, const std::string& key, const std::string& path) {
+  try {
+    return field(j, key, path).get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw std::invalid_argument("summary.json: " + path + "." + key + " is not of the type rdyn writes there");
+  }
+}
+
+}  // namespace
+
+AnimationRecord read_animation_record(const nlohmann::json& r, const std::string& path) {
   AnimationRecord a;
-  a.title = r.at("title").get<std::string>();
-  a.scene = models::parse_scene(r.at("scene_yaml").get<std::string>(), "summary.json (animation)");
-  const auto& st = r.at("start");
-  a.start = {st.at("t_s").get<double>(), st.at("q").get<double>(), st.at("qdot").get<double>(),
-             st.at("duration_s").get<double>(), st.value("revolution", true)};
-  const auto& f = r.at("frames");
-  a.frames.t_s = f.at("t_s").get<std::vector<double>>();
-  a.frames.q = f.at("q").get<std::vector<double>>();
-  a.frames.q_joint = f.at("q_joint").get<std::vector<std::vector<double>>>();
+  a.title = field_as<std::string>(r, "title", path);
+  a.scene = models::parse_scene(field_as<std::string>(r, "scene_yaml", path), "summary.json (" + path + ")");
+  const auto& st = field(r, "start", path);
+  const std::string sp = path + ".start";
+  a.start = {field_as<double>(st, "t_s", sp), field_as<double>(st, "q", sp), field_as<double>(st, "qdot", sp),
+             field_as<double>(st, "duration_s", sp), st.contains("revolution") ? field_as<bool>(st, "revolution", sp) : true};
+  const auto& f = field(r, "frames", path);
+  const std::string fp = path + ".frames";
+  a.frames.t_s = field_as<std::vector<double>>(f, "t_s", fp);
+  a.frames.q = field_as<std::vector<double>>(f, "q", fp);
+  a.frames.q_joint = field_as<std::vector<std::vector<double>>>(f, "q_joint", fp);
   for (const auto& qj : a.frames.q_joint)
     if (qj.size() != a.scene.joints.size())
-      throw std::invalid_argument("summary.json (animation): a frame without one coordinate per joint");
-  for (const auto& ar : f.at("arrows")) {
-    const auto p = ar.at("point").get<std::vector<double>>();
-    if (p.size() != 2) throw std::invalid_argument("summary.json (animation): an arrow's point is not [x, y]");
-    a.frames.arrows.push_back({ar.at("name").get<std::string>(), ar.at("body").get<std::string>(), {p[0], p[1]},
-                               ar.at("fx_N").get<std::vector<double>>(), ar.at("fy_N").get<std::vector<double>>()});
+      throw std::invalid_argument("summary.json: " + fp + ".q_joint: a frame without one coordinate per joint");
+  const auto& arrows = field(f, "arrows", fp);
+  if (!arrows.is_array()) throw std::invalid_argument("summary.json: " + fp + ".arrows is not a list");
+  for (size_t i = 0; i < arrows.size(); ++i) {
+    const auto& ar = arrows[i];
+    const std::string ap = fmt::format("{}.arrows[{}]", fp, i);
+    const auto p = field_as<std::vector<double>>(ar, "point", ap);
+    if (p.size() != 2) throw std::invalid_argument("summary.json: " + ap + ".point is not [x, y]");
+    a.frames.arrows.push_back({field_as<std::string>(ar, "name", ap), field_as<std::string>(ar, "body", ap),
+                               {p[0], p[1]}, field_as<std::vector<double>>(ar, "fx_N", ap),
+                               field_as<std::vector<double>>(ar, "fy_N", ap)});
   }
-  a.frames.traces = f.at("traces").get<std::vector<std::string>>();
+  a.frames.traces = field_as<std::vector<std::string>>(f, "traces", fp);
   return a;
 }
 
-std::string animation_record_html(const nlohmann::json& record) {
-  const AnimationRecord a = read_animation_record(record);
+std::string animation_record_html(const nlohmann::json& record, const std::string& path) {
+  const AnimationRecord a = read_animation_record(record, path);
   return "<style>" + animation_css() + "</style>\n" + animation_section(a.scene, a.frames, a.title);
 }
 
@@ -72,11 +99,11 @@ std::string validate_animation_html(const nlohmann::json& summary) {
     return "<h2>The mechanism in motion</h2><p class=warn>Not animated: " +
            html_escape(summary.at("animation_error").get<std::string>()) + "</p>\n";
   if (!summary.contains("animation")) return "";
-  const auto& st = summary.at("animation").at("start");
-  const double t0 = st.at("t_s").get<double>(), d = st.at("duration_s").get<double>();
+  const AnimationRecord a = read_animation_record(summary.at("animation"), "animation");
+  const double t0 = a.start.t_s, d = a.start.duration_s;
   // A coordinate that does not turn (a rocker, a slider) has no cycles to speak of: its last stretch.
   const std::string head =
-      st.value("revolution", true)
+      a.start.revolution
           ? fmt::format("<h2>The mechanism over one steady cycle</h2><p>The reference's last whole revolution, "
                         "from t = {:.4g} s for {:.4g} s",
                         t0, d)
@@ -86,21 +113,22 @@ std::string validate_animation_html(const nlohmann::json& summary) {
   return head +
          ": the full model (Simbody) restarted from the reference's state there, every position placed from the "
          "joint coordinates it outputs. <code>report.html#t=T</code> shows the frame nearest T.</p>\n" +
-         animation_record_html(summary.at("animation"));
+         animation_record_html(summary.at("animation"), "animation");
 }
 
 std::string strategies_animation_html(const nlohmann::json& summary) {
   if (!summary.contains("animations")) return "";
   const auto& an = summary.at("animations");
+  if (!an.is_object()) throw std::invalid_argument("summary.json: animations is not an object");
   return "<h2>The two strategies over one steady cycle</h2><p>Each strategy's full model (Simbody) from its steady "
          "point, over one period at its full-model cadence; the arrows are the scene's requested constraint "
          "forces. "
          "<code>report.html#t=T</code> shows the frame nearest T in both.</p>\n"
          "<div class=\"strategies\" style=\"display:flex;gap:1em;flex-wrap:wrap\">"
          "<div data-strategy=\"constant\" style=\"flex:1 1 420px;min-width:0\">" +
-         animation_record_html(an.at("constant")) +
+         animation_record_html(field(an, "constant", "animations"), "animations.constant") +
          "</div><div data-strategy=\"optimised\" style=\"flex:1 1 420px;min-width:0\">" +
-         animation_record_html(an.at("optimised")) + "</div></div>\n";
+         animation_record_html(field(an, "optimised", "animations"), "animations.optimised") + "</div></div>\n";
 }
 
 }  // namespace rdyn::validate

@@ -30,14 +30,14 @@ struct AnimationRecord {
   MechanismFrames frames;
   std::string title;
 };
-// Reads a record back. Throws nlohmann::json exceptions for a missing key or a wrong type,
-// models::SceneError for a scene that does not read, std::invalid_argument for frames of the
-// wrong sizes.
-AnimationRecord read_animation_record(const nlohmann::json& record);
+// Reads a record back (`path`: where it sits in summary.json, for messages). Throws
+// std::invalid_argument naming the JSON path of a missing key, a wrong type or frames of the
+// wrong sizes, models::SceneError for a scene that does not read.
+AnimationRecord read_animation_record(const nlohmann::json& record, const std::string& path = "animation");
 
 // The record's animation (mechanism_drawing.hpp's animation_section, with its style), under its
 // title.
-std::string animation_record_html(const nlohmann::json& record);
+std::string animation_record_html(const nlohmann::json& record, const std::string& path = "animation");
 
 // The assembled mechanism (summary["mechanism_svg"], `inspect --svg`'s drawing) as an image from a
 // data: URI — a summary.json edited by hand cannot run script through it; "" when there is none.

@@ -80,6 +80,10 @@ TEST(ValidateCommand, SuiteWritesReportsAndFailsOnAThreshold) {
   EXPECT_EQ(j["scenes"][1]["status"], "fail");
   EXPECT_EQ(j["scenes"][2]["status"], "error");
   EXPECT_EQ(j["scenes"][3]["status"], "pass") << j["scenes"][3].dump(1);
+  // Standard error is a pipe here, not a terminal: each scene still says how it ended, in order.
+  const size_t said_a = out.find("suite [1/4] a_pass: pass ("), said_b = out.find("suite [2/4] b_fail: fail ("),
+               said_c = out.find("suite [3/4] c_broken: error ("), said_d = out.find("suite [4/4] d_transient: pass (");
+  EXPECT_TRUE(said_a < said_b && said_b < said_c && said_c < said_d && said_d != std::string::npos) << out;
   // The index carries each scene's verdicts: the failing threshold shows as FAIL on its row.
   const std::string index = slurp(dir / "out" / "index.html");
   const size_t row_b = index.find("b_fail/report.html"), row_c = index.find("c_broken/report.html");

@@ -82,7 +82,20 @@ TEST(CycleAnimation, HandEditedTextIsEscapedAndBadRecordsAreRefused) {
   EXPECT_THROW(read_animation_record(wrong), std::invalid_argument);
   nlohmann::json missing = fourbar_record("t");
   missing.erase("frames");
-  EXPECT_THROW(read_animation_record(missing), nlohmann::json::exception);
+  try {  // a hand-edited summary: the message names the JSON path of what is missing or mistyped
+    read_animation_record(missing, "animations.constant");
+    ADD_FAILURE() << "a record without frames was read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "summary.json: animations.constant.frames is missing");
+  }
+  nlohmann::json mistyped = fourbar_record("t");
+  mistyped["frames"]["arrows"] = {{{"name", "a"}, {"body", "crank"}, {"point", {0, "x"}}}};
+  try {
+    read_animation_record(mistyped);
+    ADD_FAILURE() << "an arrow's point [0, \"x\"] was read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "summary.json: animation.frames.arrows[0].point is not of the type rdyn writes there");
+  }
   nlohmann::json bad_scene = fourbar_record("t");
   bad_scene["scene_yaml"] = "bodies: [";
   EXPECT_THROW(read_animation_record(bad_scene), models::SceneError);
