@@ -61,7 +61,7 @@ void add_simulate_command(CLI::App& app, SimulateArgs& sim) {
   auto* red = simulate->add_option_group("reduced model");
   red->add_option("--table", sim.table, "Reduced table from `rdyn extract` (default: extract now)");
   red->add_option("--grid-deg", sim.grid_deg,
-                  "Grid step when extracting [deg] (default 10, as the paper, halved down to 1.25 while the table "
+                  "Grid step when extracting [deg] (default 10, as the paper, halved down to 0.3125 while the table "
                   "does not resolve m1: its half-grid miss above 1e-3)")
       ->each([&sim](const std::string&) { sim.grid_given = true; });
   red->add_option("--method", sim.method, "Extraction method")

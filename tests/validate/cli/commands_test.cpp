@@ -96,7 +96,7 @@ TEST_F(Cli, ACoarsePeriodicTableIsFlaggedAndAFineOneIsNot) {
 
 // Without --grid-deg a periodic table that does not resolve m1 is extracted again at half the
 // step (the Jansen leg: 10° → 5° → 2.5°; its 10° run's q̈ was 6 % off with exit 0): the default
-// run's q̈ then agrees with a run on the finest automatic grid (1.25°) to 1e-3 of its peak, where
+// run's q̈ then agrees with a run on a 1.25° grid to 1e-3 of its peak, where
 // the 10° run's does not; the fourbar, resolved at 10°, keeps it.
 TEST_F(Cli, AnUnresolvedDefaultGridIsRefined) {
   const std::string jansen = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml";
