@@ -291,7 +291,7 @@ void check_energy_balance(const models::TimeSeries& ts, double tolerance, const 
   scale_J = std::max(scale_J, *hi - *lo);
   for (double w : ts.work) scale_J = std::max(scale_J, std::abs(w));
   if (eb.max_residual_J <= tolerance * scale_J + 1e-12) return;
-  throw models::NumericalError(fmt::format(
+  throw EnergyBalanceError(fmt::format(
       "reduced model's energy balance does not close: max|E − E0 − W| = {:.3g} J at t = {:.6g} s is {:.3g} % of the "
       "energy scale {:.3g} J (largest |E|, |W| or range of E; limit {:g} %): the integration lost or invented energy "
       "({}; a fixed step too long, or a table too coarse for the motion — its interpolated m2 is then not "

@@ -42,8 +42,12 @@ models::TimeSeries simulate_reduced(const ReducedModel& m, double q0, double qdo
 // (above) only stops runs that blow up: a fixed-step run too coarse for its mechanism closes it
 // worse than that and still ends (the hard light-flywheel at 0.2 s steps: 18.6 J of 22.2 J).
 // 1 %: the light flywheel at 0.01 s steps is at 0.9 %, the bicycle at 0.02 s at 5e-5.
-// Throws models::NumericalError naming the residual, where it is largest and `how` (the
-// integrator and its step or tolerance).
+// Throws EnergyBalanceError (a models::NumericalError) naming the residual, where it is largest
+// and `how` (the integrator and its step or tolerance).
+class EnergyBalanceError : public models::NumericalError {
+ public:
+  using models::NumericalError::NumericalError;
+};
 void check_energy_balance(const models::TimeSeries& ts, double tolerance, const std::string& how);
 
 }  // namespace rdyn::reduced

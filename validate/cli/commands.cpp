@@ -19,6 +19,7 @@
 #include "reduced/reduced_model.hpp"
 #include "reduced/simulate_reduced.hpp"
 #include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/unstable_rest.hpp"
 #include "validate/analysis/table_check.hpp"
 #include "models/scene_hash.hpp"
 #include "validate/analysis/calibrate.hpp"
@@ -141,6 +142,108 @@ void check_simulate_args(const models::Scene& scene, const SimulateArgs& a) {
                                     duration, duration / a.fixed_step, cli_limits::kMaxFixedSteps));
 }
 
+// The reduced model's run of simulate_scene on `table`, the --table file or a fresh extraction at
+// start_grid_deg (refined as extract_resolving refines a default one); grid_used_deg gets the
+// extraction's grid (0 for a table).
+models::TimeSeries simulate_reduced_once(const models::Scene& scene, const SimulateArgs& a, const reduced::Samples* table,
+                                         double duration, double dt_out, double start_grid_deg, double& grid_used_deg,
+                                         nlohmann::json& run) {
+  models::TimeSeries ts;
+  grid_used_deg = 0;
+  // Joint outputs: the table and the model carry one constraint line per reaction component.
+  // `reactions: all` gives those the reduced model can and names the others.
+  const models::Scene oscene = reduced_output_scene(scene, run);
+  const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
+  reduced::Samples samples;
+  double extraction_ms = 0.0;
+  if (table) {  // a table in memory (the Python module's Table)
+    samples = *table;
+    run["table"] = table->file.empty() ? std::string("(in memory)") : table->file;
+  } else if (!a.table.empty()) {
+    // Checked before opening: a FIFO without a writer would block (models::non_regular_file_kind).
+    if (const std::string kind = models::non_regular_file_kind(a.table); !kind.empty())
+      throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
+    samples = reduced::read_samples_csv(a.table);
+    run["table"] = a.table;
+  } else {
+    double grid = start_grid_deg;
+    auto e = extract_resolving(rscene, start_grid_deg, a.grid_given, reduced::parse_method(a.method), grid);
+    grid_used_deg = grid;
+    samples = std::move(e.samples);
+    extraction_ms = e.extraction_ms;
+    run.update({{"grid_deg", grid}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
+    if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;
+    if (e.range) {  // range table: its span [rad or m] and what ends it
+      run["independent_range"] = {{"min", e.range->min}, {"max", e.range->max}, {"min_edge", e.range->min_edge},
+                                  {"max_edge", e.range->max_edge}};
+      if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
+    }
+  }
+  // A table read from a file (here or by the Python module) without a content checksum: its
+  // values and annotations against a fresh extraction (validate/analysis/table_check.hpp),
+  // before the model is built from them (an m1 of 1e99 overshot to a negative interpolant there,
+  // reported without a line); a table of another scene keeps make_reduced_model's message.
+  if (!samples.file.empty() && !samples.content_checked && samples.scene_hash == models::scene_hash(rscene)) {
+    std::fprintf(stderr,
+                 "rdyn: warning: %s has no content checksum (written before rdyn recorded one): checking it "
+                 "against a fresh extraction of its scene; extract it again to skip this\n",
+                 samples.file.c_str());
+    check_table_against_scene(samples, rscene);
+  }
+  const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
+                                                 a.energy_consistent);
+  // A table of the same mechanism extracted without joint outputs (its hash does not cover
+  // outputs.joints or shaking, which add no constraint line): named with its file before the run (after
+  // make_reduced_model, whose scene check comes first).
+  if (reduced::wants_joint_outputs(oscene) && !samples.file.empty())
+    for (const auto& j : oscene.joints)
+      if (samples.column("p_" + j.name) < 0)
+        throw reduced::TableError(fmt::format(
+            "table {} has no column 'p_{}', which the scene's joint outputs (outputs.joints, reactions or shaking) "
+            "need: it was extracted from the scene without them; extract it again with `rdyn extract` for this "
+            "scene and its outputs",
+            samples.file, j.name));
+  warn_coarse_table(samples, run);
+  reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
+  ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
+  reduced::check_energy_balance(
+      ts, 0.01,
+      a.reduced_integrator == "rk4-fixed" ? fmt::format("rk4-fixed at {:g} s steps", opt.fixed_step_s)
+                                          : fmt::format("{} at tolerance {:g}", a.reduced_integrator, a.reduced_tolerance));
+  if (reduced::wants_joint_outputs(oscene)) reduced::add_joint_outputs(oscene, model, ts);
+  // The interpolant the table was built with (a range table's not-a-knot spline stands in for
+  // fourier), not the option's name.
+  run.update({{"interpolation", model.table.fit},
+              {"energy_consistent_m2", a.energy_consistent},
+              {"integrator", a.reduced_integrator},
+              {"tolerance", a.reduced_tolerance},
+              {"extraction_ms", extraction_ms},
+              {"events", ts.stats.events}});
+  return ts;
+}
+
+// A default grid (no --grid-deg, no table) whose run misses its own energy balance is halved and
+// the run repeated, down to kMinAutoGrid_deg: m1's half-grid miss (extract_resolving) does not
+// see every table too coarse for its motion — the high-saddle bicycle's 2.5° table resolves m1
+// (miss below 1e-3) while its run, through the steep me2 of an almost straight leg, misses its
+// energy balance by 3.7 %; at 1.25° it closes to 0.4 %.
+models::TimeSeries simulate_reduced_refining(const models::Scene& scene, const SimulateArgs& a,
+                                             const reduced::Samples* table, double duration, double dt_out,
+                                             nlohmann::json& run) {
+  double start = a.grid_deg, used = 0;
+  for (;;) {
+    try {
+      return simulate_reduced_once(scene, a, table, duration, dt_out, start, used, run);
+    } catch (const reduced::EnergyBalanceError&) {
+      const bool refinable = !table && a.table.empty() && !a.grid_given && used > 0;
+      if (!refinable || used / 2 < kMinAutoGrid_deg - 1e-9) throw;
+      std::fprintf(stderr, "rdyn: the reduced run on the %g° table misses its energy balance: extracting at %g°\n",
+                   used, used / 2);
+      start = used / 2;
+    }
+  }
+}
+
 SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, const reduced::Samples* table) {
   check_simulate_args(scene, a);
   const double duration = a.duration.value_or(scene.simulation.duration_s);
@@ -177,76 +280,19 @@ SimulateRun simulate_scene(const models::Scene& scene, const SimulateArgs& a, co
                    "run.json: rows_interpolated_at_rank_loss\n",
                    ts.stats.interpolated_rows);
   } else {
-    // Joint outputs: the table and the model carry one constraint line per reaction component.
-    // `reactions: all` gives those the reduced model can and names the others.
-    const models::Scene oscene = reduced_output_scene(scene, run);
-    const models::Scene rscene = reduced::wants_joint_outputs(oscene) ? reduced::with_reaction_requests(oscene) : oscene;
-    reduced::Samples samples;
-    double extraction_ms = 0.0;
-    if (table) {  // a table in memory (the Python module's Table)
-      samples = *table;
-      run["table"] = table->file.empty() ? std::string("(in memory)") : table->file;
-    } else if (!a.table.empty()) {
-      // Checked before opening: a FIFO without a writer would block (models::non_regular_file_kind).
-      if (const std::string kind = models::non_regular_file_kind(a.table); !kind.empty())
-        throw reduced::TableError(a.table + ": not a regular file (" + kind + "): give a table written by rdyn extract");
-      samples = reduced::read_samples_csv(a.table);
-      run["table"] = a.table;
-    } else {
-      double grid = a.grid_deg;
-      auto e = extract_resolving(rscene, a.grid_deg, a.grid_given, reduced::parse_method(a.method), grid);
-      samples = std::move(e.samples);
-      extraction_ms = e.extraction_ms;
-      run.update({{"grid_deg", grid}, {"method", a.method}, {"kinetostatic_calls", e.calls}});
-      if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;
-      if (e.range) {  // range table: its span [rad or m] and what ends it
-        run["independent_range"] = {{"min", e.range->min}, {"max", e.range->max}, {"min_edge", e.range->min_edge},
-                                    {"max_edge", e.range->max_edge}};
-        if (e.dead_min && e.dead_max) run["dead_points"] = {*e.dead_min, *e.dead_max};
-      }
-    }
-    // A table read from a file (here or by the Python module) without a content checksum: its
-    // values and annotations against a fresh extraction (validate/analysis/table_check.hpp),
-    // before the model is built from them (an m1 of 1e99 overshot to a negative interpolant there,
-    // reported without a line); a table of another scene keeps make_reduced_model's message.
-    if (!samples.file.empty() && !samples.content_checked && samples.scene_hash == models::scene_hash(rscene)) {
-      std::fprintf(stderr,
-                   "rdyn: warning: %s has no content checksum (written before rdyn recorded one): checking it "
-                   "against a fresh extraction of its scene; extract it again to skip this\n",
-                   samples.file.c_str());
-      check_table_against_scene(samples, rscene);
-    }
-    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation),
-                                                   a.energy_consistent);
-    // A table of the same mechanism extracted without joint outputs (its hash does not cover
-    // outputs.joints or shaking, which add no constraint line): named with its file before the run (after
-    // make_reduced_model, whose scene check comes first).
-    if (reduced::wants_joint_outputs(oscene) && !samples.file.empty())
-      for (const auto& j : oscene.joints)
-        if (samples.column("p_" + j.name) < 0)
-          throw reduced::TableError(fmt::format(
-              "table {} has no column 'p_{}', which the scene's joint outputs (outputs.joints, reactions or shaking) "
-              "need: it was extracted from the scene without them; extract it again with `rdyn extract` for this "
-              "scene and its outputs",
-              samples.file, j.name));
-    warn_coarse_table(samples, run);
-    reduced::ReducedOptions opt{duration, dt_out, a.reduced_tolerance, a.reduced_integrator, a.fixed_step};
-    ts = reduced::simulate_reduced(model, scene.initial.q, scene.initial.qdot, opt);
-    reduced::check_energy_balance(
-        ts, 0.01,
-        a.reduced_integrator == "rk4-fixed" ? fmt::format("rk4-fixed at {:g} s steps", opt.fixed_step_s)
-                                            : fmt::format("{} at tolerance {:g}", a.reduced_integrator, a.reduced_tolerance));
-    if (reduced::wants_joint_outputs(oscene)) reduced::add_joint_outputs(oscene, model, ts);
-    // The interpolant the table was built with (a range table's not-a-knot spline stands in for
-    // fourier), not the option's name.
-    run.update({{"interpolation", model.table.fit},
-                {"energy_consistent_m2", a.energy_consistent},
-                {"integrator", a.reduced_integrator},
-                {"tolerance", a.reduced_tolerance},
-                {"extraction_ms", extraction_ms},
-                {"events", ts.stats.events}});
+    ts = simulate_reduced_refining(scene, a, table, duration, dt_out, run);
   }
   const auto eb = energy_balance(ts);
+  if (const auto rest = find_unstable_rest(ts)) {
+    const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
+    run["unstable_rest"] = {{"t_from_s", rest->t_from_s}, {"t_to_s", rest->t_to_s}, {"q", rest->q}};
+    std::fprintf(stderr,
+                 "rdyn: warning: the motion crept to rest near %s (t = %.4g to %.4g s) and then left it: an unstable "
+                 "equilibrium, where when and which way it leaves is decided by differences far below the model's "
+                 "accuracy (the full and reduced models, or two tolerances, may part from there); run.json: "
+                 "unstable_rest\n",
+                 reduced::describe_q(revolute, rest->q, 6).c_str(), rest->t_from_s, rest->t_to_s);
+  }
   run.update({{"steps_taken", ts.stats.steps_taken},
               {"steps_attempted", ts.stats.steps_attempted},
               {"smallest_step_s", ts.stats.smallest_step_s},
