@@ -13,7 +13,7 @@ using namespace SimTK;
 
 SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
   SplitJacobian J;
-  m.matter.calcG(s, J.G);
+  calc_constraint_jacobian(m, s, J.G);
   std::vector<bool> keep(s.getNU(), true);
   keep[m.joint_mobod[m.independent].getFirstUIndex(s)] = false;
   for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;

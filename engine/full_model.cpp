@@ -262,6 +262,7 @@ void add_gear_couplers(FullModel::Impl& m, const std::vector<bool>& folded) {
     std::vector<MobilizedBodyIndex> mbs{m.joint_mobod[jr].getMobilizedBodyIndex(),
                                         m.joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
+    m.coupled_gears.push_back(static_cast<int>(g));
     m.constraints.emplace_back("gear '" + gear.name + "'",
                                Constraint::CoordinateCoupler(m.matter, new Function::Linear(coeff), mbs, qs));
   }
@@ -294,6 +295,7 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   try {
     default_state = system.realizeTopology();
     system.realizeModel(default_state);
+    jacobian_plan = make_constraint_jacobian_plan(*this);
   } catch (const std::exception& e) {
     throw EngineError(std::string("Simbody could not build the system: ") + describe_simbody_exception(e));
   }
