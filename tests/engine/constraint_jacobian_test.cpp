@@ -81,6 +81,30 @@ TEST(ConstraintJacobian, SlidersAsCalcG) {
   expect_as_calc_g(crane, {}, 2, prismatic ? 0.3 : 0.5);
 }
 
+// Row blocks in constraint order (what calc_mobility reads per constraint, to name redundant
+// loops): each equals that constraint's own P from Simbody (calcPositionConstraintMatrixP).
+TEST(ConstraintJacobian, RowBlocksAreEachConstraintsP) {
+  FullModelOptions o;
+  o.fold_geared_bodies = false;  // loops and a gear row
+  const FullModel model(models::load_scene("bicycle"), o);
+  const auto& m = model.impl();
+  ASSERT_TRUE(m.jacobian_plan.has_value());
+  FullWorkspace ws(model);
+  calc_kinetostatic(model, ws, 2.0, 0.0, 0.0, Loads::Off);
+  const SimTK::State& s = ws.impl().state;
+  Matrix G;
+  calc_constraint_jacobian(m, s, G);
+  int first = 0;
+  for (size_t k = 0; k < m.constraints.size(); ++k) {
+    const Matrix P = m.constraints[k].second.calcPositionConstraintMatrixP(s);
+    const int mp = m.jacobian_plan->line_of[k] >= 0 ? 2 : 1;
+    ASSERT_EQ(P.nrow(), mp) << m.constraints[k].first;
+    EXPECT_LE(relative_difference(G(first, 0, mp, G.ncol()), P), 1e-12) << m.constraints[k].first;
+    first += mp;
+  }
+  EXPECT_EQ(first, G.nrow());
+}
+
 // A disabled loop takes its rows out of Simbody's G: the plan no longer describes the system,
 // so the guard hands it to calcG (the plan's rows would be 4).
 TEST(ConstraintJacobian, DisabledConstraintFallsBackToCalcG) {
