@@ -51,8 +51,6 @@ double joint_part(const FullModel::Impl& m, const State& s, const Vector& u, int
 // 44 % of the extraction). Returns false — the caller then runs projectQ as before — when the
 // state is not of that kind (nq ≠ nu), the errors stop contracting by half per iteration (a
 // singular configuration, a start too far from the branch) or 8 iterations do not suffice.
-namespace {
-
 bool newton_project(const FullModel::Impl& m, State& s) {
   constexpr double kTolerance = 1e-13;  // [m, rad]: tighter than projectQ's 1e-12 (RMS)
   constexpr int kMaxIterations = 8;
@@ -94,8 +92,6 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   }
   return false;
 }
-
-}  // namespace
 
 // Position projection with the independent coordinate prescribed: the chord Newton iteration,
 // else Simbody's projectQ at 1e-12, else at 1e-9 (a singular configuration, counted). Throws

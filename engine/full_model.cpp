@@ -4,6 +4,7 @@
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
 #include "engine/branch_guard.hpp"
+#include "engine/branch_rates.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/inspect.hpp"  // kFarFromGuess_deg
 #include "engine/kinetostatic.hpp"
@@ -475,6 +476,21 @@ bool far_from_guesses(const FullModel::Impl& m, const State& s) {
   return false;
 }
 
+// The direct assembly by the chord Newton projection from the guesses (engine/branch_rates), kept
+// only when it closes every loop to 1e-13 within kFarFromGuess_deg of every guess; else the
+// guesses are restored for Simbody's Assembler. With the independent coordinate and the
+// actuators prescribed the configuration is isolated, so both land on the same one, to their
+// accuracies (1e-13, 1e-12); the Assembler's set-up (its own state copies, quaternion
+// conversions) was 5 % of a sweep case (issue #28).
+bool newton_assemble(const FullModel::Impl& m, State& s) {
+  const Vector guesses = s.getQ();
+  m.system.realize(s, Stage::Time);
+  m.system.prescribeQ(s);
+  if (newton_project(m, s) && !far_from_guesses(m, s)) return true;
+  s.updQ() = guesses;
+  return false;
+}
+
 // Each revolute joint's angle within half a turn of its guess: the assembler may land whole
 // turns away (8224 turns for a chain started 0.5° from flat), which is the same configuration
 // but not the coordinate a user reads or a branch check compares.
@@ -567,7 +583,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   // kFarFromGuess_deg from its guess (on another branch: a parallelogram chain started 0.1° from
   // flat with its 90° guesses folded into the antiparallelogram), by continuation from the
   // configuration the guesses describe, when that reaches the initial q.
-  const bool direct = assemble(m, s, true) <= 1e-8;
+  const bool direct = newton_assemble(m, s) || assemble(m, s, true) <= 1e-8;
   if (!direct || far_from_guesses(m, s)) {
     State walked = guesses;
     const Walk walk = assemble_by_continuation(m, walked);
