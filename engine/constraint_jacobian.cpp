@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "engine/full_model_impl.hpp"
+#include "models/gear_fold.hpp"
 
 namespace rdyn::engine {
 
@@ -47,7 +48,17 @@ std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullMo
     const MobilizedBody& mb = m.matter.getMobilizedBody(MobilizedBodyIndex(b));
     const bool pin = MobilizedBody::Pin::isInstanceOf(mb);
     if (!pin && !MobilizedBody::Slider::isInstanceOf(mb)) return std::nullopt;
-    plan.mobilities.push_back({mb.getMobilizedBodyIndex(), mb.getFirstUIndex(s), pin});
+    ConstraintJacobianPlan::Mobility mob;
+    mob.body = mb.getMobilizedBodyIndex();
+    mob.u = mb.getFirstUIndex(s);
+    mob.q = mb.getFirstQIndex(s);
+    mob.pin = pin;
+    // Simbody numbers a body after its parent: the parent's mobility is already listed.
+    mob.parent = static_cast<int>(mb.getParentMobilizedBody().getMobilizedBodyIndex()) - 1;
+    mob.X_PF = mb.getDefaultInboardFrame();
+    mob.X_BM = mb.getDefaultOutboardFrame();
+    if (mob.parent >= b - 1) return std::nullopt;
+    plan.mobilities.push_back(mob);
   }
   if (static_cast<int>(plan.mobilities.size()) != plan.nu) return std::nullopt;
   // Simbody numbers the holonomic rows constraint by constraint in ConstraintIndex order.
@@ -60,6 +71,9 @@ std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullMo
       rows.line = pol.getLineMobilizedBodyIndex();
       rows.follower = pol.getFollowerMobilizedBodyIndex();
       rows.point_F = pol.getDefaultFollowerPoint();
+      rows.point_L = pol.getDefaultPointOnLine();
+      rows.line_mobility = static_cast<int>(rows.line) - 1;
+      rows.follower_mobility = static_cast<int>(rows.follower) - 1;
       // As Simbody's PointOnLineImpl::realizeTopologyVirtual picks them.
       const UnitVec3& z = pol.getDefaultLineDirection();
       rows.x_L = z.perp();
@@ -74,7 +88,9 @@ std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullMo
       const int jr = m.scene.joint_index(g.driver), jd = m.scene.joint_index(g.driven);
       plan.line_of.push_back(-1);
       plan.gear_of.push_back(static_cast<int>(plan.gears.size()));
-      plan.gears.push_back({m.joint_mobod[jr].getFirstUIndex(s), m.joint_mobod[jd].getFirstUIndex(s), g.ratio});
+      plan.gears.push_back({m.joint_mobod[jr].getFirstUIndex(s), m.joint_mobod[jd].getFirstUIndex(s),
+                            m.joint_mobod[jr].getFirstQIndex(s), m.joint_mobod[jd].getFirstQIndex(s), g.ratio,
+                            models::calc_gear_offset(m.scene, g)});
       plan.rows += 1;
     } else {
       return std::nullopt;
@@ -125,6 +141,35 @@ void calc_constraint_jacobian(const FullModel::Impl& m, const State& s, Matrix& 
       G(row + 1, mob.u) += sign * dot(ny, v);
     }
     row += 2;
+  }
+}
+
+void calc_constraint_errors(const ConstraintJacobianPlan& plan, const Vector& q, Vector& perr) {
+  std::vector<Transform> X_GB(plan.mobilities.size());
+  for (size_t k = 0; k < plan.mobilities.size(); ++k) {
+    const auto& mob = plan.mobilities[k];
+    Transform X_FM;  // identity
+    if (mob.pin)
+      X_FM.updR().setRotationFromAngleAboutZ(q[mob.q]);
+    else
+      X_FM.updP() = Vec3(q[mob.q], 0, 0);
+    const Transform X_GF = mob.parent < 0 ? mob.X_PF : X_GB[mob.parent] * mob.X_PF;
+    X_GB[k] = X_GF * X_FM * ~mob.X_BM;
+  }
+  auto frame = [&](int mobility) { return mobility < 0 ? Transform() : X_GB[mobility]; };
+  perr.resize(plan.rows);
+  int row = 0;
+  for (size_t c = 0; c < plan.line_of.size(); ++c) {
+    if (plan.line_of[c] < 0) {
+      const auto& g = plan.gears[plan.gear_of[c]];
+      perr[row++] = q[g.q_driven] - g.ratio * q[g.q_driver] - g.offset;
+      continue;
+    }
+    const auto& l = plan.lines[plan.line_of[c]];
+    const Vec3 p_S = frame(l.follower_mobility) * l.point_F;
+    const Vec3 p_PC = ~frame(l.line_mobility) * p_S - l.point_L;  // as PointOnLineImpl's perr
+    perr[row++] = dot(p_PC, Vec3(l.x_L));
+    perr[row++] = dot(p_PC, Vec3(l.y_L));
   }
 }
 

@@ -16,21 +16,25 @@ namespace rdyn::engine {
 struct ConstraintJacobianPlan {
   struct Mobility {
     SimTK::MobilizedBodyIndex body;
-    int u = -1;
-    bool pin = true;  // else a slider
+    int u = -1, q = -1;
+    bool pin = true;   // else a slider
+    int parent = -1;   // the parent's mobility, −1 for Ground
+    SimTK::Transform X_PF, X_BM;  // the mobilizer's default frames (inboard, outboard)
   };
   // Constraint::PointOnLine: follower point S (on body F) on the line of body L, rows x and y
   // (Simbody's normals: x = line.perp(), y = line × x, fixed in L).
   struct LineRows {
     SimTK::MobilizedBodyIndex line, follower;
     SimTK::Vec3 point_F;       // S in F's frame
+    SimTK::Vec3 point_L;       // P, a point of the line, in L's frame
+    int line_mobility = -1, follower_mobility = -1;  // −1: Ground
     SimTK::UnitVec3 x_L, y_L;  // row normals in L's frame
     std::vector<std::pair<int, double>> moves;  // (mobility, +1 moves S only, −1 moves L only)
   };
   // Constraint::CoordinateCoupler of a gear q_driven − r q_driver − c = 0: one row.
   struct GearRow {
-    int u_driver = -1, u_driven = -1;
-    double ratio = 0.0;
+    int u_driver = -1, u_driven = -1, q_driver = -1, q_driven = -1;
+    double ratio = 0.0, offset = 0.0;
   };
   std::vector<Mobility> mobilities;
   // In Simbody's row order (constraint order, each constraint's rows together): entry k is a
@@ -56,5 +60,14 @@ std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullMo
 // (~14 k instructions each on the bicycle: 18 % of a sweep case, issue #28). Without a plan, with a
 // disabled constraint or rows other than the plan's: calcG itself.
 void calc_constraint_jacobian(const FullModel::Impl& m, const SimTK::State& s, SimTK::Matrix& G);
+
+// The position errors perr of the same rows from the coordinates q alone (each body's X_GB =
+// X_GP X_PF X_FM(q) X_MB down the tree, X_FM a turn about z or a shift along x; PointOnLine:
+// perr = (x, y)·(X_GL⁻¹ p_S − P), gears: q_driven − r q_driver − c), without realizing a
+// State: Simbody's Position realization (every body, cache and constraint, ~28 k instructions on
+// the bicycle) was the chord Newton projection's main cost. Equal to the state's QErr to rounding
+// (tests/engine/constraint_jacobian_test.cpp); callers accept a configuration only on Simbody's
+// own errors.
+void calc_constraint_errors(const ConstraintJacobianPlan& plan, const SimTK::Vector& q, SimTK::Vector& perr);
 
 }  // namespace rdyn::engine

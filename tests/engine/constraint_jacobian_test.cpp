@@ -1,6 +1,7 @@
 // The constraint Jacobian from the configuration (engine/constraint_jacobian.cpp) against
 // Simbody's own calcG (one multiplyByPVA per mobility, an independent route through Simbody's
-// constraint velocity errors) on the shipped scenes' kinds of systems: pins and PointOnLine loops
+// constraint velocity errors), and the position errors from q alone against a realized State's
+// QErr, on the shipped scenes' kinds of systems: pins and PointOnLine loops
 // (four-bar), constraint actuators' slider chains (the bicycle's knee forces), prismatic joints
 // (slider-crank, crane), an unfolded gear's coupler row; and the guard that hands a system it does
 // not describe back to calcG.
@@ -79,6 +80,43 @@ TEST(ConstraintJacobian, SlidersAsCalcG) {
   const bool prismatic = crane.find_joint(crane.independent)->type == models::JointType::Prismatic;
   // A prismatic independent coordinate moves 0.3 m of its stroke, a revolute one a turn.
   expect_as_calc_g(crane, {}, 2, prismatic ? 0.3 : 0.5);
+}
+
+// The position errors from the coordinates alone against the State's QErr after Simbody's
+// Position realization, off the constraint manifold (every coordinate moved by up to 0.05 from
+// a closed configuration, so the loops gape by centimetres): equal to 1e-12 of the largest gap.
+void expect_errors_as_simbody(const models::Scene& scene, FullModelOptions o) {
+  const FullModel model(scene, o);
+  const auto& m = model.impl();
+  ASSERT_TRUE(m.jacobian_plan.has_value()) << scene.source_file;
+  FullWorkspace ws(model);
+  calc_kinetostatic(model, ws, scene.initial.q, 0.0, 0.0, Loads::Off);
+  SimTK::State s = ws.impl().state;
+  const SimTK::Vector closed = s.getQ();
+  for (int trial = 0; trial < 6; ++trial) {
+    SimTK::Vector q = closed;
+    for (int i = 0; i < q.size(); ++i) q[i] += 0.05 * std::sin(1.7 * (i + 1) * (trial + 1));
+    s.updQ() = q;
+    m.system.realize(s, SimTK::Stage::Position);
+    SimTK::Vector e;
+    calc_constraint_errors(*m.jacobian_plan, q, e);
+    const SimTK::Vector& reference = s.getQErr();
+    ASSERT_EQ(e.size(), reference.size());
+    double d = 0.0, scale = 0.0;
+    for (int i = 0; i < e.size(); ++i) d = std::max(d, std::abs(e[i] - reference[i])), scale = std::max(scale, std::abs(reference[i]));
+    EXPECT_GT(scale, 1e-3) << scene.source_file;  // the loops do gape: not zero against zero
+    EXPECT_LE(d, 1e-12 * scale) << scene.source_file << " trial " << trial;
+  }
+}
+
+TEST(ConstraintErrors, AsSimbodysOffTheManifold) {
+  FullModelOptions unfolded;
+  unfolded.fold_geared_bodies = false;
+  expect_errors_as_simbody(models::load_scene("fourbar"), {});
+  expect_errors_as_simbody(models::load_scene("bicycle"), {});
+  expect_errors_as_simbody(models::load_scene("bicycle"), unfolded);  // the gear's row
+  expect_errors_as_simbody(models::load_scene("slider-crank"), {});
+  expect_errors_as_simbody(models::load_scene("crane-luffing"), {});
 }
 
 // Row blocks in constraint order (what calc_mobility reads per constraint, to name redundant
