@@ -1,4 +1,4 @@
-// The constraint Jacobian from the configuration (engine/constraint_jacobian.hpp).
+// The constraint Jacobian and errors from the configuration (engine/constraint_jacobian.hpp).
 #include "engine/constraint_jacobian.hpp"
 
 #include <algorithm>

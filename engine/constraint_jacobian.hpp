@@ -1,5 +1,6 @@
-// The constraint Jacobian G (rows: loop closures and unfolded gears; columns: mobilities) of the
-// systems rdyn builds, from the configuration alone. Internal to engine/ (includes Simbody).
+// The constraint Jacobian G (rows: loop closures and unfolded gears; columns: mobilities) and the
+// position errors of the systems rdyn builds, from the configuration alone. Internal to engine/
+// (includes Simbody).
 #pragma once
 
 #include <Simbody.h>
@@ -47,7 +48,7 @@ struct ConstraintJacobianPlan {
 
 // The plan of a built system, or none when it holds anything else than Pin and Slider mobilizers,
 // PointOnLine loops and the gears' couplers (then calc_constraint_jacobian uses calcG).
-// coupled_gears: the scene gear behind each CoordinateCoupler, in constraint order.
+// The gear rows come from Impl::coupled_gears (the scene gear behind each CoordinateCoupler).
 std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullModel::Impl& m);
 
 // G at a state realized to Position: G u = d(perr)/dt for the q̇ = N u of pins and sliders
