@@ -13,7 +13,7 @@ using namespace SimTK;
 
 SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
   SplitJacobian J;
-  m.matter.calcG(s, J.G);
+  calc_constraint_jacobian(m, s, J.G);
   std::vector<bool> keep(s.getNU(), true);
   keep[m.joint_mobod[m.independent].getFirstUIndex(s)] = false;
   for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
@@ -51,8 +51,6 @@ double joint_part(const FullModel::Impl& m, const State& s, const Vector& u, int
 // 44 % of the extraction). Returns false — the caller then runs projectQ as before — when the
 // state is not of that kind (nq ≠ nu), the errors stop contracting by half per iteration (a
 // singular configuration, a start too far from the branch) or 8 iterations do not suffice.
-namespace {
-
 bool newton_project(const FullModel::Impl& m, State& s) {
   constexpr double kTolerance = 1e-13;  // [m, rad]: tighter than projectQ's 1e-12 (RMS)
   constexpr int kMaxIterations = 8;
@@ -79,23 +77,39 @@ bool newton_project(const FullModel::Impl& m, State& s) {
   for (size_t c = 0; c < J.free_cols.size(); ++c)
     if ((q_of[c] = q_of_u[J.free_cols[c]]) < 0) return false;
   LeastSquares chord(J.G_free);  // one decomposition for every iteration
-  Vector dx, rhs;
+  // Between the first realization and the last the errors come from the coordinates alone
+  // (calc_constraint_errors, when the plan describes the state's rows): 2 Position realizations
+  // a projection instead of 4–5. A configuration is accepted on Simbody's own errors only, so a
+  // plan that disagreed would cost iterations, never accuracy.
+  const ConstraintJacobianPlan* plan =
+      m.jacobian_plan && m.jacobian_plan->rows == s.getNQErr() && m.jacobian_plan->nu == s.getNU() ? &*m.jacobian_plan
+                                                                                                    : nullptr;
+  Vector dx, rhs = s.getQErr(), e;
+  auto largest = [](const Vector& v) {
+    double w = 0.0;
+    for (int i = 0; i < v.size(); ++i) w = std::max(w, std::abs(v[i]));
+    return w;
+  };
   for (int it = 0; it < kMaxIterations; ++it) {
-    rhs = s.getQErr();
     rhs *= -1.0;
     chord.solve(rhs, dx);
     Vector& q = s.updQ();
     for (size_t c = 0; c < q_of.size(); ++c) q[q_of[c]] += dx[static_cast<int>(c)];
-    m.system.realize(s, Stage::Position);
-    const double next = worst();
-    if (next <= kTolerance) return true;
+    if (plan) calc_constraint_errors(*plan, s.getQ(), e);
+    double next = plan ? largest(e) : NAN;
+    if (!plan || next <= kTolerance) {
+      m.system.realize(s, Stage::Position);
+      next = worst();
+      if (next <= kTolerance) return true;
+      plan = nullptr;  // closed by the plan's errors, not by Simbody's: Simbody's from here on
+      e = s.getQErr();
+    }
     if (!(next < 0.5 * err)) return false;
     err = next;
+    rhs = e;
   }
   return false;
 }
-
-}  // namespace
 
 // Position projection with the independent coordinate prescribed: the chord Newton iteration,
 // else Simbody's projectQ at 1e-12, else at 1e-9 (a singular configuration, counted). Throws

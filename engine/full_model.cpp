@@ -4,6 +4,7 @@
 // sliders, and the independent coordinate driven by a prescribed law when enabled.
 #include "engine/full_model_impl.hpp"
 #include "engine/branch_guard.hpp"
+#include "engine/branch_rates.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/inspect.hpp"  // kFarFromGuess_deg
 #include "engine/kinetostatic.hpp"
@@ -262,6 +263,7 @@ void add_gear_couplers(FullModel::Impl& m, const std::vector<bool>& folded) {
     std::vector<MobilizedBodyIndex> mbs{m.joint_mobod[jr].getMobilizedBodyIndex(),
                                         m.joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
+    m.coupled_gears.push_back(static_cast<int>(g));
     m.constraints.emplace_back("gear '" + gear.name + "'",
                                Constraint::CoordinateCoupler(m.matter, new Function::Linear(coeff), mbs, qs));
   }
@@ -294,6 +296,7 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
   try {
     default_state = system.realizeTopology();
     system.realizeModel(default_state);
+    jacobian_plan = make_constraint_jacobian_plan(*this);
   } catch (const std::exception& e) {
     throw EngineError(std::string("Simbody could not build the system: ") + describe_simbody_exception(e));
   }
@@ -473,6 +476,27 @@ bool far_from_guesses(const FullModel::Impl& m, const State& s) {
   return false;
 }
 
+// The direct assembly by the chord Newton projection from the guesses (engine/branch_rates), kept
+// only when it closes every loop to 1e-13 within kFarFromGuess_deg of every guess; else the
+// guesses are restored for Simbody's Assembler. With the independent coordinate and the
+// actuators prescribed the configuration is isolated, so both land on the same one, to their
+// accuracies (1e-13, 1e-12); the Assembler's set-up (its own state copies, quaternion
+// conversions) was 5 % of a sweep case (issue #28).
+bool newton_assemble(const FullModel::Impl& m, State& s) {
+  const Vector guesses = s.getQ();
+  m.system.realize(s, Stage::Time);
+  m.system.prescribeQ(s);
+  if (newton_project(m, s) && !far_from_guesses(m, s)) {
+    // To rounding, as the Assembler closes: a forward run's first projection (the independent
+    // coordinate free) would otherwise move the start by the 1e-13 left (the cycle rerun of
+    // validate/analysis/cycle_run starts exactly at its q).
+    polish_projection(m, s);
+    return true;
+  }
+  s.updQ() = guesses;
+  return false;
+}
+
 // Each revolute joint's angle within half a turn of its guess: the assembler may land whole
 // turns away (8224 turns for a chain started 0.5° from flat), which is the same configuration
 // but not the coordinate a user reads or a branch check compares.
@@ -565,7 +589,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   // kFarFromGuess_deg from its guess (on another branch: a parallelogram chain started 0.1° from
   // flat with its 90° guesses folded into the antiparallelogram), by continuation from the
   // configuration the guesses describe, when that reaches the initial q.
-  const bool direct = assemble(m, s, true) <= 1e-8;
+  const bool direct = newton_assemble(m, s) || assemble(m, s, true) <= 1e-8;
   if (!direct || far_from_guesses(m, s)) {
     State walked = guesses;
     const Walk walk = assemble_by_continuation(m, walked);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "engine/constraint_jacobian.hpp"
 #include "engine/full_model.hpp"
 #include "models/gear_fold.hpp"
 
@@ -51,6 +52,9 @@ struct FullModel::Impl {
   SimTK::Motion::Custom independent_motion;
   // Loop closures and unfolded gears, each with the name messages give it ("loop 'C'").
   std::vector<std::pair<std::string, SimTK::Constraint>> constraints;
+  std::vector<int> coupled_gears;  // the scene gear of each CoordinateCoupler, in constraint order
+  // G from the configuration (engine/constraint_jacobian.hpp); none: calcG.
+  std::optional<ConstraintJacobianPlan> jacobian_plan;
   int independent = -1;  // scene joint index
 
   // Where this system's state variables live. Simbody allocates them in its const

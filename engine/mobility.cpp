@@ -61,8 +61,21 @@ Mobility calc_mobility(const FullModel::Impl& m, const State& s, double rank_tol
     if (keep[c]) cols.push_back(c);
   std::vector<Matrix> rows;          // one 1×ncols row per constraint equation
   std::vector<int> owner;            // its constraint
-  for (size_t k = 0; k < m.constraints.size(); ++k) {
-    const Matrix P = m.constraints[k].second.calcPositionConstraintMatrixP(s);  // mp × nu
+  // The constraints' P blocks are G's rows in constraint order (N = I: engine/constraint_jacobian);
+  // Simbody's per-constraint P (calcPositionConstraintMatrixP, one O(n) product per column) cost
+  // 4 % of a sweep case. A system the plan does not describe (G then has other rows) keeps it.
+  Matrix G;
+  calc_constraint_jacobian(m, s, G);
+  const bool planned = m.jacobian_plan && G.nrow() == m.jacobian_plan->rows;
+  for (size_t k = 0, first = 0; k < m.constraints.size(); ++k) {
+    Matrix P;  // mp × nu
+    if (planned) {
+      const int mp = m.jacobian_plan->line_of[k] >= 0 ? 2 : 1;
+      P = G(static_cast<int>(first), 0, mp, G.ncol());
+      first += static_cast<size_t>(mp);
+    } else {
+      P = m.constraints[k].second.calcPositionConstraintMatrixP(s);
+    }
     for (int r = 0; r < P.nrow(); ++r) {
       Matrix row(1, static_cast<int>(cols.size()));
       for (size_t c = 0; c < cols.size(); ++c) row(0, static_cast<int>(c)) = P(r, cols[c]);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -369,6 +371,28 @@ TEST(ReducedModel, FixedStepWithoutAnAngleAheadIsTheFullStep) {
   EXPECT_EQ(std::isnan(t_a), std::isnan(t_b));
   EXPECT_EQ(a.q, b.q);
   EXPECT_EQ(a.gate_on, b.gate_on);
+}
+
+// The interpolated m1 must stay positive between the grid points: one node 40× the others
+// makes the cubic spline ring below zero in the next intervals (refused, naming m1), a node 1.5×
+// the others leaves it positive (accepted).
+TEST(ReducedModel, RefusesAnInterpolatedInertiaThatTurnsNegativeBetweenNodes) {
+  const auto scene = test::analytic_scene();
+  for (double spike : {40.0, 1.5}) {
+    auto s = analytic_samples(0.0, scene);
+    auto& m1 = s.columns[std::find(s.names.begin(), s.names.end(), "m1") - s.names.begin()];
+    const double base = *std::min_element(m1.begin(), m1.end());
+    ASSERT_GT(base, 0.0);
+    for (double& v : m1) v = base;
+    m1[5] = spike * base;
+    std::string error;
+    try {
+      make_reduced_model(s, scene, Interpolation::CubicSpline);
+    } catch (const TableError& e) {
+      error = e.what();
+    }
+    EXPECT_EQ(error.find("interpolated reduced inertia m1") != std::string::npos, spike > 2) << spike << ": " << error;
+  }
 }
 
 TEST(ReducedModel, RefusesATableFromAnotherScene) {
