@@ -619,11 +619,14 @@ std::optional<double> fixed_speed_ratio(const Scene& s, const std::string& body)
   for (const auto& j : s.joints) {
     if (j.child != body || j.parent != kGround || j.type != JointType::Revolute) continue;
     if (j.name == s.independent) return 1.0;
+    const Joint* ind = s.find_joint(s.independent);
+    // Called before check_scene (to turn `dissipates` into a coefficient): names may be unknown.
+    if (!ind || ind->parent != kGround) continue;
     for (const auto& g : s.gears) {
-      const Joint* driver = s.find_joint(g.driver);
-      // Called before check_scene (to turn `dissipates` into a coefficient): names may be unknown.
-      if (driver && g.driven == j.name && g.driver == s.independent && driver->parent == kGround)
-        return g.ratio;
+      // rate(driven) = ratio·rate(driver), written either way round (a motor driving the crank
+      // at 0.04 is the crank driving the motor at 25).
+      if (g.driven == j.name && g.driver == s.independent) return g.ratio;
+      if (g.driver == j.name && g.driven == s.independent && g.ratio != 0) return 1.0 / g.ratio;
     }
   }
   return std::nullopt;

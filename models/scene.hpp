@@ -410,7 +410,7 @@ int dissipation_exponent(ResistanceLaw law);
 
 // Rate of `body` per unit rate of the independent coordinate, when that ratio is a
 // constant of the topology: the body is the independent joint's child (ratio 1) or the
-// child of a joint geared to it (ratio r). Empty otherwise.
+// child of a joint geared to it (ratio r as the driven joint, 1/r as the driver). Empty otherwise.
 std::optional<double> fixed_speed_ratio(const Scene& scene, const std::string& body);
 
 // The joint-output columns both models write (timeseries.csv), in this order: per outputs.joints

@@ -218,6 +218,13 @@ TEST(FixedSpeedRatio, GearsAndUnknownJointsBeforeTheChecks) {
   Scene s = geared_pair();
   EXPECT_EQ(fixed_speed_ratio(s, "wheel"), 1.0);
   EXPECT_EQ(fixed_speed_ratio(s, "pinion"), -2.0);
+  // The same gear written the other way round (the pinion drives the wheel at −1/2): a press's
+  // motor geared to its crank as `driver: motor, driven: crank, ratio: 0.04` was refused.
+  Scene reversed = s;
+  std::swap(reversed.gears[0].driver, reversed.gears[0].driven);
+  reversed.gears[0].ratio = -0.5;
+  EXPECT_EQ(fixed_speed_ratio(reversed, "pinion"), -2.0);
+  EXPECT_EQ(fixed_speed_ratio(reversed, "wheel"), 1.0);
   // The reader asks before check_scene has run: a gear whose driver names no joint (and an
   // independent coordinate naming the same) dereferenced a null joint.
   s.independent = "nosuch";

@@ -99,6 +99,17 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
   return finish(source);
 }
 
+std::pair<std::string, double> calc_resolution_miss(const reduced::Samples& samples) {
+  std::pair<std::string, double> worst{"m1", NAN};
+  for (const char* name : {"m1", "Q_cons"}) {
+    const int c = samples.column(name);
+    if (c < 0) continue;
+    const double miss = reduced::calc_half_grid_miss(samples.columns[c]);
+    if (std::isnan(worst.second) || miss > worst.second) worst = {name, miss};
+  }
+  return worst;
+}
+
 namespace {
 
 // extract_resolving's halving, over any way of extracting at a grid (a scene's new system, or
@@ -121,14 +132,13 @@ Extraction resolve(const Extract& extract, double grid_deg, bool grid_given, boo
     }
   }
   while (!grid_given && e.samples.periodic && grid / 2 >= kMinAutoGrid_deg - 1e-9) {
-    const int c = e.samples.column("m1");
-    const double miss = c < 0 ? NAN : reduced::calc_half_grid_miss(e.samples.columns[c]);
+    const auto [column, miss] = calc_resolution_miss(e.samples);
     if (!(miss > kAutoRefineMiss)) break;
     if (say)
       std::fprintf(stderr,
-                   "rdyn: the %g° table does not resolve this mechanism (m1 from every other grid point misses the "
+                   "rdyn: the %g° table does not resolve this mechanism (%s from every other grid point misses the "
                    "others by %.2g %% of its peak): extracting at %g°\n",
-                   grid, 100 * miss, grid / 2);
+                   grid, column.c_str(), 100 * miss, grid / 2);
     grid /= 2;
     e = extract(grid);
   }

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <optional>
+#include <string>
+#include <utility>
 
 #include "models/scene.hpp"
 #include "reduced/extract.hpp"
@@ -43,8 +45,14 @@ Extraction extract_from_full(const models::Scene& scene, double grid_deg, reduce
 Extraction extract_from_full(const engine::FullModel& model, double grid_deg, reduced::Method method,
                              bool require_closed_turn = true);
 
-// Above this half-grid miss of m1 (reduced::calc_half_grid_miss) a default grid does not resolve
-// the mechanism; kMinAutoGrid_deg (10° halved five times) is as far as it is halved: a five-bar
+// The larger half-grid miss (reduced::calc_half_grid_miss) of a periodic table's m1 and Q_cons (the
+// conservative generalized force), with its column's name; NaN for a range table. Q_cons sees what
+// m1 cannot: a rotor geared 25:1 to the crank and 2 mm out of balance has a constant m1 (miss
+// 3e-9 at 10°) while its weight's torque turns 25 times a turn (Q_cons miss 1.2: at 10° the
+// reduced q̈ was 4.2 % off and the motor's reaction 197 %, exit 0).
+std::pair<std::string, double> calc_resolution_miss(const reduced::Samples& samples);
+
+// Above this half-grid miss (calc_resolution_miss) a default grid does not resolve the mechanism; kMinAutoGrid_deg (10° halved five times) is as far as it is halved: a five-bar
 // whose slow crank is the coordinate, geared 20:1 to the fast one, misses 15 % at 1.25°, 2.5e-3
 // at 0.625° and 6.9e-7 at 0.3125° (its extraction there 0.7 s).
 inline constexpr double kAutoRefineMiss = 1e-3;

@@ -114,12 +114,12 @@ void check_full(const FullCheck& full, const CalibrationOptions& opt, const Sele
   const double miss = std::abs(mz.cadence_hz - opt.cadence_hz) / opt.cadence_hz;
   if (full.c.steady && miss <= kFullCadenceTolerance) return;
   const std::string reduced_point = fmt::format(
-      "the reduced operating point: {} = {:.6g} {}{}, steady cycle through q = {:.6g} rad at q̇ = {:.6g} rad/s, "
+      "the reduced operating point: {} = {:.6g} {}{}, steady cycle through q = {:.6g}° at q̇ = {:.6g} rad/s, "
       "mean cadence {:.6g} Hz",
       sel.name, r.load_value, sel.unit,
       std::isfinite(r.resistance_coefficient) ? fmt::format(", resistance coefficient {:.6g}", r.resistance_coefficient)
                                               : std::string(),
-      r.steady_q, r.steady_qdot, r.mean_cadence_hz_reduced);
+      r.steady_q * 180 / M_PI, r.steady_qdot, r.mean_cadence_hz_reduced);
   const int m = full.revolutions;
   std::string reached = fmt::format("{} whole revolutions in {:g} s of simulated time", mz.revolutions,
                                     full.c.duration_s);
@@ -614,7 +614,7 @@ CalibrationResult calibrate_reduced(reduced::ReducedModel&& m, const models::Sce
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt) {
   CalibrationTable t = extract_calibration_table(scene, opt, std::nullopt);
   if (t.grid_deg != opt.grid_deg)
-    std::fprintf(stderr, "rdyn: the %g° table does not resolve this mechanism (m1's half-grid miss above %g): "
+    std::fprintf(stderr, "rdyn: the %g° table does not resolve this mechanism (m1's or Q_cons's half-grid miss above %g): "
                  "calibrating on a %g° table\n", opt.grid_deg, kAutoRefineMiss, t.grid_deg);
   return t;
 }

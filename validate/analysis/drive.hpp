@@ -116,6 +116,7 @@ struct DriveCycleComparison {
   DriveStats full_stats, reduced_stats;
   double max_difference = 0.0;  // max |drive_reduced − drive_full| over the rows [N·m]
   double rms_difference = 0.0;  // RMS of that difference over the revolution [N·m]
+  double grid_deg = 0.0;        // the reduced model's table grid (set by the caller; 0: not said)
 };
 // `model`: a reduced model built from `scene` (its loads). Throws as calc_drive_full /
 // calc_drive_reduced.

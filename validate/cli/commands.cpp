@@ -356,9 +356,10 @@ int run_extract(const ExtractArgs& a) {
   const std::string grid =
       e.samples.periodic
           ? fmt::format("{}° grid", a.grid_deg)
-          : fmt::format("{:.6g}{} grid: {} intervals from --grid-deg {}", e.samples.step * (e.samples.revolute ? 180 / M_PI : 1.0),
-                        e.samples.revolute ? "°" : " m", e.samples.q.size() > 0 ? e.samples.q.size() - 1 : 0,
-                        a.grid_deg);
+          : fmt::format("{:.6g}{} grid: {} intervals from a {}° grid{}",
+                        e.samples.step * (e.samples.revolute ? 180 / M_PI : 1.0), e.samples.revolute ? "°" : " m",
+                        e.samples.q.size() > 0 ? e.samples.q.size() - 1 : 0, a.grid_deg,
+                        e.dead_min && e.dead_max ? ", ten times finer toward dead points" : "");
   std::fprintf(stderr, "%s\n",
                fmt::format("rdyn: extracted {} ({}, {}, {} points{}) in {:.3g} ms with {} kinetostatic calls; "
                            "wrote {}",

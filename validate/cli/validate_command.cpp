@@ -116,9 +116,11 @@ std::string suite_row(const std::string& stem, const nlohmann::json& entry) {
     speed = fmt::format("{}{:.3g}×", entry.value("recommended_full_as_accurate", true) ? "" : "≥ ",
                         entry["recommended_speedup"].get<double>());
   const std::string what = entry.contains("error") ? entry.value("error", std::string()) : entry.value("note", std::string());
-  return fmt::format("<tr><td class=l><a href='{0}/report.html'>{0}</a></td><td class={1}>{1}</td><td class=l>{2}</td>"
+  const std::string name = entry.contains("report") ? fmt::format("<a href='{0}/report.html'>{0}</a>", html_escape(stem))
+                                                   : html_escape(stem);
+  return fmt::format("<tr><td class=l>{0}</td><td class={1}>{1}</td><td class=l>{2}</td>"
                      "<td>{3}</td><td class=l>{4}</td></tr>",
-                     html_escape(stem), html_escape(status), verdicts, html_escape(speed), html_escape(what));
+                     name, html_escape(status), verdicts, html_escape(speed), html_escape(what));
 }
 
 }  // namespace
@@ -200,7 +202,9 @@ int run_suite(const ValidateArgs& a, Progress& progress) {
       entry = {{"name", stem}, {"file", files[i]}, {"status", "error"}, {"error", e.what()}};
       all_pass = false;
     }
-    entry["report"] = stem + "/report.html";
+    // A scene that failed before its report was written (it did not load or assemble) has none
+    // to link to: its row says why instead.
+    if (fs::exists(fs::path(out.file(stem)) / "report.html")) entry["report"] = stem + "/report.html";
     // One line a scene whatever standard error is (a suite runs for minutes, often into a log):
     // the progress above is drawn on a terminal only.
     std::fprintf(stderr, "rdyn: suite [%zu/%zu] %s: %s (%.0f s)\n", i + 1, files.size(), stem.c_str(),

@@ -122,6 +122,7 @@ nlohmann::json drive_cycle_json(const DriveCycleComparison& c) {
           {"max_abs_difference_Nm", num(c.max_difference)},
           {"max_abs_difference_rel_peak", num(peak > 0 ? c.max_difference / peak : NAN)},
           {"rms_of_difference_Nm", num(c.rms_difference)},
+          {"grid_deg", num(c.grid_deg)},
           {"curve", table_json({"q_deg", "t", "drive_full_Nm", "drive_reduced_Nm"}, cols)}};
 }
 

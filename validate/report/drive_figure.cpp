@@ -65,6 +65,10 @@ std::string drive_cycle_section(const json& c, const std::map<std::string, std::
        row("RMS drive", "rms_Nm", "N·m") + row("peak |drive|", "peak_Nm", "N·m") +
        row("mean drive", "mean_Nm", "N·m") + row("mean power", "mean_power_W", "W") +
        row("peak power", "peak_power_W", "W") + "</table>";
+  if (std::isfinite(number(c, "grid_deg")) && number(c, "grid_deg") > 0)
+    h += fmt::format("<p>The reduced model on a {}° table (as <code>rdyn drive</code> takes it: 10°, halved where "
+                     "that does not resolve the mechanism).</p>",
+                     shown(number(c, "grid_deg"), "{:g}"));
   h += fmt::format("<p>Largest difference along the revolution {} N·m ({} of the full model's peak).</p>",
                    shown(number(c, "max_abs_difference_Nm"), "{:.3g}"),
                    std::isfinite(number(c, "max_abs_difference_rel_peak"))

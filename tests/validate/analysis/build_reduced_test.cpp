@@ -103,6 +103,25 @@ TEST(BuildReduced, PolesBetweenGridPointsAreFoundAndListed) {
   EXPECT_GT(fourbar.samples.min_conditioning, reduced::kScanBelowConditioning);
 }
 
+// m1 does not see everything a grid must resolve: a rotor geared 25:1 to the crank and 2 mm out
+// of balance keeps m1 constant (its miss at 10° is rounding) while its weight's torque, in
+// Q_cons, turns 25 times a turn. The default grid is refined on Q_cons until it resolves it too.
+TEST(BuildReduced, AGeneralizedForceTheGridDoesNotResolveIsRefinedToo) {
+  const auto press =
+      models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/press-unbalanced-rotor.yaml");
+  const auto coarse = extract_from_full(press, 10, reduced::Method::Kinetostatic);
+  const int c = coarse.samples.column("m1");
+  ASSERT_GE(c, 0);
+  EXPECT_LT(reduced::calc_half_grid_miss(coarse.samples.columns[c]), 1e-6);
+  const auto [column, miss] = calc_resolution_miss(coarse.samples);
+  EXPECT_EQ(column, "Q_cons");
+  EXPECT_GT(miss, 0.1);
+  double grid = 0;
+  const auto e = extract_resolving(press, 10, false, reduced::Method::Kinetostatic, grid);
+  EXPECT_LT(grid, 10.0);
+  EXPECT_LE(calc_resolution_miss(e.samples).second, kAutoRefineMiss);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
 

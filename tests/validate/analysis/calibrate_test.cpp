@@ -399,7 +399,7 @@ TEST(Calibrate, AnUnsteadyConfirmationNamesTheReducedPointAndWhatTheFullModelRea
   for (const char* part :
        {"calibration not confirmed: the full model is not steady within 1 s of simulated time",
         "it reached 2 whole revolutions in 1 s of simulated time, fewer than the 6 the steady test compares",
-        "the reduced operating point: drive = 0.251327 N·m, steady cycle through q = 0 rad at q̇ = 12.5664 rad/s, "
+        "the reduced operating point: drive = 0.251327 N·m, steady cycle through q = 0° at q̇ = 12.5664 rad/s, "
         "mean cadence 2 Hz"})
     EXPECT_NE(what.find(part), std::string::npos) << part << "\n" << what;
   // Kept (`--write-scene FILE --force`): the result carries the message and the written scene

@@ -36,7 +36,7 @@ TEST_F(RangeCli, ExtractWritesARangeTableAndReportsTheDeadPoints) {
       << r.err;
   const std::string t = test::slurp(dir / "t.csv");
   // The stroke between the dead points sampled kDeadPointRefinement × finer: 360 intervals at 10°.
-  EXPECT_NE(r.err.find("0.000272222 m grid: 360 intervals from --grid-deg 10, 361 points"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("0.000272222 m grid: 360 intervals from a 10° grid, ten times finer toward dead points, 361 points"), std::string::npos) << r.err;
   EXPECT_NE(t.find("periodic=0"), std::string::npos);
   EXPECT_NE(t.find("edges=dead_point,dead_point"), std::string::npos);
   EXPECT_NE(t.find("\nq_m,m1,"), std::string::npos);
