@@ -428,14 +428,14 @@ SteadyCycle calc_steady_cycle(const ReducedModel& m, const SteadyCycleOptions& o
     } else {
       if (!any_pass)
         throw models::NumericalError(fmt::format(
-            "steady cycle: q̇ reaches zero (near q = {:.6g} rad) from every start speed tried, up to {:.6g} rad/s: no "
+            "steady cycle: q̇ reaches zero (near q = {:.6g}°) from every start speed tried, up to {:.6g} rad/s: no "
             "cycle with q̇ of one sign (the mechanism stalls or turns back)",
-            stall_q, std::sqrt(2 * lo)));
+            stall_q * 180 / M_PI, std::sqrt(2 * lo)));
       throw models::NumericalError(fmt::format(
           "steady cycle: no cycle with q̇ of one sign found in {} passes (from q̇ = {:.6g} rad/s at the section the "
           "kinetic energy still changes by {:.3g} J per cycle{})",
           passes, fi.s * std::sqrt(2 * u_ok), m.table.eval(m.c_m1, opt.q_section) * g_ok,
-          std::isfinite(stall_q) ? fmt::format("; slower starts stall near q = {:.6g} rad", stall_q) : ""));
+          std::isfinite(stall_q) ? fmt::format("; slower starts stall near q = {:.6g}°", stall_q * 180 / M_PI) : ""));
     }
   }
   SteadyCycle c;
@@ -531,9 +531,9 @@ SectionSpeed find_section_speed(const ReducedModel& m, const SteadyCycleOptions&
   }
   if (!ok && !(std::isfinite(g1) && std::abs(g1) < kFixedPointStagnation * std::abs(v1)))
     throw models::NumericalError(fmt::format(
-        "steady cycle (time stepping): no periodic cycle found in {} revolutions from q̇ = {:.6g} rad/s at q = {:.6g} "
-        "rad ({})",
-        out.passes, opt.qdot_guess, qs,
+        "steady cycle (time stepping): no periodic cycle found in {} revolutions from q̇ = {:.6g} rad/s at q = {:.6g}° "
+        "({})",
+        out.passes, opt.qdot_guess, qs * 180 / M_PI,
         std::isfinite(g1) ? fmt::format("the speed still changes by {:.3g} of itself per cycle", std::abs(g1 / v1))
                           : "a revolution was not completed: the mechanism stalls or turns back"));
   out.qdot = v1;

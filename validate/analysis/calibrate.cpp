@@ -51,9 +51,9 @@ void check_cadence(const char* what, double measured_hz, double target_hz, doubl
 
 struct Cycle {
   bool ok = false;
-  double speed = 0.0;            // q̇ at the section q = q_s on the steady cycle
-  double period = 0.0;           // [s]
+  double speed = 0.0, period = 0.0;  // q̇ at the section q = q_s on the steady cycle; [s]
   reduced::SteadyCycle detail;   // extremes, work, counts (when ok)
+  std::string why;               // the search's message (when not ok)
 };
 
 // Steady cycle of the reduced model at section q_s (reduced/steady_cycle.hpp): by the first
@@ -70,9 +70,9 @@ Cycle steady_cycle(const reduced::ReducedModel& m, double q_s, double v_guess, d
   try {
     const auto c = reduced::find_steady_cycle(m, o);
     evals += c.passes;
-    return {true, c.qdot_section, c.period_s, c};
-  } catch (const models::NumericalError&) {
-    return {};  // (the failed search's passes are not counted)
+    return {true, c.qdot_section, c.period_s, c, {}};
+  } catch (const models::NumericalError& e) {
+    return {false, 0.0, 0.0, {}, e.what()};  // (the failed search's passes are not counted)
   }
 }
 
@@ -466,7 +466,7 @@ Cycle settle_at_load(reduced::ReducedModel& m, const Selection& sel, const model
   Cycle cy = steady_cycle(m, scene.initial.q, qdot_guess, opt.tolerance, evals, true);
   if (!cy.ok)
     throw models::NumericalError(fmt::format("calibration: the reduced model has no steady cycle at the value found "
-                                             "({:.6g} {})", r.load_value, sel.unit));
+                                             "({:.6g} {}): {}", r.load_value, sel.unit, cy.why));
   r.steady_q = scene.initial.q;
   r.steady_qdot = cy.speed;
   r.mean_cadence_hz_reduced = 1.0 / cy.period;

@@ -509,7 +509,9 @@ void run_stage(ValidationResult& v, const char* what, Stage&& stage) {
   try {
     stage();
   } catch (const models::NumericalError& e) {
-    v.fail(fmt::format("{}: {}", what, e.what()));
+    // A message that already starts with the stage's name (calibrate's do) is not prefixed again.
+    const std::string msg = e.what(), prefix = std::string(what) + ": ";
+    v.fail(msg.rfind(prefix, 0) == 0 ? msg : prefix + msg);
   }
 }
 
