@@ -255,6 +255,8 @@ int run_report(const ReportArgs& a) {
     throw ArgumentError(a.summary + ": not a summary of `rdyn validate` (no 'scene' and 'runs')");
   if (const std::string bad = report_format::find_non_number(summary); !bad.empty())
     throw ArgumentError(fmt::format("{}: field {} (not what rdyn validate writes there)", a.summary, bad));
+  if (const std::string bad = report_format::find_malformed_record(summary); !bad.empty())
+    throw ArgumentError(fmt::format("{}: field {} (not what rdyn validate writes there)", a.summary, bad));
   OutputDir out(a.out, a.force);
   try {
     render_report(summary, out.file(""));

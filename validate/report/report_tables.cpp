@@ -174,6 +174,34 @@ std::string find_non_number(const json& s) {
   return found.empty() ? contradicted_threshold(s) : found;
 }
 
+std::string find_malformed_record(const json& s) {
+  const json* runs = s.contains("runs") ? &s["runs"] : nullptr;
+  if (!runs || !runs->is_array() || runs->empty()) return "runs: missing, or not a list of runs";
+  for (size_t i = 0; i < runs->size(); ++i) {
+    const json& r = (*runs)[i];
+    const std::string at = fmt::format("runs[{}]", i);
+    if (!r.is_object()) return at + ": not a run";
+    if (!r.contains("label") || !r["label"].is_string()) return at + ".label: missing or not text";
+    const std::string model = r.contains("model") && r["model"].is_string() ? r["model"].get<std::string>() : "";
+    if (model != "full" && model != "reduced" && model != "mujoco")
+      return at + ".model: missing or not full, reduced or mujoco";
+    if (!r.contains("errors") || !r["errors"].is_object()) return at + ".errors: missing or not an object";
+  }
+  const json* verdicts = s.contains("verdicts") ? &s["verdicts"] : nullptr;
+  if (!verdicts || !verdicts->is_array()) return "verdicts: missing, or not a list";
+  for (size_t i = 0; i < verdicts->size(); ++i) {
+    const json& v = (*verdicts)[i];
+    const std::string at = fmt::format("verdicts[{}]", i);
+    if (!v.is_object()) return at + ": not a verdict";
+    if (!v.contains("quantity") || !v["quantity"].is_string()) return at + ".quantity: missing or not text";
+    if (!v.contains("within_target") || !v["within_target"].is_boolean())
+      return at + ".within_target: missing or not true/false";
+    for (const char* k : {"target", "error"})  // null: not measured (NaN)
+      if (!v.contains(k) || !(v[k].is_number() || v[k].is_null())) return at + "." + k + ": missing or not a number";
+  }
+  return "";
+}
+
 bool is_joint_output(const json& s, const json& q) {
   for (const auto& j : s.value("joint_output_quantities", json::array()))
     if (j == q) return true;

@@ -41,6 +41,12 @@ bool is_joint_output(const json& s, const json& q);
 // contradicts its error and limit); empty when there is none. The report would render such a
 // value as "not measured", "inf", "-5× faster" or a wrong verdict, exit 0.
 std::string find_non_number(const json& s);
+// The first record of a hand-edited summary the report cannot draw truthfully, as "path: why":
+// `runs` a non-empty list, each run with its text label, a model validate writes (full, reduced,
+// mujoco: another vanished from the figures) and its errors; `verdicts` a list, each with its
+// quantity, target, error and whether within it (a renamed key read as "above target").
+// Empty when every record is whole.
+std::string find_malformed_record(const json& s);
 }  // namespace report_format
 
 // <!DOCTYPE html> … <body>: the title naming the scene and the page's style.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -99,6 +100,32 @@ TEST(ReportTables, ANumberEditedIntoTextIsFoundByItsPath) {
   EXPECT_EQ(find_non_number(edited), "thresholds[0].pass: true contradicts its error 1 and max_error 0.005");
   edited["thresholds"][0]["pass"] = false;
   EXPECT_EQ(find_non_number(edited), "");
+}
+
+// Records the report draws from, edited by hand (a hostile pass: each rendered with exit 0 and
+// content changed): the first broken one named by its path; a whole summary has none.
+TEST(ReportTables, ABrokenRunOrVerdictRecordIsFoundByItsPath) {
+  const json s = summary_json(test::synthetic_validation());
+  ASSERT_FALSE(s["verdicts"].empty());
+  EXPECT_EQ(find_malformed_record(s), "");
+  auto edited = [&](const std::function<void(json&)>& edit) {
+    json e = s;
+    edit(e);
+    return find_malformed_record(e);
+  };
+  EXPECT_EQ(edited([](json& e) { e["runs"] = json::array(); }), "runs: missing, or not a list of runs");
+  EXPECT_EQ(edited([](json& e) { e["runs"][1].erase("label"); }), "runs[1].label: missing or not text");
+  EXPECT_EQ(edited([](json& e) { e["runs"][0]["model"] = "bogus"; }),
+            "runs[0].model: missing or not full, reduced or mujoco");
+  EXPECT_EQ(edited([](json& e) { e["runs"][0]["errors"] = "x"; }), "runs[0].errors: missing or not an object");
+  EXPECT_EQ(edited([](json& e) { e["verdicts"] = nullptr; }), "verdicts: missing, or not a list");
+  EXPECT_EQ(edited([](json& e) {
+              e["verdicts"][0]["within"] = e["verdicts"][0]["within_target"];
+              e["verdicts"][0].erase("within_target");
+            }),
+            "verdicts[0].within_target: missing or not true/false");
+  EXPECT_EQ(edited([](json& e) { e["verdicts"][0].erase("target"); }), "verdicts[0].target: missing or not a number");
+  EXPECT_EQ(edited([](json& e) { e["verdicts"][0]["error"] = nullptr; }), "");  // not measured: null, as written
 }
 
 // A window of fewer than two revolutions (a run that never settles, which fails validate) is not
