@@ -54,7 +54,7 @@ double domain_edge(const ReducedModel& m, double q) {
   const std::string& kind = at_min ? m.min_edge : m.max_edge;
   throw models::NumericalError(fmt::format(
       "reduced model left the validity domain at {} ({}) at t = {:.6g} s: the table's range ends there",
-      m.revolute ? fmt::format("q = {:.9g}°", edge * 180 / M_PI) : fmt::format("q = {:.9g} m", edge),
+      describe_q(m.revolute, edge),
       kind.empty() ? "edge of the table" : kind, t));
 }
 

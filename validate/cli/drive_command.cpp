@@ -1,3 +1,4 @@
+#include "reduced/reduced_model.hpp"
 #include "validate/cli/drive_command.hpp"
 
 #include "reduced/joint_outputs.hpp"
@@ -22,9 +23,6 @@ namespace rdyn::validate {
 
 namespace {
 
-std::string engine_free_coordinate(double q, bool revolute) {
-  return revolute ? fmt::format("q = {:.6g}°", q * 180 / M_PI) : fmt::format("q = {:.6g} m", q);
-}
 
 // The output rows: every k-th row of the fine record and its last (the duration itself).
 DriveRecord every_kth_row(const DriveRecord& r, long k) {
@@ -310,7 +308,7 @@ int run_drive(const DriveArgs& a) {
     std::fprintf(stderr, "rdyn: motor %s: %s (smallest margin %.4g %s, %.3g %% of stall, at t = %.6g s, %s)\n",
                  a.motor.c_str(), mc["covers"].get<bool>() ? "covers the drive at every row" : "does NOT cover the drive",
                  mc["min_margin"].get<double>(), unit, 100 * mc["min_margin_fraction_of_stall"].get<double>(),
-                 mc["at_t_s"].get<double>(), engine_free_coordinate(at_q, d.revolute).c_str());
+                 mc["at_t_s"].get<double>(), reduced::describe_q(d.revolute, at_q, 6).c_str());
   }
   return 0;
 }

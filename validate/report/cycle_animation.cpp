@@ -80,9 +80,16 @@ AnimationRecord read_animation_record(const nlohmann::json& r, const std::string
   return a;
 }
 
-std::string animation_record_html(const nlohmann::json& record, const std::string& path) {
-  const AnimationRecord a = read_animation_record(record, path);
+namespace {
+
+std::string record_html(const AnimationRecord& a) {
   return "<style>" + animation_css() + "</style>\n" + animation_section(a.scene, a.frames, a.title);
+}
+
+}  // namespace
+
+std::string animation_record_html(const nlohmann::json& record, const std::string& path) {
+  return record_html(read_animation_record(record, path));
 }
 
 std::string mechanism_drawing_html(const nlohmann::json& summary) {
@@ -113,7 +120,7 @@ std::string validate_animation_html(const nlohmann::json& summary) {
   return head +
          ": the full model (Simbody) restarted from the reference's state there, every position placed from the "
          "joint coordinates it outputs. <code>report.html#t=T</code> shows the frame nearest T.</p>\n" +
-         animation_record_html(summary.at("animation"), "animation");
+         record_html(a);
 }
 
 std::string strategies_animation_html(const nlohmann::json& summary) {

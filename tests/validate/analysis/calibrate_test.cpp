@@ -19,6 +19,7 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/table.hpp"
 #include "validate/analysis/build_reduced.hpp"
+#include "tests/validate/analysis/jansen_text.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -55,15 +56,10 @@ TEST(Calibrate, OptionsTakeTheScenesCalibrationGrid) {
 // 10° calibrates its drive 3.1815 N·m where 2° gives 3.1831: refined, within a quarter of that.
 TEST(Calibrate, ADefaultGridIsRefinedWhereItDoesNotResolveTheMechanism) {
   EXPECT_FALSE(calibration_options_of(models::load_scene("bicycle"), 0.0, 0.0, "").grid_given);
-  std::ifstream in(RDYN_SOURCE_DIR "/tests/validate/scenes/jansen-leg.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  const auto at = yaml.find(", grid_deg: 2}");
-  ASSERT_NE(at, std::string::npos);
-  const auto declared = models::parse_scene(yaml, "jansen-leg.yaml");
-  yaml.replace(at, 14, "}");
-  const auto undeclared = models::parse_scene(yaml, "jansen-leg.yaml");
+  const std::string without = test::jansen_text_without_calibration_grid();
+  ASSERT_FALSE(without.empty());
+  const auto declared = models::parse_scene(test::jansen_text(), "jansen-leg.yaml");
+  const auto undeclared = models::parse_scene(without, "jansen-leg.yaml");
   Progress quiet(false);
   auto calibrated = [&](const models::Scene& s, std::optional<double> grid) {
     CalibrationOptions opt = calibration_options_of(s, 0.0, 0.0, "");

@@ -20,6 +20,7 @@
 #include "models/scene_yaml.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/cli/sweep_axis.hpp"
+#include "tests/validate/analysis/jansen_text.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -85,13 +86,8 @@ namespace {
 // resolve m1, as calibrate's: the Jansen leg's (10° misses m1 by 10 %) is 2.5°, so its rows are
 // those of a sweep given 2.5° (the first case cold, the second continued), bit for bit.
 TEST(Sweep, ADefaultGridIsRefinedPerCaseAsCalibrateRefinesIt) {
-  std::ifstream in(RDYN_SOURCE_DIR "/tests/validate/scenes/jansen-leg.yaml");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  const auto at = yaml.find(", grid_deg: 2}");
-  ASSERT_NE(at, std::string::npos);
-  yaml.replace(at, 14, "}");
+  const std::string yaml = test::jansen_text_without_calibration_grid();
+  ASSERT_FALSE(yaml.empty());
   const std::string path = ::testing::TempDir() + "jansen-no-grid.yaml";
   std::ofstream(path) << yaml;
   SweepOptions o;
