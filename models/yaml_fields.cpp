@@ -306,7 +306,24 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
     return;
   }
   if (!cur.IsMap()) fail("the parent of the last key is not a mapping");
-  if (cur[last] && !cur[last].IsScalar()) fail("only scalar values can be set");
+  // A list of numbers written as a YAML flow list, `independent_range_deg=[95, 135]`: a scene
+  // without a range could not be given one (`independent_range.0=…` has no item to set). Only
+  // scalars inside, so no structure enters through --set.
+  YAML::Node list;
+  if (o.value.size() >= 2 && o.value.front() == '[' && o.value.back() == ']' &&
+      !(cur[last] && cur[last].IsScalar())) {  // a scalar key keeps its text: description=[draft]
+    try {
+      list = YAML::Load(o.value);
+    } catch (const YAML::Exception&) {
+      fail("a list value is written [a, b, …] with scalar items");
+    }
+    if (!list.IsSequence() || list.size() > 64 ||
+        std::any_of(list.begin(), list.end(), [](const YAML::Node& n) { return !n.IsScalar(); }))
+      fail("a list value is written [a, b, …] with at most 64 scalar items");
+    if (cur[last] && !cur[last].IsSequence()) fail("only scalars and lists can be set");
+  } else if (cur[last] && !cur[last].IsScalar()) {
+    fail("only scalar values can be set");
+  }
   // The same quantity in another angle unit (q / q_deg / q_rad): the override replaces it, as the
   // user means (`--set initial.q_deg=179` on a scene giving initial.q was refused with "give q or
   // q_deg, not both", blaming the file's line).
@@ -315,8 +332,11 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
   };
   const std::string base = ends_with("_deg") || ends_with("_rad") ? last.substr(0, last.size() - 4) : last;
   for (const std::string& other : {base, base + "_deg", base + "_rad"})
-    if (other != last && cur[other] && cur[other].IsScalar()) cur.remove(other);
-  cur[last] = o.value;
+    if (other != last && cur[other] && (cur[other].IsScalar() || cur[other].IsSequence())) cur.remove(other);
+  if (list.IsSequence())
+    cur[last] = list;
+  else
+    cur[last] = o.value;
   if (touched) touched->push_back({cur[last], o.path});
 }
 

@@ -85,6 +85,17 @@ TEST(YamlFields, OverridesReachScalarsByPathAndName) {
   EXPECT_NEAR(c.initial.q, 75 * M_PI / 180, 1e-15);
   const Scene back = load_scene("crane-luffing", {parse_override("initial.q_deg=75"), parse_override("initial.q=1.5")});
   EXPECT_DOUBLE_EQ(back.initial.q, 1.5);
+  // A list as a flow list: a scene without a range is given one (`independent_range.0=…` had no
+  // item to set), and the other unit's key is replaced as for scalars.
+  const Scene r = parse_scene(kFourbar, "t.yaml", {parse_override("independent_range_deg=[-10, 80]")});
+  ASSERT_TRUE(r.independent_range);
+  EXPECT_NEAR(r.independent_range->min, -10 * M_PI / 180, 1e-15);
+  EXPECT_NEAR(r.independent_range->max, 80 * M_PI / 180, 1e-15);
+  const Scene r2 = parse_scene(kFourbar, "t.yaml",
+                               {parse_override("independent_range_deg=[-10, 80]"),
+                                parse_override("independent_range=[-0.2, 1.0]")});
+  ASSERT_TRUE(r2.independent_range);
+  EXPECT_DOUBLE_EQ(r2.independent_range->max, 1.0);
 }
 
 TEST(YamlFields, MalformedEmptyAndBinaryInputsAreRefused) {
@@ -155,6 +166,9 @@ TEST(YamlFields, MalformedOverridesAreRefusedNamingThem) {
       {"loads.bearing.coefficient=.nan", "--set loads.bearing.coefficient", "finite"},
       {"name=a b", "--set name", "not a valid name"},
       {"bodies=3", "--set bodies", "only scalar values"},
+      {"bodies=[a, {b: 1}]", "--set bodies", "at most 64 scalar items"},  // no structure through --set
+      {"ground_points=[1, 2]", "--set ground_points", "only scalars and lists"},
+      {"independent_range=[1, [2]]", "--set independent_range", "scalar items"},
       {"independent.x=3", "--set independent.x", "not a mapping"},
   };
   for (const auto& c : cases) expect_refused(kFourbar, c.field, c.says, "", {parse_override(c.override_text)});

@@ -325,9 +325,6 @@ void check_optimize_options(const models::Scene& scene, const OptimizeOptions& o
                             : scene.optimize && !scene.optimize->force.empty() ? scene.optimize->force
                                                                                : std::string();
   if (cf.empty()) fail("outputs.constraint_forces", "optimize minimises a constraint force: request one");
-  if (scene.joint_torques.empty())
-    fail("loads", "optimize shapes joint torques and the scene has none: add a joint_torque, or one with --add-torque "
-                  "JOINT, and remove the scene's drive loads of other kinds (point forces and motors are not design loads)");
   // One amplitude scales the design loads (every joint torque) to hold the cadence, every other
   // load as given. A motor or a point force would drive beside them, neither shaped nor scaled:
   // with a motor as the real drive (slider-crank) the design load is the piston's load, which
@@ -335,6 +332,7 @@ void check_optimize_options(const models::Scene& scene, const OptimizeOptions& o
   // (bicycle-muscle) an added torque has nothing left to do. Refused before any work.
   std::string designed;
   for (const auto& t : scene.joint_torques) designed += (designed.empty() ? "'" : ", '") + t.name + "'";
+  if (designed.empty()) designed = "none in this scene";
   auto refuse_drive = [&](const std::string& kind, const std::string& name, const std::string& joint) {
     throw models::SceneError(
         scene.source_file, scene.line_of("loads." + name), "loads." + name,
@@ -343,8 +341,13 @@ void check_optimize_options(const models::Scene& scene, const OptimizeOptions& o
                     "drive must be joint torques alone; give the drive as a joint_torque{} and remove the {}",
                     kind, name, designed, joint.empty() ? "" : " on joint '" + joint + "'", kind));
   };
+  // A motor or a point force is named at its own line before the missing joint torques: a
+  // motor-driven scene was refused at `loads` without a line.
   for (const auto& mo : scene.motors) refuse_drive("motor", mo.name, mo.joint);
   for (const auto& pf : scene.point_forces) refuse_drive("point force", pf.name, "");
+  if (scene.joint_torques.empty())
+    fail("loads", "optimize shapes joint torques and the scene has none: add a joint_torque, or one with --add-torque "
+                  "JOINT");
   if (!force.empty() &&
       std::none_of(cf.begin(), cf.end(), [&](const models::ConstraintForceRequest& c) { return c.name == force; }))
     fail(opt.force_name.empty() ? "optimize.force" : "--force-name",

@@ -268,19 +268,33 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
       v.samples10 = e.samples;
     }
     for (const auto& var : plan.variants) {
-      const auto model = reduced::make_reduced_model(e.samples, extraction_scene(scene),
-                                                     reduced::parse_interpolation(var.interpolation), var.energy_consistent);
+      // A table whose interpolant is not a model (m1 ≤ 0 between coarse grid points of a crank
+      // that folds flat) stops that variant's runs, recorded with the reason: the scene's
+      // validation exited 2 at its 30° grid.
+      std::optional<reduced::ReducedModel> built;
+      std::string not_a_model;
+      try {
+        built = reduced::make_reduced_model(e.samples, extraction_scene(scene),
+                                            reduced::parse_interpolation(var.interpolation), var.energy_consistent);
+      } catch (const reduced::TableError& err) {
+        not_a_model = err.what();
+      }
       auto add_run = [&](const std::string& integrator, double tol, double h) {
         progress.count(scene.name + ": reduced ladder", done++, total);
         RunRecord r;
         r.model = "reduced";
         r.grid_deg = grid;
         r.interpolation = var.interpolation;
-        r.fit = model.table.fit;
         r.energy_consistent = var.energy_consistent;
         r.integrator = integrator;
         r.tolerance = tol;
         r.fixed_step_s = h;
+        if (!built) {
+          record_stopped(r, not_a_model, v);
+          return;
+        }
+        const reduced::ReducedModel& model = *built;
+        r.fit = model.table.fit;
         auto ro = reduced_options(v, integrator, tol, h);
         models::TimeSeries timed, rows, ts;
         std::vector<double> walls;
@@ -311,7 +325,7 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
         r.compared_run_wall_s = ts.stats.wall_time_s;
         r.output_interpolation = compare_series(ts, rows, v.window.t_start);
         v.runs.push_back(r);
-        if (grid == 10 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
+        if (std::abs(grid - v.default_grid_deg) < 1e-9 && var.interpolation == kDefaultInterpolation && !var.energy_consistent && integrator == "rk8pd" &&
             tol == plan.tightest_tolerance()) {
           v.showcase = ts;
           v.showcase_run = static_cast<int>(v.runs.size()) - 1;
@@ -329,7 +343,13 @@ void run_reduced_ladder(const models::Scene& scene, const LadderPlan& plan, Vali
 // The interpolant of the 10° table at 1° (figure 1).
 void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
   if (v.samples10.q.empty()) return;
-  const auto m = reduced::make_reduced_model(v.samples10, extraction_scene(scene), reduced::Interpolation::Fourier);
+  std::optional<reduced::ReducedModel> built;
+  try {
+    built = reduced::make_reduced_model(v.samples10, extraction_scene(scene), reduced::Interpolation::Fourier);
+  } catch (const reduced::TableError&) {
+    return;  // not a model at 10° (its ladder runs say why): no figure
+  }
+  const auto& m = *built;
   std::vector<int> cols{m.c_m1, m.c_m2};
   v.dense_names = {"q_deg", "m1", "m2"};
   for (size_t k = 0; k < scene.outputs.constraint_forces.size(); ++k) {  // not the internal lines
@@ -354,7 +374,7 @@ void calc_dense_params(const models::Scene& scene, ValidationResult& v) {
 // Stage 6: the scene's thresholds; a grid outside the ladder is run now.
 void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
   v.default_thresholds = scene.validation.thresholds.empty();
-  for (const auto& th : thresholds_of(scene)) {
+  for (const auto& th : thresholds_of(scene, v.quantities, v.default_grid_deg)) {
     // A reference that moves by more than a threshold when its tolerance is halved cannot
     // judge that threshold: the error measured would be the reference's own (a chain through
     // its flat configuration passed with a reference whose q̇ changed by 100 % of its peak).
@@ -368,18 +388,23 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
       const std::string interp = th.interpolation.empty() ? kDefaultInterpolation : th.interpolation;
       const auto e =
           extract_from_full(extraction_scene(scene), th.grid_deg, reduced::Method::Kinetostatic, /*require_closed_turn=*/false);
-      const auto m = reduced::make_reduced_model(e.samples, extraction_scene(scene), reduced::parse_interpolation(interp));
       RunRecord r;
       r.model = "reduced";
       r.grid_deg = th.grid_deg;
       r.interpolation = interp;
-      r.fit = m.table.fit;
       r.integrator = "rk8pd";
       r.tolerance = v.tightest_tolerance;
-      auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);
-      ro.step_outputs = true;  // compared rows as accurate as the steps, as in the ladder
-      const auto ts = with_joint_outputs(scene, m, reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro));
-      r.errors = compare_series(v.reference, ts, v.window.t_start);
+      try {  // a table that is not a model, a run that stops: the threshold fails, saying why
+        const auto m =
+            reduced::make_reduced_model(e.samples, extraction_scene(scene), reduced::parse_interpolation(interp));
+        r.fit = m.table.fit;
+        auto ro = reduced_options(v, "rk8pd", v.tightest_tolerance, 0.0);
+        ro.step_outputs = true;  // compared rows as accurate as the steps, as in the ladder
+        const auto ts = with_joint_outputs(scene, m, reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro));
+        r.errors = compare_series(v.reference, ts, v.window.t_start);
+      } catch (const std::runtime_error& err) {  // TableError (validity domain) or NumericalError
+        mark_stopped(r, err.what(), v.quantities);
+      }
       tr = judge_threshold_on(th, r);
     }
     if (!tr->pass)
@@ -390,6 +415,18 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
 }
 
 }  // namespace
+
+// A table whose full-turn sweep does not close at any grid keeps 10°: the ladder
+// (require_closed_turn off) records what each grid gives.
+double calc_default_grid(const models::Scene& scene) {
+  double grid = kDefaultThresholdGrid_deg;
+  try {
+    extract_resolving(extraction_scene(scene), grid, /*grid_given=*/false, reduced::Method::Kinetostatic, grid);
+  } catch (const reduced::SweepNotClosed&) {
+    return kDefaultThresholdGrid_deg;
+  }
+  return grid;
+}
 
 void run_reference(const models::Scene& scene, engine::FullModel& full, ValidationResult& v, Progress& progress) {
   // A coordinate confined to a range (a rocker, a slider) has no revolutions to count.
@@ -436,7 +473,12 @@ void analyse_runs(ValidationResult& v) {
   v.speedup_at_matched_error.reset();
   // No claim from too few samples or a validation that already failed.
   if (v.failures.empty() && v.reference_change.samples >= kMinComparedSamples) v.speedup_at_matched_error = matched.speedup;
-  v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
+  // Every judged quantity within the target (so the first screen's verdicts are all met); when no
+  // run reaches that, the speed and the headline alone, its misses shown (and, on the default
+  // thresholds, a failure: calc_first_screen).
+  v.recommended = pick_recommended(v.runs, v.quantities, v.matched_target);
+  v.recommended_on_all = v.recommended >= 0;
+  if (v.recommended < 0) v.recommended = pick_recommended(v.runs, {"qdot", v.headline_quantity}, v.matched_target);
   const SignalError* ref = v.reference_change.find(v.headline_quantity);
   v.convergence_floor = 10 * std::max(1e-12, ref ? ref->max_rel : 0.0);
   v.convergence = calc_convergence(v.runs, v.headline_quantity, v.tightest_tolerance, v.convergence_floor);
@@ -447,17 +489,15 @@ void calc_drive_cycle(const models::Scene& scene, ValidationResult& v) {
   const double cadence = scene.validation.calibrate_cadence_Hz;
   const bool revolute = scene.find_joint(scene.independent)->type == models::JointType::Revolute;
   if (!(cadence > 0) || !revolute || v.samples10.q.empty() || !v.samples10.periodic) return;
-  // On the table `rdyn drive --cadence-hz` takes (10°, refined where it does not resolve the
-  // mechanism): a five-bar geared 6:1 was drawn 25 % off on the 10° one while the command the
-  // report names agreed to 2e-7.
-  double grid = 10.0;  // the ladder's 10° table, when it resolves the mechanism; else from 5° on
+  // On the table `rdyn drive --cadence-hz` takes (the default grid): a five-bar geared 6:1 was
+  // drawn 25 % off on the 10° one while the command the report names agreed to 2e-7.
   const reduced::Samples samples =
-      calc_resolution_miss(v.samples10).second > kAutoRefineMiss
-          ? extract_resolving(extraction_scene(scene), 5.0, false, reduced::Method::Kinetostatic, grid).samples
-          : v.samples10;
+      v.default_grid_deg == 10.0
+          ? v.samples10
+          : extract_from_full(extraction_scene(scene), v.default_grid_deg, reduced::Method::Kinetostatic).samples;
   const auto model = reduced::make_reduced_model(samples, extraction_scene(scene), reduced::Interpolation::Fourier);
   v.drive_cycle = calc_drive_cycle_comparison(scene, model, cadence);
-  v.drive_cycle->grid_deg = grid;
+  v.drive_cycle->grid_deg = v.default_grid_deg;
 }
 
 void calc_first_screen(ValidationResult& v) {
@@ -471,6 +511,16 @@ void calc_first_screen(ValidationResult& v) {
                        v.matched_target, v.headline_quantity));
   const RunRecord* rec = v.recommended >= 0 ? &v.runs[v.recommended] : nullptr;
   v.verdicts = calc_verdicts(v.quantities, rec, v.matched_target);
+  // On the defaults every judged quantity must be reachable too: a scene passed while its
+  // first screen said its reactions were above the target.
+  if (rec && !v.recommended_on_all && v.default_thresholds) {
+    std::string missed;
+    for (const auto& vd : v.verdicts)
+      if (!vd.within_target) missed += fmt::format("{}{} ({:.3g})", missed.empty() ? "" : ", ", vd.quantity, vd.error);
+    v.fail(fmt::format("no reduced run reached the error target {:.3g} on every judged quantity; the recommended "
+                       "setting ({}) misses it on {}",
+                       v.matched_target, rec->label(), missed));
+  }
   v.baselines.clear();
   v.budget.reset();
   v.recommended_full = -1;
@@ -545,7 +595,8 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   // 2–3. The ladders.
   run_stage(v, "full-model ladder", [&] { run_full_ladder(scene.name, full, plan, v, progress); });
   run_stage(v, "reduced ladder", [&] {
-    run_reduced_ladder(scene, plan, v, progress);
+    v.default_grid_deg = calc_default_grid(scene);
+    run_reduced_ladder(scene, with_grid(plan, v.default_grid_deg), v, progress);
     calc_dense_params(scene, v);
   });
   // 3b. Peer engines (MuJoCo) on the same scene, timed like the full model.

@@ -70,6 +70,9 @@ struct ValidationResult {
   std::optional<double> speedup_at_matched_error;
   int matched_full = -1, matched_reduced = -1;  // indices into runs
   int recommended = -1;                         // cheapest reduced run within the target (index)
+  // Whether `recommended` is within the target on every judged quantity (else on the speed and
+  // the headline quantity only, the others' misses shown in the verdicts).
+  bool recommended_on_all = false;
   // The cheapest full run at equal or better error than the recommended run on the speed and
   // the headline quantity, and the recommended run's speedup over it: the first screen's one
   // speedup. When no ladder run is that accurate, the ladder's most accurate run (still less
@@ -83,7 +86,11 @@ struct ValidationResult {
   std::optional<ErrorBudget> budget;            // of the recommended run, headline quantity
   std::vector<ConvergenceSeries> convergence;   // headline quantity against the grid
   double convergence_floor = 0.0;               // 10× the reference's own change
-  models::TimeSeries reference, showcase;        // showcase: reduced, 10°, default settings
+  // The grid rdyn's commands take for this scene by default: 10°, halved while its table does not
+  // resolve the mechanism (validate/analysis/build_reduced's extract_resolving). The ladder always
+  // has it; the default thresholds, the figure's reduced run and the drive cycle are on it.
+  double default_grid_deg = 10.0;
+  models::TimeSeries reference, showcase;        // showcase: reduced, default grid, default settings
   int showcase_run = -1;
   reduced::Samples samples10;                    // the 10° table
   std::vector<std::vector<double>> dense_params; // q_deg, then m1, m2, me1.., me2.. at 1° (interpolant)
@@ -117,6 +124,10 @@ models::Scene extraction_scene(const models::Scene& scene);
 // stages, in order: run_reference, plan_ladders (validate/harness/ladder_plan.hpp), the full and reduced
 // ladders, analyse_runs, calibration, thresholds, calc_first_screen.
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress);
+
+// The grid rdyn's commands take for the scene by default (ValidationResult::default_grid_deg):
+// 10°, halved while its table does not resolve the mechanism (extract_resolving).
+double calc_default_grid(const models::Scene& scene);
 
 // Stage 1: the reference (full model at the scene's reference tolerance), its change when the
 // tolerance is halved, the compared window and the scene's time scale, into `v` (whose

@@ -1,5 +1,9 @@
 #include "validate/harness/ladder_plan.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
 namespace rdyn::validate {
 
 long LadderPlan::reduced_runs() const {
@@ -37,6 +41,15 @@ LadderPlan plan_ladders(const TimeScale& scale, bool quick) {
   p.peer_repeats = p.full_repeats;
   p.reduced_repeats = quick ? RepeatPolicy{1, 200, 0.02} : RepeatPolicy{3, 200, 0.1};
   return p;
+}
+
+LadderPlan with_grid(LadderPlan plan, double grid_deg) {
+  auto& g = plan.grids_deg;
+  if (std::none_of(g.begin(), g.end(), [&](double x) { return std::abs(x - grid_deg) < 1e-9; })) {
+    g.push_back(grid_deg);
+    std::sort(g.begin(), g.end(), std::greater<double>());
+  }
+  return plan;
 }
 
 }  // namespace rdyn::validate

@@ -44,4 +44,10 @@ struct LadderPlan {
 // `quick`: short ladders and single repeats (suites, smoke runs).
 LadderPlan plan_ladders(const TimeScale& scale, bool quick);
 
+// The plan with `grid_deg` among its grids (kept coarse to fine), when it is not already: the
+// scene's default grid (ValidationResult::default_grid_deg) is always run, so a scene that 10°
+// does not resolve is judged and recommended on the grid the commands take (2.5° for a five-bar
+// geared 6:1, not in the quick ladder's 30, 10, 5).
+LadderPlan with_grid(LadderPlan plan, double grid_deg);
+
 }  // namespace rdyn::validate

@@ -308,8 +308,14 @@ nlohmann::json summary_json(const ValidationResult& v) {
   // The settings to use for this scene, chosen from the measurements (validate/harness/pareto.hpp).
   j["recommended_reduced"] =
       v.recommended >= 0 ? run_json(v.runs[v.recommended]) : nlohmann::json(nullptr);
+  // false: no run was within the target on every judged quantity; the recommended one is on the
+  // speed and the headline quantity, its misses in the verdicts.
+  j["recommended_on_all_quantities"] = v.recommended_on_all;
   j["showcase_reduced"] =
       v.showcase_run >= 0 ? run_json(v.runs[v.showcase_run]) : nlohmann::json(nullptr);
+  // The grid rdyn's commands take for this scene by default (10°, halved while it does not
+  // resolve the mechanism): the showcase's and the default thresholds' grid.
+  j["default_grid_deg"] = v.default_grid_deg;
   add_first_screen_json(v, j);
   if (v.budget)
     j["error_budget"] = {

@@ -4,11 +4,12 @@
 
 namespace rdyn::validate {
 
-std::vector<models::Threshold> thresholds_of(const models::Scene& scene) {
+std::vector<models::Threshold> thresholds_of(const models::Scene& scene, const std::vector<std::string>& judged,
+                                             double default_grid_deg) {
   if (!scene.validation.thresholds.empty()) return scene.validation.thresholds;
-  std::vector<models::Threshold> th{{"qdot", kDefaultThresholdGrid_deg, "", kDefaultThresholdMaxError}};
-  for (const auto& f : scene.outputs.constraint_forces)
-    th.push_back({f.name, kDefaultThresholdGrid_deg, "", kDefaultThresholdMaxError});
+  std::vector<models::Threshold> th;
+  for (const auto& q : judged)
+    if (q != "mean_qdot") th.push_back({q, default_grid_deg, "", kDefaultThresholdMaxError});
   return th;
 }
 
@@ -17,10 +18,11 @@ ThresholdResult judge_threshold_on(const models::Threshold& th, const RunRecord&
   // An error relative to a peak of zero (a mechanism at rest, a force that never acts) is no
   // error at all: the threshold cannot be met (issue #9, "never exit 0 on nothing").
   const SignalError* s = r.errors.find(th.quantity);
-  if (s && !(s->peak > 0)) {
+  if (s && !(s->peak > 0) && r.failure.empty()) {  // a stopped run records no peaks
     t.error = NAN;
     t.run += " (the reference's peak of " + th.quantity + " is 0: no relative error exists)";
   }
+  if (!r.failure.empty()) t.run += " (stopped: " + r.failure + ")";  // why the error is +∞
   t.pass = t.error <= th.max_error;  // false for NaN and +∞ (a stopped run)
   return t;
 }

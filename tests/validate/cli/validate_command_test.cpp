@@ -291,4 +291,59 @@ TEST(ValidateCommand, ReportAnimatesOneSteadyCycleWhereTheFullModelPutsIt) {
   fs::remove_all(dir);
 }
 
+// A user's five-bar geared 6:1 without thresholds (issue #23): 10° misses m1 by 50 % from every
+// other grid point, and validate judged it there (q̇ 61 % off: a false failure) while every other
+// command refines. It is judged on the grid the commands take (1.25°), every joint output
+// included, and its figure draws that grid's run.
+TEST(ValidateCommand, ASceneWithoutThresholdsIsJudgedOnTheCommandsGridAndEveryJointOutput) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_default_grid_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::string text = slurp(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/fivebar-2to1.yaml");
+  text = text.substr(0, text.find("validation:"));
+  text.replace(text.find("ratio: 2.0"), 10, "ratio: 6.0");
+  text.replace(text.find("q_deg: 90"), 9, "q_deg: 80");
+  std::ofstream(dir / "fivebar6.yaml") << text;
+  rdyn::test::RunLimits limits;
+  limits.time_limit_s = 600.0;
+  const auto r = rdyn::test::run_rdyn({"validate", "fivebar6.yaml", "--quick", "--out", "v"}, dir, limits);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto s = nlohmann::json::parse(slurp(dir / "v/summary.json"));
+  EXPECT_EQ(s.at("default_grid_deg").get<double>(), 1.25);
+  EXPECT_TRUE(s.at("thresholds_are_defaults").get<bool>());
+  EXPECT_TRUE(s.at("recommended_on_all_quantities").get<bool>());
+  std::vector<std::string> judged;
+  for (const auto& t : s.at("thresholds")) {
+    judged.push_back(t.at("quantity"));
+    EXPECT_EQ(t.at("grid_deg").get<double>(), 1.25);
+    EXPECT_LT(t.at("error").get<double>(), 1e-4) << t.at("quantity");  // measured ≤ 5e-6
+  }
+  for (const char* q : {"qdot", "arm1_axial", "R_P_x", "R_fast_y", "qddot_arm2", "shaking_M"})
+    EXPECT_NE(std::find(judged.begin(), judged.end(), q), judged.end()) << q;
+  EXPECT_NE(s.at("showcase_reduced").at("label").get<std::string>().find("1.25°"), std::string::npos);
+  EXPECT_NE(slurp(dir / "v/report.html").find("The reduced run drawn is the 1.25° table"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// An isosceles crank folds flat twice a turn, where the rod force has a pole: coarse tables are
+// not models (m1 ≤ 0 between 30° points). Those runs are recorded as stopped with the reason and
+// the validation fails with its report written (it exited 2, writing nothing).
+TEST(ValidateCommand, ATableThatIsNotAModelStopsItsRunsNotTheValidation) {
+  const fs::path dir = fs::temp_directory_path() / ("rdyn_validate_not_a_model_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto r = rdyn::test::run_rdyn(
+      {"validate", std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/iso-crank-driven.yaml", "--quick", "--out", "v"},
+      dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  ASSERT_TRUE(fs::exists(dir / "v/report.html")) << r.err;
+  const auto s = nlohmann::json::parse(slurp(dir / "v/summary.json"));
+  bool stopped = false;
+  for (const auto& run : s.at("runs"))
+    stopped |= run.value("failure", std::string()).find("is not positive") != std::string::npos;
+  EXPECT_TRUE(stopped);
+  EXPECT_NE(r.err.find("stopped:"), std::string::npos) << r.err;  // the failing threshold says why
+  fs::remove_all(dir);
+}
+
 }  // namespace

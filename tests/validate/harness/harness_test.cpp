@@ -96,6 +96,8 @@ TEST(Harness, DriveCycleRefinesATableThatDoesNotResolveTheMechanism) {
   const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/fivebar-2to1.yaml");
   ValidationResult v;
   v.samples10 = extract_from_full(extraction_scene(scene), 10, reduced::Method::Kinetostatic).samples;
+  v.default_grid_deg = calc_default_grid(scene);
+  EXPECT_EQ(v.default_grid_deg, 2.5);
   calc_drive_cycle(scene, v);
   ASSERT_TRUE(v.drive_cycle);
   EXPECT_EQ(v.drive_cycle->grid_deg, 2.5);
@@ -105,6 +107,50 @@ TEST(Harness, DriveCycleRefinesATableThatDoesNotResolveTheMechanism) {
       scene, reduced::make_reduced_model(v.samples10, extraction_scene(scene), reduced::Interpolation::Fourier),
       scene.validation.calibrate_cadence_Hz);
   EXPECT_GT(coarse.max_difference / coarse.full_stats.peak, 100 * refined);
+}
+
+// The default grid is the one the commands take: 10° where it resolves the mechanism (the
+// four-bar: m1 misses 1.4e-4 from every other grid point), finer where it does not.
+TEST(Harness, DefaultGridIsTheCommandsGrid) {
+  EXPECT_EQ(calc_default_grid(models::load_scene("fourbar")), 10.0);
+  double grid = 0.0;
+  const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml");
+  extract_resolving(extraction_scene(scene), 10.0, false, reduced::Method::Kinetostatic, grid);
+  EXPECT_LT(grid, 10.0);
+  EXPECT_EQ(calc_default_grid(scene), grid);
+}
+
+// On the default thresholds every judged quantity must be reachable: a run within the target on
+// the speed and the headline but not on a reaction is recommended (its misses in the verdicts)
+// and the validation fails, naming the reaction; a declared threshold set leaves that verdict to
+// the scene.
+TEST(Harness, DefaultThresholdsFailWhenNoRunReachesEveryQuantity) {
+  auto v = test::synthetic_validation();
+  for (auto& r : v.runs) r.errors.signals.push_back({"R_crank_x", 5.0, r.error_of("qdot") * 20, 0.0});
+  v.quantities = {"qdot", "F", "R_crank_x", "mean_qdot"};
+  v.failures.clear();
+  v.pass = true;
+  v.default_thresholds = true;
+  analyse_runs(v);
+  EXPECT_EQ(v.recommended, 2);  // 2e-4, 4e-4 on the speed and F; 4e-3 on R_crank_x
+  EXPECT_FALSE(v.recommended_on_all);
+  calc_first_screen(v);
+  EXPECT_FALSE(v.pass);
+  EXPECT_NE(v.failure_summary().find("misses it on R_crank_x (0.004)"), std::string::npos) << v.failure_summary();
+  ASSERT_EQ(v.verdicts.size(), 4u);
+  EXPECT_FALSE(v.verdicts[2].within_target);
+  v.failures.clear();
+  v.pass = true;
+  v.default_thresholds = false;
+  calc_first_screen(v);
+  EXPECT_TRUE(v.pass) << v.failure_summary();
+  // Within the target on every quantity: recommended on all, no failure.
+  v.runs[2].errors.signals.back().max_rel = 5e-4;
+  v.default_thresholds = true;
+  analyse_runs(v);
+  EXPECT_TRUE(v.recommended_on_all);
+  calc_first_screen(v);
+  EXPECT_TRUE(v.pass) << v.failure_summary();
 }
 
 TEST(Harness, AnalysisAndFirstScreenFromRecords) {

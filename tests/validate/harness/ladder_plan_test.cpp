@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <vector>
 
 namespace rdyn::validate {
 namespace {
@@ -35,6 +36,19 @@ TEST(LadderPlan, FullAndQuickLadders) {
   EXPECT_EQ(q.reduced_runs(), 3 * 2 * 2);  // 3 grids × 2 variants × (rk8pd + one rk4)
   EXPECT_EQ(q.full_repeats.min_repeats, 1);
   EXPECT_EQ(q.tightest_tolerance(), 1e-8);
+}
+
+TEST(LadderPlan, TheDefaultGridIsAlwaysRun) {
+  const TimeScale one_second{1.0, 5.0, ""};
+  const auto q = plan_ladders(one_second, true);
+  // 2.5° (a five-bar geared 6:1) joins the quick ladder in its place, coarse to fine; a grid the
+  // ladder has is not run twice.
+  const auto with = with_grid(q, 2.5);
+  EXPECT_EQ(with.grids_deg, (std::vector<double>{30, 10, 5, 2.5}));
+  EXPECT_EQ(with.reduced_runs(), 4 * 2 * 2);
+  EXPECT_EQ(with_grid(q, 10.0).grids_deg, q.grids_deg);
+  EXPECT_EQ(with_grid(plan_ladders(one_second, false), 1.25).grids_deg,
+            (std::vector<double>{30, 20, 10, 5, 2, 1.25, 1, 0.5}));
 }
 
 TEST(LadderPlan, FixedStepsFollowTheTimeScale) {

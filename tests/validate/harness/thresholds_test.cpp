@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "models/scene_yaml.hpp"
+#include "validate/harness/harness.hpp"
 #include "tests/validate/harness/run_records.hpp"
 
 namespace rdyn::validate {
@@ -38,30 +39,40 @@ TEST(Thresholds, AStoppedRunOrAMissingQuantityFails) {
   const auto t = judge_threshold_on({"qdot", 10.0, "", 1e9}, stopped);
   EXPECT_FALSE(t.pass);
   EXPECT_TRUE(std::isinf(t.error));
+  EXPECT_NE(t.run.find("(stopped: diverged)"), std::string::npos) << t.run;  // the failure says why
+  // A stopped run as the harness records it (every quantity +∞, peak 0) is not read as a
+  // reference whose peak is 0.
+  mark_stopped(stopped, "m1 not positive", {"qdot"});
+  const auto m = judge_threshold_on({"qdot", 10.0, "", 1e9}, stopped);
+  EXPECT_TRUE(std::isinf(m.error));
+  EXPECT_EQ(m.run.find("peak"), std::string::npos) << m.run;
 }
 
 TEST(Thresholds, ASceneWithoutThresholdsIsJudgedOnTheDefaults) {
   // Without defaults a validation whose every reduced run was 176 % off passed: nothing was
-  // judged. The defaults cover the speed and every requested constraint force.
+  // judged. The defaults cover every judged quantity but the mean speed, on the default grid.
   auto scene = models::load_scene("fourbar");
   ASSERT_TRUE(scene.validation.thresholds.empty());  // the shipped four-bar declares none
-  const auto th = thresholds_of(scene);
-  ASSERT_EQ(th.size(), 1 + scene.outputs.constraint_forces.size());
+  const std::vector<std::string> judged{"qdot", scene.outputs.constraint_forces[0].name, "R_crank_x", "mean_qdot"};
+  const auto th = thresholds_of(scene, judged, 2.5);
+  ASSERT_EQ(th.size(), 3u);
   EXPECT_EQ(th[0].quantity, "qdot");
   EXPECT_EQ(th[1].quantity, scene.outputs.constraint_forces[0].name);
+  EXPECT_EQ(th[2].quantity, "R_crank_x");  // a joint output: a scene passed while its reactions missed
   for (const auto& t : th) {
-    EXPECT_EQ(t.grid_deg, kDefaultThresholdGrid_deg);
+    EXPECT_EQ(t.grid_deg, 2.5);
     EXPECT_EQ(t.max_error, kDefaultThresholdMaxError);
   }
   // A run 176 % off fails them; a declared threshold replaces them all.
   std::vector<RunRecord> runs{record("reduced", 1e-3, {{"qdot", 1.76}})};
   runs[0].tolerance = 1e-10;
+  runs[0].grid_deg = 2.5;
   const auto t = judge_threshold(th[0], runs, 1e-10);
   ASSERT_TRUE(t);
   EXPECT_FALSE(t->pass);
   scene.validation.thresholds = {{"qdot", 5.0, "", 0.01}};
-  ASSERT_EQ(thresholds_of(scene).size(), 1u);
-  EXPECT_EQ(thresholds_of(scene)[0].grid_deg, 5.0);
+  ASSERT_EQ(thresholds_of(scene, judged, 2.5).size(), 1u);
+  EXPECT_EQ(thresholds_of(scene, judged, 2.5)[0].grid_deg, 5.0);
 }
 
 }  // namespace
