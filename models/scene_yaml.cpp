@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -573,15 +572,16 @@ std::string resolve_scene_path(const std::string& name_or_path) {
   throw SceneError(name_or_path, 0, "", "no such scene file (nor a shipped scene of that name)");
 }
 
-Scene parse_scene(const std::string& text, const std::string& file,
-                  const std::vector<Override>& overrides) {
-  YAML::Node root = load_checked_yaml(text, file);
+Scene parse_scene(const std::string& text, const std::string& file, const std::vector<Override>& overrides) {
+  return read_scene_tree(load_checked_yaml(text, file), file, overrides);
+}
+
+Scene yaml::read_scene_tree(YAML::Node root, const std::string& file, const std::vector<Override>& overrides) {
   Context ctx{file, {}};
   for (const auto& o : overrides) apply_override(root, o, file, &ctx.set_by_override);
   // The overrides may have added nodes: check the tree they left (duplicates cannot arise,
   // but depth and size can grow with created mappings).
   if (!overrides.empty()) check_yaml_tree(root, file);
-
   Scene s;
   s.source_file = file;
   try {

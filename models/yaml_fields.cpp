@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 namespace rdyn::models::yaml {
 
@@ -338,6 +339,55 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
   else
     cur[last] = o.value;
   if (touched) touched->push_back({cur[last], o.path});
+}
+
+struct MarkAccess;  // names the as_if specialisation below
+}  // namespace rdyn::models::yaml
+
+namespace YAML {
+// yaml-cpp keeps a node's mark (its line and column in the text) private, and YAML::Clone puts
+// every node at the text's start (its NodeEvents emits each event at a default Mark, line 1:
+// yaml-cpp 0.7 src/nodeevents.cpp). Node befriends every as_if<T, S>; this specialisation for a type of ours
+// reads a node's identity and sets its mark through detail::node::set_mark, the call yaml-cpp's
+// own NodeBuilder makes while parsing.
+template <>
+struct as_if<rdyn::models::yaml::MarkAccess, void> {
+  static const void* identity(const Node& n) { return n.m_pNode; }
+  static void set_mark(const Node& n, const Mark& mark) {
+    if (n.m_pNode) n.m_pNode->set_mark(mark);
+  }
+};
+}  // namespace YAML
+
+namespace rdyn::models::yaml {
+
+namespace {
+using Marks = YAML::as_if<MarkAccess, void>;
+
+// Copies the marks of `from`'s nodes (keys too) onto `to`'s, which has the same shape. A node
+// shared through an alias is visited once (`seen`), so the walk is linear in the nodes of the
+// text, however often aliases repeat them.
+void copy_marks(const YAML::Node& from, const YAML::Node& to, std::unordered_set<const void*>& seen) {
+  if (!seen.insert(Marks::identity(from)).second) return;
+  Marks::set_mark(to, from.Mark());
+  if (from.IsSequence()) {
+    for (size_t i = 0; i < from.size(); ++i) copy_marks(from[i], to[i], seen);
+  } else if (from.IsMap()) {
+    auto b = to.begin();
+    for (auto a = from.begin(); a != from.end() && b != to.end(); ++a, ++b) {
+      copy_marks(a->first, b->first, seen);
+      copy_marks(a->second, b->second, seen);
+    }
+  }
+}
+}  // namespace
+
+YAML::Node clone_with_marks(const YAML::Node& root) {
+  // YAML::Clone keeps the tree's shape, order, tags, styles and shared (aliased) nodes.
+  YAML::Node copy = YAML::Clone(root);
+  std::unordered_set<const void*> seen;
+  copy_marks(root, copy, seen);
+  return copy;
 }
 
 }  // namespace rdyn::models::yaml

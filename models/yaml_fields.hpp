@@ -39,6 +39,11 @@ Vec2 unit_vector(const Vec2& v, double len);
 void check_yaml_tree(const YAML::Node& root, const std::string& file);
 // Parses one YAML document under those limits (a second document is refused with its line).
 YAML::Node load_checked_yaml(const std::string& text, const std::string& file);
+// A copy of a tree that keeps every node's mark (line and column: YAML::Clone's are line 1), so a
+// scene read from it names the file's lines; aliased nodes stay shared (models/scene_source).
+YAML::Node clone_with_marks(const YAML::Node& root);
+// parse_scene on a tree load_checked_yaml returned: overrides applied to it, then read and checked.
+Scene read_scene_tree(YAML::Node root, const std::string& file, const std::vector<Override>& overrides);
 // The node a field path names, or its deepest ancestor in the tree.
 YAML::Node locate_field(const YAML::Node& root, const std::string& field);
 // Applies one override to the tree; records the nodes it created or set in `touched`.

@@ -1,5 +1,5 @@
 // The largest values of several quantities over a periodic cycle split into smooth pieces:
-// sampled, then refined by golden-section search beside each quantity's largest sample
+// sampled, then refined beside each quantity's largest sample (Brent's method, golden section)
 // (reduced/steady_cycle.cpp: speed extremes and peak constraint forces of a steady cycle).
 #pragma once
 
@@ -42,11 +42,62 @@ void golden_max(F&& f, double lo, double hi, double f_lo, double f_hi, double xt
   keep(x2, f2);
 }
 
+// Max of f over [lo, hi] by Brent's method (parabolic steps, golden section where a parabola
+// does not shrink the bracket; Brent, Algorithms for Minimization without Derivatives, 1973,
+// ch. 5, as in Numerical Recipes §10.3), from x inside with f(x) = fx ≥ f(lo), f(hi): stops when
+// the bracket is at most xtol wide. The maximum of a smooth f is found in ~10 evaluations where
+// golden section takes ~35 for the same bracket; its value differs from golden section's by
+// ~f''·xtol² (rounding), its place by at most xtol.
+template <typename F>
+void brent_max(F&& f, double lo, double hi, double x, double fx, double xtol, double& x_best, double& f_best) {
+  constexpr double c = 0.3819660112501051;  // (3 − √5)/2
+  const double tol = 0.25 * xtol;           // the bracket ends ≤ 4·tol wide
+  double w = x, v = x, gx = -fx, gw = gx, gv = gx, d = 0.0, e = 0.0;  // minimises g = −f
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (std::abs(x - mid) <= 2 * tol - 0.5 * (hi - lo)) break;
+    bool parabolic = false;
+    if (std::abs(e) > tol) {  // the parabola through x, w, v
+      const double r = (x - w) * (gx - gv);
+      double q = (x - v) * (gx - gw), p = (x - v) * q - (x - w) * r;
+      q = 2 * (q - r);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      const double e_old = e;
+      e = d;
+      if (std::abs(p) < std::abs(0.5 * q * e_old) && p > q * (lo - x) && p < q * (hi - x)) {
+        d = p / q;
+        if (x + d - lo < 2 * tol || hi - (x + d) < 2 * tol) d = mid >= x ? tol : -tol;
+        parabolic = true;
+      }
+    }
+    if (!parabolic) {
+      e = x >= mid ? lo - x : hi - x;
+      d = c * e;
+    }
+    const double u = std::abs(d) >= tol ? x + d : x + (d >= 0 ? tol : -tol);
+    const double gu = -f(u);
+    if (gu <= gx) {
+      (u >= x ? lo : hi) = x;
+      v = w, gv = gw, w = x, gw = gx, x = u, gx = gu;
+    } else {
+      (u < x ? lo : hi) = u;
+      if (gu <= gw || w == x) {
+        v = w, gv = gw, w = u, gw = gu;
+      } else if (gu <= gv || v == x || v == w) {
+        v = u, gv = gu;
+      }
+    }
+  }
+  if (-gx > f_best) f_best = -gx, x_best = x;
+}
+
 // The cycle split into pieces [a_j, b_j] of θ (inside a piece every load is smooth); eval(j, θ,
 // out) gives the followed quantities at θ with piece j's gates. Samples every piece at
-// ≥ `samples` points per period P, then refines each quantity's largest sample by golden
-// section over the sub-intervals on either side of it (in the neighbouring piece when the
-// sample is a piece's end; the pieces wrap around: the cycle is periodic).
+// ≥ `samples` points per period P, then refines each quantity's largest sample over the
+// sub-intervals on either side of it: by Brent's method over both when they lie in one piece and
+// the sample is above both neighbours, else by golden section over each (in the neighbouring
+// piece when the sample is a piece's end; the pieces wrap around: the cycle is periodic).
 // `scan(j, θ, out)` gives the samples (it may be a cheap approximation of eval: it only picks
 // which sample each refinement starts beside); every value returned comes from `eval`.
 template <typename Scan, typename Eval>
@@ -81,12 +132,30 @@ void find_extremes(const std::vector<double>& a, const std::vector<double>& b, i
     const int jl = (bk.piece + pieces - 1) % pieces, jr = (bk.piece + 1) % pieces;
     side[0] = bk.i > 0 ? std::make_pair(bk.piece, bk.i - 1) : std::make_pair(jl, subs[jl] - 1);
     side[1] = bk.i < subs[bk.piece] ? std::make_pair(bk.piece, bk.i) : std::make_pair(jr, 0);
-    for (const auto& [j, i] : side) {
-      const double lo = sample_theta(a[j], b[j], i, subs[j]), hi = sample_theta(a[j], b[j], i + 1, subs[j]);
-      auto f = [&](double th) {
+    auto f_in = [&](int j) {
+      return [&, j](double th) {
         eval(j, th, out.data());
         return out[k];
       };
+    };
+    if (bk.i > 0 && bk.i < subs[bk.piece]) {
+      // Both sub-intervals in the piece: if eval confirms the sample is above its neighbours,
+      // Brent's method over the two at once, from the sample (~10 evaluations, not ~70).
+      const int j = bk.piece;
+      const double lo = sample_theta(a[j], b[j], bk.i - 1, subs[j]), hi = sample_theta(a[j], b[j], bk.i + 1, subs[j]);
+      auto f = f_in(j);
+      const double x = where[k], fx = value[k], f_lo = f(lo), f_hi = f(hi);
+      if (fx >= f_lo && fx >= f_hi) {
+        brent_max(f, lo, hi, x, fx, xtol, where[k], value[k]);
+        continue;
+      }
+      golden_max(f, lo, x, f_lo, fx, xtol, where[k], value[k]);  // each side alone, as below
+      golden_max(f, x, hi, fx, f_hi, xtol, where[k], value[k]);
+      continue;
+    }
+    for (const auto& [j, i] : side) {
+      const double lo = sample_theta(a[j], b[j], i, subs[j]), hi = sample_theta(a[j], b[j], i + 1, subs[j]);
+      auto f = f_in(j);
       const double f_lo = f(lo), f_hi = f(hi);
       golden_max(f, lo, hi, f_lo, f_hi, xtol, where[k], value[k]);
     }

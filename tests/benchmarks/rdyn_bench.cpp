@@ -19,6 +19,7 @@
 #include "engine/kinetostatic.hpp"
 #include "engine/mujoco_peer.hpp"
 #include "engine/reduced_source.hpp"
+#include "models/scene_source.hpp"
 #include "models/scene_yaml.hpp"
 #include "reduced/extract.hpp"
 #include "reduced/reduced_model.hpp"
@@ -310,7 +311,8 @@ BENCHMARK(BM_CalibrationWithoutFullCheck)->Unit(benchmark::kMillisecond);
 // bicycle-leg generator), the Simbody system build, the dead-point walk (assembly and
 // calc_independent_domain), the 10° extraction, the table fit and the reduced calibration.
 // Arg 0: the walk with the singular-point scan (before the edges-only walk); Arg 1: the cold
-// route (edges-only walk before every extraction); Arg 2: what the sweep runs now, continuation
+// route (edges-only walk before every extraction); Arg 2: what the sweep runs now (the scene
+// file parsed once, each case's scene a SceneSource load with its override), continuation
 // in the parameters — extract_calibration_table with the previous case's neighbour record (the
 // walk only where a case's own sweep or its neighbour's comes near rank loss) — whose build,
 // walk, extraction and fit are one stage, "table"; `walks` counts the cases that walked.
@@ -329,10 +331,13 @@ void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
   long walks = 0;
   for (auto _ : st) {
     std::optional<validate::TableNeighbour> neighbour;
+    std::optional<models::SceneSource> scenes;  // the sweep's: the file parsed by its first case
     for (int k = 0; k < kCases; ++k) {
       const double h = 1.6 + 0.3 * k / (kCases - 1);
       std::vector<double> t{now()};
-      const auto scene = models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", std::to_string(h)}});
+      const std::vector<models::Override> height{{"bicycle_leg.subject.height_m", std::to_string(h)}};
+      if (continued && !scenes) scenes.emplace("bicycle");
+      const auto scene = continued ? scenes->load(height) : models::load_scene("bicycle", height);
       validate::CalibrationOptions o = validate::calibration_options_of(scene, 0.0, 0.0, "");
       o.full_max_s = 0.0;
       t.push_back(now());

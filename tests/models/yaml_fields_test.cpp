@@ -233,5 +233,47 @@ TEST(YamlFields, MalformedItemsAndUnderflowingNumbersNameTheField) {
   EXPECT_EQ(refusal(fb, {parse_override("initial.qdot=3e-400")}).field(), "--set initial.qdot");
 }
 
+// clone_with_marks: a copy whose every node (keys too) has the original's line and column,
+// independent of the original, with aliased nodes still shared. YAML::Clone, the route it
+// builds on, puts every node at the text's start (line 1): the test would fail on it.
+void expect_same_marks(const YAML::Node& a, const YAML::Node& b, int& nodes) {
+  ++nodes;
+  EXPECT_EQ(a.Mark().line, b.Mark().line);
+  EXPECT_EQ(a.Mark().column, b.Mark().column);
+  EXPECT_EQ(a.Mark().pos, b.Mark().pos);
+  ASSERT_EQ(a.Type(), b.Type());
+  if (a.IsScalar()) {
+    EXPECT_EQ(a.Scalar(), b.Scalar());
+  }
+  if (a.IsSequence()) {
+    for (size_t i = 0; i < a.size(); ++i) expect_same_marks(a[i], b[i], nodes);
+  }
+  if (a.IsMap()) {
+    auto j = b.begin();
+    for (auto i = a.begin(); i != a.end(); ++i, ++j) {
+      expect_same_marks(i->first, j->first, nodes);
+      expect_same_marks(i->second, j->second, nodes);
+    }
+  }
+}
+
+TEST(YamlFields, CloneWithMarksKeepsEveryLineAndSharesAliases) {
+  const std::string text = "name: x\nlist:\n  - {a: 1, b: [2, 3]}\n  - &k\n    c: 4\nother: *k\nlast: 5\n";
+  const YAML::Node root = yaml::load_checked_yaml(text, "t.yaml");
+  YAML::Node copy = yaml::clone_with_marks(root);
+  int nodes = 0;
+  expect_same_marks(root, copy, nodes);
+  EXPECT_EQ(nodes, 21);  // the alias's mapping walked twice, through both names
+  EXPECT_EQ(yaml::line_of(copy["last"]), 7);
+  EXPECT_EQ(yaml::line_of(copy["list"][1]["c"]), 5);
+  EXPECT_EQ(yaml::line_of(YAML::Clone(root)["last"]), 1);  // why the marks are copied: Clone's are all line 1
+  // The alias is one node in the copy as in the original; the copy is not the original.
+  EXPECT_TRUE(copy["other"].is(copy["list"][1]));
+  copy["list"][1]["c"] = "9";
+  EXPECT_EQ(copy["other"]["c"].Scalar(), "9");
+  EXPECT_EQ(root["list"][1]["c"].Scalar(), "4");
+  EXPECT_EQ(root["other"]["c"].Scalar(), "4");
+}
+
 }  // namespace
 }  // namespace rdyn::models

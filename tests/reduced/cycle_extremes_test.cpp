@@ -31,6 +31,30 @@ TEST(CycleExtremes, GoldenSectionFindsAnInteriorMaximumAndKeepsAnEndOfAMonotoneP
   EXPECT_EQ(v2, 2.0);
 }
 
+// Brent's method against the closed form and against golden section (the other route) on the
+// same bracket: the same maximum to rounding, its place within the bracket's width, in half
+// golden section's evaluations or fewer.
+TEST(CycleExtremes, BrentFindsTheMaximumGoldenSectionFindsInFewerEvaluations) {
+  for (const double c : {0.37, 0.5, 0.61, 0.999}) {
+    int brent_evals = 0, golden_evals = 0;
+    auto bump = [c](double t) { return 2.0 + std::cos(3 * (t - c)) + 0.1 * std::sin(t); };
+    auto brent_f = [&](double t) { return ++brent_evals, bump(t); };
+    auto golden_f = [&](double t) { return ++golden_evals, bump(t); };
+    double xb = 0, vb = -INFINITY, xg = 0, vg = -INFINITY;
+    const double lo = c - 0.4, hi = c + 0.3, x0 = c - 0.05;  // x0 above both ends: a bracket
+    brent_max(brent_f, lo, hi, x0, bump(x0), 1e-10, xb, vb);
+    golden_max(golden_f, lo, hi, bump(lo), bump(hi), 1e-10, xg, vg);
+    // The maximum of cos(3(t − c)) + 0.1 sin t: 3 sin(3(t − c)) = 0.1 cos t, t ≈ c + cos(c)/90.
+    double t = c;
+    for (int it = 0; it < 50; ++it) t -= (-3 * std::sin(3 * (t - c)) + 0.1 * std::cos(t)) /
+                                         (-9 * std::cos(3 * (t - c)) - 0.1 * std::sin(t));
+    EXPECT_NEAR(vb, bump(t), 2e-15) << c;
+    EXPECT_NEAR(vb, vg, 2e-15) << c;
+    EXPECT_NEAR(xb, t, 1e-7) << c;  // a flat maximum: its place to √(rounding)
+    EXPECT_LE(2 * brent_evals, golden_evals) << c << ": " << brent_evals << " against " << golden_evals;
+  }
+}
+
 TEST(CycleExtremes, ThreeQuantitiesOverTwoPiecesMatchTheirClosedForms) {
   // Pieces [0, 3] and [3, 2π]; 12 samples per period (every maximum lies between samples).
   // q0 = cos(θ − 1.234): max 1 at 1.234. q1 = θ on the first piece, θ − 4 on the second: a jump
