@@ -142,6 +142,12 @@ TEST(BuildReduced, AMechanismGearedToRepeatEveryTwoTurnsIsToldAndTheSlowJointWor
     EXPECT_NE(m.find("repeats only every 2 turns of 'c1'"), std::string::npos) << m;
     EXPECT_EQ(m.find("finer grid"), std::string::npos) << m;
   }
+  // A default grid is not halved for it: no grid closes the turn (five halvings took 1.4 s).
+  testing::internal::CaptureStderr();
+  double grid = 0.0;
+  EXPECT_THROW(extract_resolving(scene, 10.0, false, reduced::Method::Kinetostatic, grid), reduced::SweepNotClosed);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said.find("extracting at"), std::string::npos) << said;
   scene.independent = "c2";
   scene.initial = {M_PI / 4, 5.0};
   const auto e = extract_from_full(scene, 5, reduced::Method::Kinetostatic);
