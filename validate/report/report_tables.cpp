@@ -237,7 +237,13 @@ std::string thresholds_table(const json& s) {
     h += "<h2>Acceptance thresholds</h2>";
     if (s.value("thresholds_are_defaults", false))
       h += "<p>The scene declares no thresholds: it is judged against the defaults (docs/scene-format.md, "
-           "\"Validation settings\").</p>";
+           "\"Validation settings\"): every compared quantity within 0.5 % of its peak on the grid rdyn's commands "
+           "take for this scene" +
+           (s.contains("default_grid_deg") && s.at("default_grid_deg").is_number()
+                ? fmt::format(" ({:g}°: 10°, halved while the table does not resolve the mechanism)",
+                              s.at("default_grid_deg").get<double>())
+                : std::string()) +
+           ".</p>";
     h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
          "th><th>run</th>"
          "<th></th></tr>";

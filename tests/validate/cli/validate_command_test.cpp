@@ -321,7 +321,9 @@ TEST(ValidateCommand, ASceneWithoutThresholdsIsJudgedOnTheCommandsGridAndEveryJo
   for (const char* q : {"qdot", "arm1_axial", "R_P_x", "R_fast_y", "qddot_arm2", "shaking_M"})
     EXPECT_NE(std::find(judged.begin(), judged.end(), q), judged.end()) << q;
   EXPECT_NE(s.at("showcase_reduced").at("label").get<std::string>().find("1.25°"), std::string::npos);
-  EXPECT_NE(slurp(dir / "v/report.html").find("The reduced run drawn is the 1.25° table"), std::string::npos);
+  const std::string html = slurp(dir / "v/report.html");
+  EXPECT_NE(html.find("The reduced run drawn is the 1.25° table"), std::string::npos);
+  EXPECT_NE(html.find("take for this scene (1.25°: 10°, halved"), std::string::npos);
   fs::remove_all(dir);
 }
 
