@@ -3,11 +3,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "engine/full_model.hpp"
 #include "engine/independent_range.hpp"
 #include "engine/reduced_source.hpp"
 #include "models/gear_fold.hpp"
+#include "reduced/reduced_model.hpp"
 #include "reduced/table_resolution.hpp"
 
 namespace rdyn::validate {
@@ -111,6 +113,44 @@ std::pair<std::string, double> calc_resolution_miss(const reduced::Samples& samp
   return worst;
 }
 
+std::pair<std::string, double> calc_line_resolution_miss(const reduced::Samples& samples, const models::Scene& scene) {
+  std::pair<std::string, double> worst{"", 0.0};
+  if (!samples.periodic || samples.q.size() < 8 || samples.q.size() % 2 != 0) return worst;
+  // Every constraint line's force along the turn at the scene's starting speed, with q̈ from the
+  // model there: at the grid points any interpolation gives the samples, so the cheapest one
+  // evaluates them. Its own peak is the scale (as validate judges it), floored at 1e-9 of the
+  // largest line's (a reaction zero but for rounding, compare_series's rule).
+  reduced::ReducedModel m;
+  try {
+    m = reduced::make_reduced_model(samples, scene, reduced::Interpolation::Linear);
+  } catch (const reduced::TableError&) {
+    return worst;  // not a model on this grid: m1 and Q_cons decide
+  }
+  const size_t nf = m.force_names.size(), n = samples.q.size();
+  if (nf == 0) return worst;
+  const double omega = scene.initial.qdot;
+  reduced::ReducedWorkspace ws(m);
+  ws.q = samples.q[0], ws.qdot = omega;
+  reduced::init_gates(m, ws);
+  std::vector<std::vector<double>> f(nf, std::vector<double>(n));
+  std::vector<double> row(nf);
+  for (size_t i = 0; i < n; ++i) {
+    double qddot = 0.0, power_nc = 0.0;
+    reduced::calc_sample(m, ws, samples.q[i], omega, qddot, power_nc, row.data());
+    for (size_t k = 0; k < nf; ++k) f[k][i] = row[k];
+  }
+  double scale = 0.0;
+  for (const auto& c : f)
+    for (double x : c) scale = std::max(scale, std::abs(x));
+  for (size_t k = 0; k < nf; ++k) {
+    double peak = 0.0;
+    for (double x : f[k]) peak = std::max(peak, std::abs(x));
+    const double miss = reduced::calc_half_grid_miss(f[k]) * peak / std::max(peak, 1e-9 * scale);
+    if (miss > worst.second) worst = {"the force of line " + m.force_names[k], miss};
+  }
+  return worst;
+}
+
 namespace {
 
 // extract_resolving's halving, over any way of extracting at a grid (a scene's new system, or
@@ -138,8 +178,11 @@ Extraction resolve(const models::Scene& scene, const Extract& extract, double gr
     }
   }
   while (!grid_given && e.samples.periodic && grid / 2 >= kMinAutoGrid_deg - 1e-9) {
-    const auto [column, miss] = calc_resolution_miss(e.samples);
-    if (!(miss > kAutoRefineMiss)) break;
+    auto [column, miss] = calc_resolution_miss(e.samples);
+    if (!(miss > kAutoRefineMiss)) {
+      std::tie(column, miss) = calc_line_resolution_miss(e.samples, scene);
+      if (!(miss > kAutoRefineLineMiss)) break;
+    }
     if (say)
       std::fprintf(stderr,
                    "rdyn: the %g° table does not resolve this mechanism (%s from every other grid point misses the "

@@ -51,15 +51,28 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
 // 3e-9 at 10°) while its weight's torque turns 25 times a turn (Q_cons miss 1.2: at 10° the
 // reduced q̈ was 4.2 % off and the motor's reaction 197 %, exit 0).
 std::pair<std::string, double> calc_resolution_miss(const reduced::Samples& samples);
+// The largest half-grid miss of a constraint line's force (the requested ones and the internal
+// lines of joint outputs) along the turn at the scene's starting speed, each against its own
+// peak, with the line's name; 0 for a range table or a scene without lines. An unbalanced
+// flywheel geared 24:1, without gravity, has m1 and Q_cons resolved at 10° (2.9e-6, 0) while its
+// bearing's reaction, ω² times a line that turns 24 times a turn, came out 199 % off with exit 0
+// (its line misses 2.0).
+std::pair<std::string, double> calc_line_resolution_miss(const reduced::Samples& samples, const models::Scene& scene);
 
 // Above this half-grid miss (calc_resolution_miss) a default grid does not resolve the mechanism; kMinAutoGrid_deg (10° halved five times) is as far as it is halved: a five-bar
 // whose slow crank is the coordinate, geared 20:1 to the fast one, misses 15 % at 1.25°, 2.5e-3
 // at 0.625° and 6.9e-7 at 0.3125° (its extraction there 0.7 s).
 inline constexpr double kAutoRefineMiss = 1e-3;
+// Above this a line's force (calc_line_resolution_miss) has turns the half table cannot
+// represent at all, and the table itself is at its limit: refined too. A line's half-grid miss
+// says little about the table's own error below that (measured at 10°: the bicycle's knee 0.11,
+// the slider-crank's rod 0.065, each within 1e-3 of the full model at 10°), while the lines
+// that turn with a fast geared mass miss 2.0 (a flywheel 24:1, a rotor 25:1).
+inline constexpr double kAutoRefineLineMiss = 0.25;
 inline constexpr double kMinAutoGrid_deg = 0.3125;
 
 // extract_from_full at grid_deg; when the grid is a default (`grid_given` false), a periodic
-// table that does not resolve m1 — interpolated from every other grid point it misses the others
+// table that does not resolve m1 or Q_cons (or whose constraint lines miss kAutoRefineLineMiss) — interpolated from every other grid point it misses the others
 // by more than kAutoRefineMiss of its peak — is extracted again at half the step, down to
 // kMinAutoGrid_deg, each step said on standard error. `grid_deg_used` gets the grid of the table
 // returned. Measured misses at 10°: slider-crank 1.7e-7, bicycle 8e-5, fourbar 1.4e-4 (q̈ within
