@@ -252,6 +252,7 @@ void add_loop_closures(FullModel::Impl& m) {
 
 // Stage 4: gears that were not folded: q_driven − r·q_driver − c = 0.
 void add_gear_couplers(FullModel::Impl& m, const std::vector<bool>& folded) {
+  m.gear_coupled.assign(m.scene.joints.size(), false);
   for (size_t g = 0; g < m.scene.gears.size(); ++g) {
     if (folded[g]) continue;
     const auto& gear = m.scene.gears[g];
@@ -264,6 +265,7 @@ void add_gear_couplers(FullModel::Impl& m, const std::vector<bool>& folded) {
                                         m.joint_mobod[jd].getMobilizedBodyIndex()};
     std::vector<MobilizerQIndex> qs{MobilizerQIndex(0), MobilizerQIndex(0)};
     m.coupled_gears.push_back(static_cast<int>(g));
+    m.gear_coupled[jr] = m.gear_coupled[jd] = true;
     m.constraints.emplace_back("gear '" + gear.name + "'",
                                Constraint::CoordinateCoupler(m.matter, new Function::Linear(coeff), mbs, qs));
   }
@@ -374,6 +376,18 @@ std::pair<double, std::string> FullModel::Impl::worst_loop_gap(const State& s) c
   return worst;
 }
 
+std::pair<double, std::string> FullModel::Impl::worst_gear_error(const State& s) const {
+  std::pair<double, std::string> worst{0.0, ""};
+  for (int g : coupled_gears) {
+    const auto& gear = scene.gears[g];
+    const double q_driver = joint_q(s, scene.joint_index(gear.driver));
+    const double q_driven = joint_q(s, scene.joint_index(gear.driven));
+    const double error = std::abs(q_driven - gear.ratio * q_driver - models::calc_gear_offset(scene, gear));
+    if (!(error < worst.first)) worst = {error, gear.name};  // NaN too
+  }
+  return worst;
+}
+
 FullModel::FullModel(const models::Scene& scene, FullModelOptions options)
     : impl_(std::make_unique<Impl>(scene, options)) {}
 FullModel::~FullModel() = default;
@@ -388,7 +402,8 @@ bool FullModel::is_folded(const std::string& body) const {
 namespace {
 
 // Simbody's assembler from the state's coordinates, the constraint actuators locked at x = 0 and
-// the independent coordinate locked when `lock_independent`; the loops' worst gap after it [m].
+// the independent coordinate locked when `lock_independent`; the worst closure error after it:
+// the loops' gap [m] or a gear's residual [rad or m] (the Assembler gives up silently).
 double assemble(const FullModel::Impl& m, State& s, bool lock_independent) {
   Assembler assembler(m.system);
   assembler.setAccuracy(1e-12);
@@ -402,7 +417,7 @@ double assemble(const FullModel::Impl& m, State& s, bool lock_independent) {
   }
   assembler.updateFromInternalState(s);
   m.system.realize(s, Stage::Position);
-  return m.worst_loop_gap(s).first;
+  return std::max(m.worst_loop_gap(s).first, m.worst_gear_error(s).first);
 }
 
 // Direct assembly at the initial q failed from the scene's guesses: they are too far from the
@@ -499,10 +514,13 @@ bool newton_assemble(const FullModel::Impl& m, State& s) {
 
 // Each revolute joint's angle within half a turn of its guess: the assembler may land whole
 // turns away (8224 turns for a chain started 0.5° from flat), which is the same configuration
-// but not the coordinate a user reads or a branch check compares.
+// but not the coordinate a user reads or a branch check compares. Not a joint of a gear coupler:
+// q_driven = r·q_driver + c holds absolute angles, so a turn taken off one side is a residual of
+// 2π (r·2π) that the next projection cannot undo (a five-bar geared 6:1 started at 430.2° had its
+// fast crank turned back 6 turns: 37.7 rad off, projectQ stalled). Its angle stays as assembled.
 void wrap_to_guesses(const FullModel::Impl& m, State& s) {
   for (size_t j = 0; j < m.scene.joints.size(); ++j) {
-    if (m.joint_fold[j] || static_cast<int>(j) == m.independent) continue;
+    if (m.joint_fold[j] || static_cast<int>(j) == m.independent || m.gear_coupled[j]) continue;
     if (m.scene.joints[j].type != models::JointType::Revolute) continue;
     const double q = m.joint_mobod[j].getOneQ(s, MobilizerQIndex(0)), g = m.scene.joints[j].guess;
     const double wrapped = g + std::remainder(q - g, 2 * M_PI);
@@ -612,16 +630,23 @@ FullWorkspace::FullWorkspace(const FullModel& model)
     }
   }
   wrap_to_guesses(m, s);
+  const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  const std::string at =
+      rev ? fmt::format("{:.6g}°", m.scene.initial.q * 180 / Pi) : fmt::format("{:.6g} m", m.scene.initial.q);
   const auto [gap, loop] = m.worst_loop_gap(s);
-  if (gap > 1e-8) {
-    const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
-    const std::string at = rev ? fmt::format("{:.6g}°", m.scene.initial.q * 180 / Pi) : fmt::format("{:.6g} m", m.scene.initial.q);
+  if (gap > 1e-8)
     throw EngineError(fmt::format("{}: loop '{}' cannot close at {} = {}: the best assembly attempt "
                                   "leaves a gap of {:.6g} m (check lengths and ground points, and that the joints' "
                                   "guesses describe the configuration at this q: assembly walks from them to q, but "
                                   "not across a singular configuration)",
                                   m.scene.source_file, loop, m.scene.independent, at, gap));
-  }
+  // The state must be on the manifold every later projection starts from: the gears too.
+  const auto [residual, gear] = m.worst_gear_error(s);
+  if (!(residual <= 1e-8))
+    throw EngineError(fmt::format("{}: gear '{}' does not hold at {} = {}: the best assembly attempt leaves "
+                                  "q_driven − ratio·q_driver − c = {:.6g} (rad or m of the driven joint; c from the "
+                                  "joints' guesses)",
+                                  m.scene.source_file, gear, m.scene.independent, at, residual));
   check_one_dof(m, s);
   // A start where the loops' Jacobian (less the prescribed columns) is singular by the measure
   // the extraction marks singular grid points with: refused (issue #22 item 5).

@@ -53,6 +53,7 @@ struct FullModel::Impl {
   // Loop closures and unfolded gears, each with the name messages give it ("loop 'C'").
   std::vector<std::pair<std::string, SimTK::Constraint>> constraints;
   std::vector<int> coupled_gears;  // the scene gear of each CoordinateCoupler, in constraint order
+  std::vector<bool> gear_coupled;  // per scene joint: the driver or driven joint of a coupler
   // G from the configuration (engine/constraint_jacobian.hpp); none: calcG.
   std::optional<ConstraintJacobianPlan> jacobian_plan;
   int independent = -1;  // scene joint index
@@ -96,6 +97,9 @@ struct FullModel::Impl {
   std::vector<double> constraint_forces(const SimTK::State& s) const;
   // Largest loop-closure gap [m] and the loop's name, at a state realized to Position.
   std::pair<double, std::string> worst_loop_gap(const SimTK::State& s) const;
+  // Largest gear-coupler residual |q_driven − r·q_driver − c| [rad or m] and the gear's name, from
+  // the coordinates (the CoordinateCoupler's own condition; NaN is reported as the worst).
+  std::pair<double, std::string> worst_gear_error(const SimTK::State& s) const;
 };
 
 struct FullWorkspace::Impl {

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "engine/inspect.hpp"
 #include "engine/kinetostatic.hpp"
@@ -173,6 +174,87 @@ TEST(FullModelAssembly, FarGuessesNearAFlatConfigurationWalkToTheStart) {
     }
   }
 }
+
+// A five-bar whose fast crank is geared 6:1 to the independent slow crank
+// (tests/validate/scenes/fivebar-6to1.yaml): the gear holds absolute angles, fast = 6·slow + c,
+// so a start n turns on puts the fast crank 6n turns on. The assembly's wrap of every angle to
+// within half a turn of its guess turned the fast crank back too: at 430.2° it left the coupler
+// 37.7 rad off, and the first projection there (validate's cycle run) failed with "cannot reach".
+models::Scene fivebar_6to1(double q_deg) {
+  return models::load_scene(RDYN_TEST_SCENES "/fivebar-6to1.yaml", {{"initial.q_deg", fmt::format("{}", q_deg)}});
+}
+
+// The joint angles at a start, projected there by calc_kinetostatic [rad].
+std::vector<double> fivebar_6to1_joints(double q_deg) {
+  const auto scene = fivebar_6to1(q_deg);
+  FullModel model(scene);
+  FullWorkspace ws(model);
+  return calc_kinetostatic(model, ws, scene.initial.q, 0, 0, Loads::Off).joint_q;
+}
+
+// The same configuration, every joint equal modulo a turn.
+void expect_same_configuration(const std::vector<double>& a, const std::vector<double>& b, const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (size_t j = 0; j < a.size(); ++j)
+    EXPECT_NEAR(std::remainder(a[j] - b[j], 2 * kPi), 0, 1e-9) << what << " joint " << j;
+}
+
+TEST(FullModelAssembly, GearedStartATurnOnProjectsToTheSameConfiguration) {
+  const auto scene = fivebar_6to1(0);
+  const auto& joints = scene.joints;
+  auto index = [&](const std::string& name) { return static_cast<size_t>(scene.joint_index(name)); };
+  const double c = joints[index("fast")].guess - 6.0 * joints[index("slow")].guess;
+  const auto base = fivebar_6to1_joints(70.2), turned = fivebar_6to1_joints(430.2);
+  expect_same_configuration(base, turned, "430.2° against 70.2°");
+  for (const auto* q : {&base, &turned})  // the coupler's condition, not modulo a turn
+    EXPECT_NEAR((*q)[index("fast")], 6.0 * (*q)[index("slow")] + c, 1e-9 * (1 + std::abs((*q)[index("fast")])));
+  EXPECT_NEAR(turned[index("slow")], 430.2 * kPi / 180, 1e-12);
+}
+
+// The five-bar's closed form on the scene's branch (P left of T_slow → T_fast): slow θ, fast
+// φ = 6θ + c, T_slow = 0.07 (cos θ, sin θ), T_fast = B + 0.05 (cos φ, sin φ), P where the arms
+// (0.22 m from T_slow, 0.20 m from T_fast) meet; arm1 = ∠(P − T_slow) − θ, arm2 = ∠(P − T_fast) − φ.
+// Joint angles in scene order: slow, arm1, fast, arm2 [rad].
+std::vector<double> fivebar_6to1_closed_form(double theta) {
+  const double phi = 6 * theta + (45 - 6 * 90) * kPi / 180;
+  const double x1 = 0.07 * std::cos(theta), y1 = 0.07 * std::sin(theta);
+  const double x2 = 0.25 + 0.05 * std::cos(phi), y2 = 0.05 * std::sin(phi);
+  const double d = std::hypot(x2 - x1, y2 - y1), ex = (x2 - x1) / d, ey = (y2 - y1) / d;
+  const double a = (0.22 * 0.22 - 0.20 * 0.20 + d * d) / (2 * d), h = std::sqrt(0.22 * 0.22 - a * a);
+  const double px = x1 + a * ex - h * ey, py = y1 + a * ey + h * ex;
+  return {theta, std::atan2(py - y1, px - x1) - theta, phi, std::atan2(py - y2, px - x2) - phi};
+}
+
+// Starts every 7.3° from −400° to 800° (continuation walks and direct assemblies, near the guesses
+// and far), in four interleaved parts (each ~15 s: the walks from the guesses take up to 360 moves):
+// each assembles and projects at its q to the closed form's configuration, every joint modulo a
+// turn, and keeps the gear's relation exactly. The scene's `branch` (arm2's angle positive) is
+// left out: arm2 turns against the fast crank, which turns six times a slow turn, so that sign is
+// not the branch and refuses half the starts (0°, 1.5°, 45.3°, … also before this fix).
+class GearedStarts : public ::testing::TestWithParam<int> {};
+
+TEST_P(GearedStarts, AllAssembleAndProject) {
+  std::string yaml = models::read_scene_text(RDYN_TEST_SCENES "/fivebar-6to1.yaml");
+  const std::string branch = ", branch: {joint: arm2, sign: positive}";
+  ASSERT_NE(yaml.find(branch), std::string::npos);
+  yaml.erase(yaml.find(branch), branch.size());
+  for (int k = 0; -400.0 + 7.3 * k <= 800.0; ++k) {
+    const double deg = -400.0 + 7.3 * k;
+    if (k % 4 != GetParam()) continue;  // another part's
+    const auto scene = models::parse_scene(yaml, "fivebar-6to1.yaml", {{"initial.q_deg", fmt::format("{}", deg)}});
+    try {
+      FullModel model(scene);
+      FullWorkspace ws(model);
+      const auto q = calc_kinetostatic(model, ws, scene.initial.q, 0, 0, Loads::Off).joint_q;
+      expect_same_configuration(q, fivebar_6to1_closed_form(scene.initial.q), fmt::format("{}°", deg));
+      EXPECT_NEAR(q[2], 6 * q[0] + (45 - 6 * 90) * kPi / 180, 1e-9 * (1 + std::abs(q[2]))) << deg << "°";
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << deg << "°: " << e.what();
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(FullModelAssembly, GearedStarts, ::testing::Range(0, 4));
 
 // A point force whose points coincide where the mechanism assembles has no direction: refused
 // as bad input, naming the file, the line of its point_b and the field.
