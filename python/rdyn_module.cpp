@@ -127,6 +127,11 @@ rr::Drive drive_of(const std::optional<double>& torque, const std::optional<doub
 
 PYBIND11_MODULE(_rdyn, m) {
   m.doc() = "rdyn's C++ library (the rdyn package wraps it; use `import rdyn`).";
+  // pybind11 finds numpy's C API in a function-local static on the first array made, importing
+  // numpy there; an import lets other threads take the GIL, and a second thread that then made an
+  // array waited for that static while holding the GIL the first one needed to finish it: two
+  // threads' first calls hung forever. Made here, at import, while one thread runs.
+  (void)py::array_t<double>(1);
 
   // Exceptions: rdyn.Error is the base; SceneError carries file, line and field.
   g_rdyn_error = PyErr_NewException("rdyn.Error", PyExc_RuntimeError, nullptr);

@@ -420,3 +420,23 @@ def test_sweep_errors_have_their_fields():
     with pytest.raises(rdyn.SceneError) as e:
         rdyn.sweep(scene, {"bicycle_leg.crank_length_m": (0.16, 0.18, 2)}, drive_cadence_hz=1, cadence_hz=1)
     assert e.value.field == "--drive-cadence-hz"
+
+
+def test_two_threads_first_calls_do_not_hang(tmp_path):
+    """Two threads whose first rdyn calls run at once, in a fresh interpreter: the first array
+    pybind11 made initialised numpy's C API in a static while an import let the other thread take
+    the GIL and wait for that static: both hung forever (a hostile pass, issue #23)."""
+    import subprocess
+    import sys
+    script = (
+        "import threading, rdyn\n"
+        "out = []\n"
+        "def work(): out.append(rdyn.simulate(rdyn.load_scene('fourbar'), model='reduced', duration=0.05)['qdot'][-1])\n"
+        "ts = [threading.Thread(target=work) for _ in range(4)]\n"
+        "[t.start() for t in ts]; [t.join() for t in ts]\n"
+        "assert len(out) == 4 and len(set(out)) == 1, out\n"
+        "print('ok')\n")
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                       env=dict(os.environ))
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip() == "ok"
