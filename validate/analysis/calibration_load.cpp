@@ -61,7 +61,14 @@ Selection select_load(const models::Scene& scene, const CalibrationOptions& opt)
       sel.name += (sel.name.empty() ? "" : "+") + t.name;
       const std::string u = unit_of(scene, t.joint);
       if (units.empty()) units = u;
-      else if (units != u) units = "N·m|N";
+      // One magnitude in two units is no load at all: a Whitworth's 20 N·m crank torque and
+      // −50 N ram force both came out 1.7 (and the scene written with −1.7 N), as `--load a+b`
+      // already refuses.
+      if (units != u)
+        fail("validation.calibrate.load",
+             fmt::format("name the load to calibrate (validation.calibrate.load or --load): without a name every "
+                         "joint torque is scaled to one magnitude, and joint torque '{}' is in {} while '{}' is in {}",
+                         scene.joint_torques[0].name, units, t.name, u));
     }
     sel.kind = "joint_torques";
     sel.unit = units;

@@ -45,6 +45,28 @@ TEST(CalibrationLoad, WithoutANameEveryJointTorqueIsScaledKeepingItsSign) {
   EXPECT_EQ(with_load(scene, sel, 1.0, 0.07).resistances[0].coefficient, 0.07);
 }
 
+// Without a name, joint torques in N·m and N would share one magnitude (a Whitworth's crank
+// torque and ram force both 1.7): refused, as `--load a+b` refuses mixed units, naming both.
+TEST(CalibrationLoad, WithoutANameJointTorquesInTwoUnitsAreRefused) {
+  const auto slider = models::load_scene("slider-crank");  // a motor, and a joint torque in N
+  models::Scene scene = slider;
+  scene.joint_torques.insert(scene.joint_torques.begin(), scene.joint_torques[0]);
+  scene.joint_torques[0].name = "crank_drive";
+  scene.joint_torques[0].joint = "crank";
+  try {
+    select_load(scene, CalibrationOptions{});
+    ADD_FAILURE() << "mixed units accepted";
+  } catch (const models::SceneError& e) {
+    EXPECT_EQ(e.field(), "validation.calibrate.load");
+    EXPECT_NE(e.message().find("'crank_drive' is in N·m while 'piston_load' is in N"), std::string::npos)
+        << e.message();
+  }
+  CalibrationOptions named;
+  named.load = "crank_drive";
+  named.load_field = "--load";
+  EXPECT_EQ(select_load(scene, named).unit, "N·m");  // a name chooses one
+}
+
 TEST(CalibrationLoad, AMotorTakesItsNoLoadSpeedsSign) {
   const auto scene = models::parse_scene(
       flywheel("  - {type: motor, name: m, joint: wheel, stall_torque_Nm: -1.0, no_load_speed_rad_s: -30}\n"),
