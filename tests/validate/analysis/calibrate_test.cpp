@@ -377,6 +377,19 @@ TEST(Calibrate, PowerModeDissipatesThePowerOnTheFluctuatingCycle) {
   EXPECT_LT(r.resistance_coefficient, 0.9 * 20.0 / (omega * omega));
 }
 
+// At 50 Hz a revolution lasts 20 ms: the full model's rows (2 ms apart, 36°) missed the force
+// peak, and at 100 Hz read 26075 N for 40176 N. Its rows are at least 360 a turn now, and its
+// peak and fluctuation are the reduced model's to the sampling of one degree.
+TEST(Calibrate, TheFullModelsPeakAtAFastCadenceIsReadOnEveryDegree) {
+  const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/flywheel-24to1.yaml");
+  CalibrationOptions opt = calibration_options_of(scene, 50.0, 1e4, "drive");
+  Progress quiet(false);
+  const auto r = calibrate(scene, opt, quiet);
+  EXPECT_NEAR(r.mean_cadence_hz_full, 50.0, 1e-6 * 50.0);
+  EXPECT_NEAR(r.peak_force_full_N, r.peak_force_N, 1e-3 * r.peak_force_N);  // measured 1.8e-4
+  EXPECT_NEAR(r.speed_fluctuation_full, r.speed_fluctuation, 1e-3 * r.speed_fluctuation);
+}
+
 // A confirmation that cannot become steady within its cap is a numerical failure whose message
 // gives the reduced operating point and what the full model reached (here a cap of 1 s holds 2
 // of the 6 whole revolutions the steady test compares).
