@@ -338,7 +338,11 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
     cur[last] = list;
   else
     cur[last] = o.value;
-  if (touched) touched->push_back({cur[last], o.path});
+  if (touched) {
+    touched->push_back({cur[last], o.path});
+    // Its items too: an error in one names the --set (it named line 1 of the scene file).
+    for (size_t i = 0; list.IsSequence() && i < list.size(); ++i) touched->push_back({list[i], o.path});
+  }
 }
 
 struct MarkAccess;  // names the as_if specialisation below

@@ -169,6 +169,7 @@ TEST(YamlFields, MalformedOverridesAreRefusedNamingThem) {
       {"bodies=[a, {b: 1}]", "--set bodies", "at most 64 scalar items"},  // no structure through --set
       {"ground_points=[1, 2]", "--set ground_points", "only scalars and lists"},
       {"independent_range=[1, [2]]", "--set independent_range", "scalar items"},
+      {"independent_range_deg=[95, .nan]", "--set independent_range_deg", "independent_range_deg"},
       {"independent.x=3", "--set independent.x", "not a mapping"},
   };
   for (const auto& c : cases) expect_refused(kFourbar, c.field, c.says, "", {parse_override(c.override_text)});
