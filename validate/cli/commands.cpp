@@ -76,7 +76,8 @@ void require_grid(const std::string& option, double g) {
 
 // Duration, output interval and the number of rows they make.
 void require_timing(double duration, double dt_out) {
-  require_positive_up_to("--duration", duration, cli_limits::kMaxDuration_s, " s");
+  // At least one shortest output interval: 1e-300 s was refused as "--dt-out: must be in [1e-06, 1e-300]".
+  require_in("--duration", duration, cli_limits::kMinOutputInterval_s, cli_limits::kMaxDuration_s, " s");
   require_in("--dt-out", dt_out, cli_limits::kMinOutputInterval_s, duration, " s (and at most --duration)");
   // Rows as the simulations count them (t = 0, then one per interval, the last at the duration:
   // models::calc_output_rows), so that no run the CLI accepts meets their own, wordier refusal.

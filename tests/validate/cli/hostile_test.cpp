@@ -143,6 +143,10 @@ void bad_numbers(std::vector<Case>& cs) {
       c.out = o.suffix.size() == 2 ? o.suffix[1] : "";
       cs.push_back(c);
     }
+  // A duration below the shortest output interval names --duration (it blamed the --dt-out never given,
+  // with the empty range [1e-06, 1e-300]).
+  cs.push_back({"sim_duration_tiny", {"simulate", "fourbar", "--duration", "1e-300", "--out", "o"}, 2,
+                "--duration: must be a finite number in [1e-06", {}, nullptr, "o"});
   // Sweep ranges and shards.
   const std::vector<std::pair<std::string, std::string>> shards{
       {"x", "--shard"}, {"1/1", "--shard"}, {"-1/2", "--shard"}, {"0/0", "--shard"}, {"0/2x", "--shard"},
