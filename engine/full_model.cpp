@@ -639,7 +639,7 @@ FullWorkspace::FullWorkspace(const FullModel& model)
                                   "leaves a gap of {:.6g} m (check lengths and ground points, and that the joints' "
                                   "guesses describe the configuration at this q: assembly walks from them to q, but "
                                   "not across a singular configuration)",
-                                  m.scene.source_file, loop, m.scene.independent, at, gap));
+                                  models::where(m.scene, "loops." + loop), loop, m.scene.independent, at, gap));
   // The state must be on the manifold every later projection starts from: the gears too.
   const auto [residual, gear] = m.worst_gear_error(s);
   if (!(residual <= 1e-8))

@@ -20,7 +20,6 @@
 namespace rdyn::models {
 
 using namespace yaml;
-
 namespace {
 ResistanceLaw read_law(const Fields& f, const std::string& key) {
   const std::string v = f.str(key);
@@ -176,6 +175,7 @@ BranchSign read_branch(const Fields& b, const Fields& top, const Scene& s, const
 Loop read_loop(const Fields& f, const Fields& top, Scene& s) {
   Loop l;
   l.name = f.name("name");
+  s.key_lines["loops." + l.name] = f.line();  // the engine's "cannot close" names the loop's line
   l.body_a = f.str("body_a");
   l.body_b = f.str("body_b");
   l.point_a = read_point(f, "point_a", l.body_a, s);

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <string>
 
+#include "models/scene_yaml.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -154,6 +156,12 @@ TEST(InspectCli, BadInputIsExitTwoNamingTheField) {
   r = rdyn("inspect fourbar --set bodies.rocker.points.C.0=0.01");
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("loop 'C' cannot close"), std::string::npos) << r.err;
+  // The loop's line and field (the message gave the file alone).
+  EXPECT_NE(r.err.find("fourbar.yaml:" + std::to_string(rdyn::models::load_scene("fourbar").line_of("loops.C")) +
+                       ": field 'loops.C'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_GT(rdyn::models::load_scene("fourbar").line_of("loops.C"), 0);
   EXPECT_TRUE(r.out.empty());
   r = rdyn("inspect no-such-scene");
   EXPECT_EQ(r.status, 2) << r.err;
