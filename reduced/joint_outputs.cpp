@@ -345,6 +345,12 @@ void drop_internal_lines(const models::Scene& s, models::TimeSeries& ts) {
 
 }  // namespace
 
+std::vector<std::string> joint_output_columns(const models::Scene& scene) {
+  std::vector<std::string> names;
+  for (const auto& jt : scene.joints) names.insert(names.end(), {"p_" + jt.name, "k_" + jt.name, "r_" + jt.name});
+  return names;
+}
+
 JointOutputModel make_joint_output_model(const models::Scene& scene, const Table& table,
                                          const std::vector<std::string>& force_names) {
   JointOutputModel m;
@@ -359,10 +365,12 @@ JointOutputModel make_joint_output_model(const models::Scene& scene, const Table
                        "': extract it from a scene that asks for outputs.joints, reactions or shaking");
     return c;
   };
-  for (const auto& jt : s.joints) {
-    m.c_p.push_back(col("p_" + jt.name));
-    m.c_k.push_back(col("k_" + jt.name));
-    m.c_r.push_back(col("r_" + jt.name));
+  const auto columns = joint_output_columns(s);
+  for (size_t j = 0; j < nj; ++j) {
+    const auto& jt = s.joints[j];
+    m.c_p.push_back(col(columns[3 * j]));
+    m.c_k.push_back(col(columns[3 * j + 1]));
+    m.c_r.push_back(col(columns[3 * j + 2]));
     m.parent.push_back(jt.parent == models::kGround ? -1 : s.body_index(jt.parent));
     m.child.push_back(s.body_index(jt.child));
   }

@@ -89,6 +89,9 @@ struct JointOutputModel {
   std::vector<int> loop_body, loop_sign;  // per loop a reaction needs: the body that balances it, ±1 (−1, 0: none)
   double gx = 0.0, gy = 0.0;         // gravity [m/s²] (0 when disabled)
 };
+// The table columns make_joint_output_model reads (the reaction lines' are the reduced model's):
+// p_<j>, k_<j> and r_<j> of every joint j, in the scene's joint order.
+std::vector<std::string> joint_output_columns(const models::Scene& scene);
 // `force_names`: the run's constraint forces in the order calc_joint_outputs gets their values
 // (a reduced model's force_names). Throws TableError when the table lacks a joint's p_, k_ or r_
 // column (extracted without joint outputs) or the forces a reaction line, or for a reaction

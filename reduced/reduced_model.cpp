@@ -36,6 +36,94 @@ void set_force_poles(const Samples& s, ReducedModel& m) {
   m.pole_band = pole_band(s, m.table.fit);
 }
 
+// The one place that says which columns a reduced model reads, each index from col(name): the column
+// fields, the gates (column and sign; roots need the samples), rhs_cols and out_cols.
+template <typename Col>
+ReducedModel resolve_columns(const models::Scene& scene, Col&& col) {
+  ReducedModel m;
+  m.c_m1 = col("m1");
+  m.c_m2 = col("m2");
+  m.c_V = col("V");
+  m.c_Q = col("Q_cons");
+  for (const auto& f : scene.outputs.constraint_forces) {
+    m.force_names.push_back(f.name);
+    m.c_me1.push_back(col("me1_" + f.name));
+    m.c_me2.push_back(col("me2_" + f.name));
+    m.c_Qx.push_back(col("Qx_cons_" + f.name));
+  }
+  auto rx_cols = [&](const std::string& prefix, const std::string& what) {
+    std::vector<int> c;
+    for (const auto& f : scene.outputs.constraint_forces) c.push_back(col(prefix + f.name + "_" + what));
+    return c;
+  };
+  m.rhs_cols = {m.c_m1, m.c_m2, m.c_Q};
+  // The gate of a load: its index in m.gates, −1 when the load always acts.
+  auto add_gate = [&](const std::optional<models::RateGate>& active_when) {
+    if (!active_when) return -1;
+    m.gates.push_back(ReducedModel::Gate{col("r_" + active_when->joint), active_when->sign, {}, 1.0, {}});
+    return static_cast<int>(m.gates.size()) - 1;
+  };
+  for (const auto& t : scene.joint_torques) {
+    ReducedModel::Torque tq{t.value, col("r_" + t.joint), rx_cols("rx_", t.joint), -1};
+    tq.gate = add_gate(t.active_when);
+    if (t.profile) tq.c_tau = col("tau_" + t.name);
+    m.torques.push_back(tq);
+    m.rhs_cols.push_back(tq.c_r);
+    if (tq.c_tau >= 0) m.rhs_cols.push_back(tq.c_tau);
+  }
+  for (const auto& mo : scene.motors) {
+    m.motors.push_back({mo.stall_torque, mo.no_load_speed, col("r_" + mo.joint), rx_cols("rx_", mo.joint)});
+    m.rhs_cols.push_back(m.motors.back().c_r);
+  }
+  for (const auto& r : scene.resistances) {
+    m.brakes.push_back({r.law, r.coefficient, col("w_" + r.body), rx_cols("wx_", r.body)});
+    m.rhs_cols.push_back(m.brakes.back().c_w);
+  }
+  for (const auto& f : scene.point_forces) {
+    std::vector<int> cx;
+    for (const auto& c : scene.outputs.constraint_forces) cx.push_back(col("Qxpf_" + c.name + "_" + f.name));
+    ReducedModel::Torque pf{f.value, col("Qpf_" + f.name), cx, add_gate(f.active_when)};
+    if (f.profile) pf.c_tau = col("tau_" + f.name);
+    m.point_forces.push_back(pf);
+    m.rhs_cols.push_back(pf.c_r);
+    if (pf.c_tau >= 0) m.rhs_cols.push_back(pf.c_tau);
+  }
+  // Last, V: the divergence guard's energy from q̈'s own lookup (calc_acceleration_energy).
+  m.rhs_cols.push_back(m.c_V);
+  m.out_cols = {m.c_m1, m.c_V};
+  for (size_t k = 0; k < m.c_me1.size(); ++k) {
+    m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
+    for (const auto& t : m.torques) {
+      m.out_cols.push_back(t.c_rx[k]);
+      if (t.c_tau >= 0) m.out_cols.push_back(t.c_tau);
+    }
+    for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
+    for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
+    for (const auto& f : m.point_forces) {
+      m.out_cols.push_back(f.c_rx[k]);
+      if (f.c_tau >= 0) m.out_cols.push_back(f.c_tau);
+    }
+  }
+  return m;
+}
+
+// A gate with its ratio's exact zeros: the product of sines, oriented like r farthest from any root.
+void set_gate_orientation(const Samples& s, const Table& table, ReducedModel::Gate& g) {
+  const auto* roots = s.roots_of(s.names[g.c_r]);
+  if (!roots || !s.periodic || roots->empty() || roots->size() % 2 != 0) return;
+  set_gate_roots(g, *roots);
+  double best = -1, q_best = s.q[0];
+  for (double q : s.q) {
+    double d = INFINITY;
+    for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
+    if (d > best) best = d, q_best = q;
+  }
+  const double r_val = table.eval(g.c_r, q_best);
+  double prod = 1.0;
+  for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
+  g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
+}
+
 }  // namespace
 
 void check_force_poles(const ReducedModel& m, double q, double t) {
@@ -58,100 +146,25 @@ void check_force_poles(const ReducedModel& m, double q, double t) {
     }
 }
 
-ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
-                                bool energy_consistent_m2) {
-  check_samples_fit(s, scene);  // before the table is built
-  return make_reduced_model(s, scene, build_table(s, interp, energy_consistent_m2));
+std::vector<std::string> reduced_model_columns(const models::Scene& scene) {
+  std::vector<std::string> names;  // each name once, in the order first required
+  auto col = [&](const std::string& name) {
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    return static_cast<int>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  resolve_columns(scene, col);
+  return names;
 }
 
 ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Table table) {
   check_samples_fit(s, scene);
-  ReducedModel m;
+  ReducedModel m = resolve_columns(scene, [&](const std::string& name) { return s.require(name); });
   m.table = std::move(table);
   m.min_edge = s.min_edge;
   m.max_edge = s.max_edge;
   m.revolute = s.revolute;
-  m.c_m1 = s.require("m1");
-  m.c_m2 = s.require("m2");
-  m.c_V = s.require("V");
-  m.c_Q = s.require("Q_cons");
-  for (const auto& f : scene.outputs.constraint_forces) {
-    m.force_names.push_back(f.name);
-    m.c_me1.push_back(s.require("me1_" + f.name));
-    m.c_me2.push_back(s.require("me2_" + f.name));
-    m.c_Qx.push_back(s.require("Qx_cons_" + f.name));
-  }
   set_force_poles(s, m);
-  auto rx_cols = [&](const std::string& prefix, const std::string& what) {
-    std::vector<int> c;
-    for (const auto& f : scene.outputs.constraint_forces) c.push_back(s.require(prefix + f.name + "_" + what));
-    return c;
-  };
-  m.rhs_cols = {m.c_m1, m.c_m2, m.c_Q};
-  // The gate of a load: its index in m.gates, −1 when the load always acts.
-  auto add_gate = [&](const std::optional<models::RateGate>& active_when) {
-    if (!active_when) return -1;
-    ReducedModel::Gate g{s.require("r_" + active_when->joint), active_when->sign, {}, 1.0, {}};
-    const auto* roots = s.roots_of("r_" + active_when->joint);
-    if (roots && s.periodic && !roots->empty() && roots->size() % 2 == 0) {
-      // Orient the product of sines like r at the grid sample farthest from any root.
-      set_gate_roots(g, *roots);
-      double best = -1, q_best = s.q[0];
-      for (double q : s.q) {
-        double d = INFINITY;
-        for (double r : g.roots) d = std::min(d, std::abs(std::remainder(q - r, 2 * M_PI)));
-        if (d > best) best = d, q_best = q;
-      }
-      const double r_val = m.table.eval(g.c_r, q_best);
-      double prod = 1.0;
-      for (double r : g.roots) prod *= std::sin(0.5 * (q_best - r));
-      g.root_sign = (r_val > 0) == (prod > 0) ? 1.0 : -1.0;
-    }
-    m.gates.push_back(std::move(g));
-    return static_cast<int>(m.gates.size()) - 1;
-  };
-  for (const auto& t : scene.joint_torques) {
-    ReducedModel::Torque tq{t.value, s.require("r_" + t.joint), rx_cols("rx_", t.joint), -1};
-    tq.gate = add_gate(t.active_when);
-    if (t.profile) tq.c_tau = s.require("tau_" + t.name);
-    m.torques.push_back(tq);
-    m.rhs_cols.push_back(tq.c_r);
-    if (tq.c_tau >= 0) m.rhs_cols.push_back(tq.c_tau);
-  }
-  for (const auto& mo : scene.motors) {
-    m.motors.push_back({mo.stall_torque, mo.no_load_speed, s.require("r_" + mo.joint), rx_cols("rx_", mo.joint)});
-    m.rhs_cols.push_back(m.motors.back().c_r);
-  }
-  for (const auto& r : scene.resistances) {
-    m.brakes.push_back({r.law, r.coefficient, s.require("w_" + r.body), rx_cols("wx_", r.body)});
-    m.rhs_cols.push_back(m.brakes.back().c_w);
-  }
-  for (const auto& f : scene.point_forces) {
-    std::vector<int> cx;
-    for (const auto& c : scene.outputs.constraint_forces) cx.push_back(s.require("Qxpf_" + c.name + "_" + f.name));
-    ReducedModel::Torque pf{f.value, s.require("Qpf_" + f.name), cx, add_gate(f.active_when)};
-    if (f.profile) pf.c_tau = s.require("tau_" + f.name);
-    m.point_forces.push_back(pf);
-    m.rhs_cols.push_back(pf.c_r);
-    if (pf.c_tau >= 0) m.rhs_cols.push_back(pf.c_tau);
-  }
-  // Last, V: a fixed step's end point has its energy (the divergence guard) from the same lookup
-  // as its q̈ (calc_acceleration_energy), not from a second interval search.
-  m.rhs_cols.push_back(m.c_V);
-  m.out_cols = {m.c_m1, m.c_V};
-  for (size_t k = 0; k < m.c_me1.size(); ++k) {
-    m.out_cols.insert(m.out_cols.end(), {m.c_me1[k], m.c_me2[k], m.c_Qx[k]});
-    for (const auto& t : m.torques) {
-      m.out_cols.push_back(t.c_rx[k]);
-      if (t.c_tau >= 0) m.out_cols.push_back(t.c_tau);
-    }
-    for (const auto& mo : m.motors) m.out_cols.insert(m.out_cols.end(), {mo.c_r, mo.c_rx[k]});
-    for (const auto& b : m.brakes) m.out_cols.insert(m.out_cols.end(), {b.c_w, b.c_wx[k]});
-    for (const auto& f : m.point_forces) {
-      m.out_cols.push_back(f.c_rx[k]);
-      if (f.c_tau >= 0) m.out_cols.push_back(f.c_tau);
-    }
-  }
+  for (auto& g : m.gates) set_gate_orientation(s, m.table, g);
   // The interpolated reduced inertia must stay positive (Eksergian divides by it); a coarse
   // grid over a sharp inertia peak can undershoot. Each interval's cubic read from its
   // coefficients (Table::eval's formula without locating q: 1440 × 16 evaluations of a fourier
@@ -171,6 +184,12 @@ ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Ta
   m.rhs_block = make_column_block(m.table, m.rhs_cols);
   m.record_block = make_column_block(m.table, m.record_cols);
   return m;
+}
+
+ReducedModel make_reduced_model(const Samples& s, const models::Scene& scene, Interpolation interp,
+                                bool energy_consistent_m2) {
+  check_samples_fit(s, scene);  // before the table is built
+  return make_reduced_model(s, scene, build_table(s, interp, energy_consistent_m2));
 }
 
 ReducedWorkspace::ReducedWorkspace(const ReducedModel& m)

@@ -104,6 +104,11 @@ ReducedModel make_reduced_model(const Samples& samples, const models::Scene& sce
 // share one table; each gets its own loads. Throws as above.
 ReducedModel make_reduced_model(const Samples& samples, const models::Scene& scene, Table table);
 
+// The columns make_reduced_model(samples, scene, …) reads for `scene`'s constraint forces and
+// loads, each once, in the order it asks for them. A model built on select_columns(samples, these)
+// (reduced/samples.hpp) is the model of all the samples, value for value: what a sweep fits.
+std::vector<std::string> reduced_model_columns(const models::Scene& scene);
+
 // Per-run state: the ODE state, the load gates, and scratch space sized once.
 struct ReducedWorkspace {
   double t = 0.0, q = 0.0, qdot = 0.0, work = 0.0;

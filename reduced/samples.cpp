@@ -51,6 +51,17 @@ void Samples::add(const std::string& name, std::vector<double> values) {
   columns.push_back(std::move(values));
 }
 
+Samples select_columns(const Samples& s, const std::vector<std::string>& keep) {
+  auto kept = [&](const std::string& name) { return std::find(keep.begin(), keep.end(), name) != keep.end(); };
+  Samples out = s;  // the grid and metadata (the columns, a few hundred values at 10°, are rebuilt)
+  out.names.clear(), out.columns.clear(), out.roots.clear();
+  for (size_t c = 0; c < s.names.size(); ++c)
+    if (kept(s.names[c])) out.add(s.names[c], s.columns[c]);
+  for (const auto& r : s.roots)
+    if (kept(r.first)) out.roots.push_back(r);
+  return out;
+}
+
 namespace {
 
 constexpr const char* kHeader = "# rdyn-table v1 ";

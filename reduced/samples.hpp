@@ -70,6 +70,13 @@ struct Samples {
   void add(const std::string& name, std::vector<double> values);
 };
 
+// `s` with only the columns `keep` names, in s's order (a name s lacks is skipped: whoever needs
+// it then gets require's message), and the roots of the kept columns; the grid and everything
+// else as in s. Each interpolant fits every column on its own, so a table built from the result
+// has, column for column, the values of the table of s (bit for bit; energy_consistent_m2 also
+// reads m1 and V, so keep them with m2 and Q_cons). A sweep fits only what its cases read.
+Samples select_columns(const Samples& s, const std::vector<std::string>& keep);
+
 // Limits on a table that is read (what `rdyn extract` can write, with margin): a grid of at
 // most 36 001 points (0.01° over a turn, the finest extraction grid), at most 4096 columns,
 // 2·10⁷ values and 256 MiB of text.

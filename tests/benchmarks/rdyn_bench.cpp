@@ -29,6 +29,7 @@
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
 #include "validate/analysis/calibrate_on_table.hpp"
+#include "validate/analysis/sweep_peaks.hpp"
 
 namespace {
 
@@ -314,8 +315,9 @@ BENCHMARK(BM_CalibrationWithoutFullCheck)->Unit(benchmark::kMillisecond);
 // route (edges-only walk before every extraction); Arg 2: what the sweep runs now (the scene
 // file parsed once, each case's scene a SceneSource load with its override), continuation
 // in the parameters — extract_calibration_table with the previous case's neighbour record (the
-// walk only where a case's own sweep or its neighbour's comes near rank loss) — whose build,
-// walk, extraction and fit are one stage, "table"; `walks` counts the cases that walked.
+// walk only where a case's own sweep or its neighbour's comes near rank loss) and only the
+// columns a case reads fitted (sweep_table_columns) — whose build, walk, extraction and fit are
+// one stage, "table"; `walks` counts the cases that walked.
 void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
   auto now = [] {
     timespec t{};
@@ -343,7 +345,7 @@ void BM_SweepCaseStagesOverHeight(benchmark::State& st) {
       t.push_back(now());
       validate::CalibrationTable table;
       if (continued) {
-        table = validate::extract_calibration_table(scene, o, neighbour);
+        table = validate::extract_calibration_table(scene, o, neighbour, validate::sweep_table_columns(scene, {}));
         neighbour = validate::neighbour_of(scene, table);
         walks += table.walked ? 1 : 0;
         t.push_back(now());

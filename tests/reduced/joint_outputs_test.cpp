@@ -15,7 +15,10 @@
 #include <map>
 #include <sstream>
 
+#include "analytic_source.hpp"
 #include "models/scene_yaml.hpp"
+#include "reduced/extract.hpp"
+#include "reduced/simulate_reduced.hpp"
 
 namespace rdyn::reduced {
 namespace {
@@ -71,6 +74,52 @@ TEST(JointOutputNames, PointForceOnABalancedBodyIsRefusedLikeASpring) {
   r.point_forces[0].body_b = "crank";
   r.outputs.reactions = {"crank"};
   EXPECT_NO_THROW(with_reaction_requests(r));
+}
+
+// joint_output_columns names what the joint outputs read beside the reduced model's columns: on a
+// table of only those (select_columns) the joint motions are those of the whole table bit for bit,
+// and without any one of them make_joint_output_model refuses the table.
+TEST(JointOutputNames, TheColumnsTheyReadGiveTheSameOutputs) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"drive", "lever", 0.2, std::nullopt, std::nullopt});
+  scene.outputs.joints = {"crank", "lever"};
+  // The analytic source with its joints' coordinates (crank q, lever sin q) at each grid sample.
+  struct WithPositions : test::AnalyticSource {
+    RatioPoint ratios(double q) override {
+      auto r = AnalyticSource::ratios(q);
+      r.joint_q = {q, std::sin(q)};
+      return r;
+    }
+  } src;
+  ExtractOptions eo;
+  eo.step_rad = 10 * M_PI / 180;
+  const Samples s = extract_samples(src, scene, eo);
+  const auto joint = joint_output_columns(scene);
+  EXPECT_EQ(joint, (std::vector<std::string>{"p_crank", "k_crank", "r_crank", "p_lever", "k_lever", "r_lever"}));
+  auto names = reduced_model_columns(scene);
+  names.insert(names.end(), joint.begin(), joint.end());
+  const auto whole = make_reduced_model(s, scene, Interpolation::Fourier);
+  const auto part = make_reduced_model(select_columns(s, names), scene, Interpolation::Fourier);
+  EXPECT_LT(part.table.cols, whole.table.cols);  // rx_F_crank is not read
+  ReducedOptions ro;
+  ro.duration_s = 0.5;
+  ro.output_interval_s = 0.01;
+  const auto base = simulate_reduced(whole, 0.1, 3.0, ro);
+  auto a = base, b = base;
+  add_joint_outputs(scene, whole, a);
+  add_joint_outputs(scene, part, b);
+  ASSERT_FALSE(a.column_names.empty());
+  EXPECT_EQ(b.column_names, a.column_names);
+  EXPECT_EQ(b.columns, a.columns);
+  for (const auto& name : joint) {
+    std::vector<std::string> fewer;
+    for (const auto& n : names)
+      if (n != name) fewer.push_back(n);
+    auto c = base;
+    const auto without = select_columns(s, fewer);
+    EXPECT_THROW(add_joint_outputs(scene, make_reduced_model(without, scene, Interpolation::Fourier), c), TableError)
+        << name;
+  }
 }
 
 struct Csv {

@@ -242,6 +242,51 @@ TEST(ReducedModel, ProfiledTorqueEntersEksergianAndTheConstraintLine) {
   }
 }
 
+// reduced_model_columns names what make_reduced_model reads: a model on only those columns
+// (select_columns) is the model of all the samples value for value, each listed column is needed
+// (the model refuses samples without it), and an unloaded joint's ratios are not listed until a
+// load acts on that joint.
+TEST(ReducedModel, TheColumnsItReadsGiveTheSameModel) {
+  auto lever = test::analytic_scene();
+  lever.joint_torques.push_back(profiled(2.0, 1.0, 0.5, models::RateGate{"lever", +1}));
+  auto both = lever;
+  both.joint_torques.push_back({"crank_drive", "crank", 0.3, std::nullopt, std::nullopt});
+  for (const auto& scene : {lever, both}) {
+    const bool crank_loaded = scene.joint_torques.size() == 2;
+    const auto s = analytic_samples(0.5, scene, 10);
+    const auto names = reduced_model_columns(scene);
+    for (const char* crank : {"r_crank", "rx_F_crank"})
+      EXPECT_EQ(std::count(names.begin(), names.end(), crank), crank_loaded ? 1 : 0) << crank;
+    EXPECT_EQ(names.size() + (crank_loaded ? 0 : 2), s.names.size());
+    const auto whole = make_reduced_model(s, scene, Interpolation::Fourier);
+    const auto part = make_reduced_model(select_columns(s, names), scene, Interpolation::Fourier);
+    EXPECT_EQ(part.table.cols, static_cast<int>(names.size()));
+    ASSERT_EQ(part.gates.size(), 1u);
+    EXPECT_EQ(part.gates[0].roots, whole.gates[0].roots);
+    EXPECT_EQ(part.gates[0].root_sign, whole.gates[0].root_sign);
+    ReducedWorkspace wa(whole), wb(part);
+    for (int i = 0; i < 72; ++i)
+      for (const double qd : {4.0, -4.0}) {
+        const double q = 0.087 * i + 0.01;
+        wa.q = wb.q = q, wa.qdot = wb.qdot = qd;
+        init_gates(whole, wa), init_gates(part, wb);
+        double qdd_a, p_a, F_a, qdd_b, p_b, F_b;
+        const double e_a = calc_sample(whole, wa, q, qd, qdd_a, p_a, &F_a);
+        const double e_b = calc_sample(part, wb, q, qd, qdd_b, p_b, &F_b);
+        ASSERT_EQ(qdd_b, qdd_a) << q;
+        ASSERT_EQ(p_b, p_a) << q;
+        ASSERT_EQ(F_b, F_a) << q;
+        ASSERT_EQ(e_b, e_a) << q;
+      }
+    for (const auto& name : names) {
+      std::vector<std::string> fewer;
+      for (const auto& n : names)
+        if (n != name) fewer.push_back(n);
+      EXPECT_THROW(make_reduced_model(select_columns(s, fewer), scene, Interpolation::Fourier), TableError) << name;
+    }
+  }
+}
+
 TEST(ReducedModel, ConstantProfileReproducesTheConstantTorque) {
   // τ(θ) ≡ a0 with amplitude 1 is the constant torque a0: the same right-hand side and
   // constraint force to round-off, and so the same motion (fixed-step RK4, so that no step-size

@@ -225,11 +225,12 @@ void check_full_turn(const models::Scene& scene, const engine::FullModel& model)
   if (!engine::calc_independent_domain_edges(model).periodic) fail_dead_points(scene);
 }
 
-CalibrationTable table_of(Extraction e, const CalibrationOptions& opt, bool walked, double grid_deg) {
+CalibrationTable table_of(Extraction e, const CalibrationOptions& opt, bool walked, double grid_deg,
+                          const std::optional<std::vector<std::string>>& columns) {
   CalibrationTable t;
   t.grid_deg = grid_deg;
-  t.table = reduced::build_table(e.samples, reduced::parse_interpolation(opt.interpolation));
-  t.samples = std::move(e.samples);
+  t.samples = columns ? reduced::select_columns(e.samples, *columns) : std::move(e.samples);
+  t.table = reduced::build_table(t.samples, reduced::parse_interpolation(opt.interpolation));
   t.walked = walked;
   return t;
 }
@@ -620,12 +621,12 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
 }
 
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt,
-                                           const std::optional<TableNeighbour>& neighbour) {
+                                           const std::optional<TableNeighbour>& neighbour,
+                                           const std::optional<std::vector<std::string>>& columns) {
   // Dead points are looked for twice, because each route alone misses some: the domain walk
-  // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts)
-  // and the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over
-  // the blocked range twice comes back on its branch and closes). The walk costs about an
-  // extraction (2.9 ms on the bicycle); sweeps pay it once per table. One system serves both.
+  // (check_calibratable; its plain 10° moves miss a blocked range of 2–3° from some starts) and
+  // the extraction's closed turn (reduced::SweepNotClosed; a coarse sweep that steps over the
+  // blocked range twice comes back on its branch and closes). One system serves both.
   check_calibration_input(scene, opt);
   const engine::FullModel model(scene);
   const bool continued = neighbour && neighbour->min_conditioning >= kWalkSkipConditioning &&
@@ -635,12 +636,11 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
     check_full_turn(scene, model);
     auto e = extract_resolving(model, opt.grid_deg, opt.grid_given, reduced::Method::Kinetostatic, false, grid);
     if (e.range || !e.samples.periodic) fail_dead_points(scene);
-    return table_of(std::move(e), opt, true, grid);
+    return table_of(std::move(e), opt, true, grid, columns);
   }
-  // Continuation from a neighbour far from dead points: the extraction first, the walk only
-  // where this case's own sweep gives a reason (a failure, a dead point, a grid sample nearer
-  // rank loss than kWalkSkipConditioning or than kWalkSkipDrop of the neighbour's). Its errors
-  // come after the walk's, as in the cold route.
+  // Continuation from a neighbour far from dead points: the extraction first, the walk only where
+  // this case's own sweep gives a reason (a failure, a dead point, a grid sample nearer rank loss
+  // than kWalkSkipConditioning or kWalkSkipDrop of the neighbour's); its errors after the walk's.
   Extraction e;
   try {
     e = extract_resolving(model, opt.grid_deg, opt.grid_given, reduced::Method::Kinetostatic, false, grid);
@@ -653,7 +653,7 @@ CalibrationTable extract_calibration_table(const models::Scene& scene, const Cal
                     !(c >= kWalkSkipDrop * neighbour->min_conditioning);
   if (walk) check_full_turn(scene, model);
   if (e.range || !e.samples.periodic) fail_dead_points(scene);
-  return table_of(std::move(e), opt, walk, grid);
+  return table_of(std::move(e), opt, walk, grid, columns);
 }
 
 CalibrationResult calibrate(const models::Scene& scene, const CalibrationOptions& opt, Progress& progress) {

@@ -182,8 +182,12 @@ inline constexpr double kWalkSkipDrop = 0.5;
 // extraction's sweep traverses the same turn in the same 10° moves. A case that skips the walk
 // gets the same table (the walk changes nothing in it); one that fails gets the same error as
 // the cold route (the walk, run before the error is passed on, refuses dead points first).
+// `columns` set: the table's samples keep only those columns (reduced::select_columns) and only
+// they are fitted — a sweep fits what its cases read (validate/analysis/sweep_peaks.hpp,
+// sweep_table_columns), with the same values in them as the whole table (issue #28 item 3).
 CalibrationTable extract_calibration_table(const models::Scene& scene, const CalibrationOptions& opt,
-                                           const std::optional<TableNeighbour>& neighbour);
+                                           const std::optional<TableNeighbour>& neighbour,
+                                           const std::optional<std::vector<std::string>>& columns = std::nullopt);
 
 // calibrate() on a table already extracted for a scene of the same hash (sweeps whose axes vary
 // only load values reuse one; reduced::TableError when the hashes differ).

@@ -140,7 +140,8 @@ std::string calibrated_fields(const SweepPlan& plan, const models::Scene& case_s
     ++cache.extracted;
     auto previous = std::move(cache.neighbour);
     cache.neighbour.reset();
-    cache.calibration.emplace(key, extract_calibration_table(scene, plan.calibration, previous));
+    cache.calibration.emplace(key, extract_calibration_table(scene, plan.calibration, previous,
+                                                             sweep_table_columns(case_scene, plan.opt.peaks)));
     cache.neighbour = neighbour_of(scene, cache.calibration->second);
     if (cache.calibration->second.walked) ++cache.walks;
   }
@@ -172,9 +173,10 @@ std::string driven_fields(const SweepPlan& plan, const models::Scene& case_scene
     cache.drive.reset();
     ++cache.extracted;
     double grid = 0;  // a default grid refined quietly, as a calibrated case's
-    cache.drive.emplace(key, extract_resolving(engine::FullModel(scene), plan.calibration.grid_deg,
-                                               plan.calibration.grid_given, reduced::Method::Kinetostatic, false, grid)
-                                 .samples);
+    const auto e = extract_resolving(engine::FullModel(scene), plan.calibration.grid_deg, plan.calibration.grid_given,
+                                     reduced::Method::Kinetostatic, false, grid);
+    // Only the columns its rows read: the model below fits its table every case.
+    cache.drive.emplace(key, reduced::select_columns(e.samples, sweep_table_columns(case_scene, plan.opt.peaks)));
   }
   const auto model = reduced::make_reduced_model(cache.drive->second, scene, reduced::Interpolation::Fourier);
   const auto motion = revolution_motion(scene.initial.q, plan.opt.drive_cadence_hz);

@@ -89,6 +89,16 @@ models::Scene peak_table_scene(const models::Scene& scene, const std::vector<std
   return reduced::with_reaction_requests(reduced_joint_output_scene(scene));
 }
 
+std::vector<std::string> sweep_table_columns(const models::Scene& scene, const std::vector<std::string>& peaks) {
+  const models::Scene table_scene = peak_table_scene(scene, peaks);
+  auto names = reduced::reduced_model_columns(table_scene);
+  if (peaks_need_joint_outputs(scene, peaks)) {
+    const auto joint = reduced::joint_output_columns(table_scene);
+    names.insert(names.end(), joint.begin(), joint.end());
+  }
+  return names;
+}
+
 std::vector<double> calc_column_peaks(const std::vector<std::string>& names,
                                       const std::function<const std::vector<double>&(size_t)>& column,
                                       const std::vector<std::string>& peaks) {

@@ -40,6 +40,12 @@ void check_peak_columns(const models::Scene& scene, const std::vector<std::strin
 // those outputs need (reduced::with_reaction_requests; its TableError when it cannot give them).
 models::Scene peak_table_scene(const models::Scene& scene, const std::vector<std::string>& peaks);
 
+// The table columns a sweep case reads on the table of peak_table_scene(scene, peaks): its reduced
+// model's (reduced::reduced_model_columns), and with joint-output peaks the joint columns
+// (reduced::joint_output_columns). The constraint lines, joint ratios and joint positions no case
+// reads are neither kept nor fitted (issue #28 item 3: the fit was ~14 % of such a case).
+std::vector<std::string> sweep_table_columns(const models::Scene& scene, const std::vector<std::string>& peaks);
+
 // Whether a peak column is a joint output (the run needs reduced::add_joint_outputs).
 bool peaks_need_joint_outputs(const models::Scene& scene, const std::vector<std::string>& peaks);
 

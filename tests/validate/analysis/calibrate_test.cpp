@@ -19,6 +19,8 @@
 #include "models/scene_yaml.hpp"
 #include "reduced/table.hpp"
 #include "validate/analysis/build_reduced.hpp"
+#include "validate/analysis/calibrate_on_table.hpp"
+#include "validate/analysis/sweep_peaks.hpp"
 #include "tests/validate/analysis/jansen_text.hpp"
 
 namespace rdyn::validate {
@@ -539,6 +541,34 @@ TEST(Calibrate, AContinuedTableIsTheColdTable) {
   CalibrationTable range;
   range.samples.periodic = false;
   EXPECT_FALSE(neighbour_of(b, range));
+}
+
+// A sweep's table keeps and fits only the columns its cases read (sweep_table_columns): the
+// bicycle's ratios of joints no load acts on are left out, and the calibration on it is the calibration on
+// the whole table bit for bit (calibrate_on_table, the sweep's route, against calibrate()).
+TEST(Calibrate, ATableOfTheColumnsACaseReadsCalibratesAsTheWholeTable) {
+  const auto scene = models::load_scene("bicycle", {{"bicycle_leg.subject.height_m", "1.75"}});
+  CalibrationOptions opt = calibration_options_of(scene, 0.0, 0.0, "");
+  opt.full_max_s = 0;
+  const auto whole = extract_calibration_table(scene, opt);
+  const auto columns = sweep_table_columns(scene, {});
+  auto part = extract_calibration_table(scene, opt, std::nullopt, columns);
+  EXPECT_EQ(part.samples.names, reduced::select_columns(whole.samples, columns).names);
+  EXPECT_LT(part.samples.names.size(), whole.samples.names.size());
+  EXPECT_EQ(part.table.cols, static_cast<int>(part.samples.names.size()));
+  for (const char* unread : {"r_crank", "r_knee_l", "rx_knee_knee_r", "rx_knee_flywheel"})
+    EXPECT_EQ(part.samples.column(unread), -1) << unread;
+  EXPECT_EQ(part.samples.min_conditioning, whole.samples.min_conditioning);
+  Progress quiet(false);
+  const auto a = calibrate(scene, whole, opt, quiet);
+  const auto b = calibrate_on_table(part, scene, scene, opt, quiet);
+  EXPECT_EQ(b.load_value, a.load_value);
+  EXPECT_EQ(b.mean_cadence_hz_reduced, a.mean_cadence_hz_reduced);
+  EXPECT_EQ(b.mean_power_w, a.mean_power_w);
+  EXPECT_EQ(b.peak_force_N, a.peak_force_N);
+  EXPECT_EQ(b.speed_fluctuation, a.speed_fluctuation);
+  EXPECT_EQ(b.steady_q, a.steady_q);
+  EXPECT_EQ(b.steady_qdot, a.steady_qdot);
 }
 
 // A case near a dead point is handled as cold even after the best neighbour (its own topology,

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <stdexcept>
 
 #include "models/scene_yaml.hpp"
+#include "reduced/reduced_model.hpp"
 #include "validate/analysis/sweep.hpp"
 #include "validate/analysis/sweep_part.hpp"
 #include "validate/cli/sweep_axis.hpp"
@@ -136,6 +138,24 @@ TEST(SweepPeaks, ColumnPeaksAreTheLargestMagnitudeAndNeverNaN) {
 // crank, so the peaks of R_x, R_y, shaking_x and shaking_y are all m l ω² (the cycle starts at
 // q = 0, where R is along x), q̇ peaks at ω and q̈ is 0. The other columns are those of the
 // same sweep without --peak (its table carries reaction lines the calibration does not read).
+// A case's table columns: its reduced model's, and with a joint-output peak also the joint columns
+// (p_, k_, r_ of every joint) beside the reaction lines that peak_table_scene adds; without one,
+// the scene's own joint outputs are not read by any case and not kept.
+TEST(SweepPeaks, TheTableKeepsTheJointColumnsOnlyForJointOutputPeaks) {
+  const WheelScene wheel("gravity: {enabled: false}\noutputs: {reactions: [wheel], shaking: true}\n");
+  const auto scene = models::load_scene(wheel.path.string());
+  auto has = [](const std::vector<std::string>& v, const std::string& s) {
+    return std::find(v.begin(), v.end(), s) != v.end();
+  };
+  const auto plain = sweep_table_columns(scene, {"qdot"});
+  EXPECT_EQ(plain, reduced::reduced_model_columns(scene));
+  EXPECT_FALSE(has(plain, "p_wheel"));
+  const auto joint = sweep_table_columns(scene, {"R_wheel_x"});
+  for (const char* c : {"m1", "r_wheel", "w_wheel", "p_wheel", "k_wheel"}) EXPECT_TRUE(has(joint, c)) << c;
+  for (const auto& f : peak_table_scene(scene, {"R_wheel_x"}).outputs.constraint_forces)
+    EXPECT_TRUE(has(joint, "me1_" + f.name)) << f.name;
+}
+
 TEST(SweepPeaks, CalibratedWheelReactionsFollowTheirClosedForm) {
   const WheelScene wheel("gravity: {enabled: false}\noutputs: {reactions: [wheel], shaking: true}\n");
   SweepOptions o;
