@@ -505,6 +505,13 @@ int report_sweep(const std::string& what, const std::string& done, long failed, 
 
 int run_sweep_merge(const SweepArgs& a) {
   if (a.inputs.empty()) throw ArgumentError("--merge: give the part CSVs after OUT.csv");
+  // The merged file replacing one of its own parts would lose that part (the same file by any
+  // path: equivalent() compares device and inode).
+  std::error_code ec;
+  for (const auto& path : a.inputs)
+    if (std::filesystem::equivalent(a.merge, path, ec))
+      throw ArgumentError(fmt::format("--merge: the output {} is one of the parts ({}): write the merge elsewhere",
+                                      a.merge, path));
   OutputFile out(a.merge, a.force, is_rdyn_sweep);  // fails early on an unusable destination
   std::vector<SweepPart> parts;
   for (const auto& path : a.inputs) parts.push_back(parse_sweep_part(read_sweep_file(path), path));

@@ -57,6 +57,13 @@ TEST_F(SweepCli, ShardsResumeAndMergeIntoTheOneProcessSweep) {
   const std::string merged = test::slurp(dir / "merged.csv");
   EXPECT_EQ(merged, test::slurp(dir / "whole.csv"));
   EXPECT_EQ(std::count(merged.begin(), merged.end(), '\n'), 8);  // metadata, header, six cases
+  // The merge written over one of its own parts (here through another path) is refused, the part kept.
+  const std::string part0 = test::slurp(dir / "part0.csv");
+  const auto onto = test::run_rdyn({"sweep", "--merge", "./part0.csv", "part0.csv", "part1.csv", "part2.csv", "--force"},
+                                   dir);
+  EXPECT_EQ(onto.status, 2) << onto.err;
+  EXPECT_NE(onto.err.find("is one of the parts (part0.csv)"), std::string::npos) << onto.err;
+  EXPECT_EQ(test::slurp(dir / "part0.csv"), part0);
 
   // A complete shard is skipped: the file is not rewritten.
   const std::string part1 = test::slurp(dir / "part1.csv");
