@@ -37,6 +37,14 @@ __all__ = ["load_scene", "extract", "load_table", "simulate", "calibrate", "driv
            "TableError", "OutputError"]
 
 
+def _real(value, name):
+    """A number argument as float; True and False are refused (float(True) is 1.0: calibrate ran at
+    1 Hz when given cadence_hz=True)."""
+    if isinstance(value, bool):
+        raise ArgumentError(f"{name}: expected a number (got {value!r})")
+    return float(value)
+
+
 def _override_text(path, value):
     # --set's syntax: PATH=VALUE, VALUE as YAML; Python's booleans are YAML's true/false.
     if isinstance(value, bool):
@@ -130,7 +138,7 @@ class Table(_Columns):
 def extract(scene, grid_deg=10, method="kinetostatic"):
     """``rdyn extract``: the reduced table of a scene on a grid of ``grid_deg`` degrees."""
     scene = _as_scene(scene, "extract")
-    samples, calls, ms = _rdyn.extract(scene._scene, float(grid_deg), method)
+    samples, calls, ms = _rdyn.extract(scene._scene, _real(grid_deg, "grid_deg"), method)
     return Table(samples, scene, calls, ms)
 
 
@@ -175,7 +183,7 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
     args = _rdyn.SimulateArgs()
     args.model = model
     if duration is not None:
-        args.duration = float(duration)
+        args.duration = _real(duration, "duration")
     if options.get("grid_deg", 0) is None:  # None: the default grid, refined as in drive()
         del options["grid_deg"]
     for key, value in options.items():
@@ -194,8 +202,9 @@ def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=None, in
     None: the scene's validation.calibrate.grid_deg, else 10° halved while it does not resolve
     the mechanism (the JSON's "grid_deg" is the grid used)."""
     scene = _as_scene(scene, "calibrate")
-    return _json.loads(_rdyn.calibrate(scene._scene, cadence_hz, power_w, load or "",
-                                       None if grid_deg is None else float(grid_deg), interpolation))
+    return _json.loads(_rdyn.calibrate(scene._scene, None if cadence_hz is None else _real(cadence_hz, "cadence_hz"),
+                                       None if power_w is None else _real(power_w, "power_w"), load or "",
+                                       None if grid_deg is None else _real(grid_deg, "grid_deg"), interpolation))
 
 
 def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, table=None, dt_out=None,
@@ -213,15 +222,15 @@ def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, 
     args = _rdyn.DriveArgs()
     args.model = model
     if cadence_hz is not None:
-        args.cadence_hz = float(cadence_hz)
+        args.cadence_hz = _real(cadence_hz, "cadence_hz")
     if profile is not None:
         args.profile = _os.fspath(profile)
     if duration is not None:
-        args.duration = float(duration)
+        args.duration = _real(duration, "duration")
     if dt_out is not None:
-        args.dt_out = float(dt_out)
+        args.dt_out = _real(dt_out, "dt_out")
     if grid_deg is not None:  # None: 10°, refined where it does not resolve the mechanism (as the CLI)
-        args.grid_deg = float(grid_deg)
+        args.grid_deg = _real(grid_deg, "grid_deg")
         args.grid_given = True
     args.interpolation = interpolation
     if motor is not None:
@@ -304,9 +313,10 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
         peaks = (peaks,)
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
             tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
-            None if cadence_hz is None else float(cadence_hz), None if power_w is None else float(power_w),
-            load or "", None if grid_deg is None else float(grid_deg),
-            None if drive_cadence_hz is None else float(drive_cadence_hz),
+            None if cadence_hz is None else _real(cadence_hz, "cadence_hz"),
+            None if power_w is None else _real(power_w, "power_w"),
+            load or "", None if grid_deg is None else _real(grid_deg, "grid_deg"),
+            None if drive_cadence_hz is None else _real(drive_cadence_hz, "drive_cadence_hz"),
             tuple(peaks))
     plan = _plan(spec)  # checked here, before any case runs: bad input raises at once
     header = _csv_rows(plan.header)[0]

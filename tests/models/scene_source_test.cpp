@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "models/scene_write.hpp"
+#include "tests/models/scene_yaml_checks.hpp"
 
 namespace rdyn::models {
 namespace {
@@ -114,20 +115,7 @@ TEST(SceneSource, AFileThatDoesNotParseFailsEveryLoadAsLoadScene) {
 
 // A line-numbered refusal after loading: the node's line must be the file's, from the copy's marks.
 TEST(SceneSource, ARefusalInTheFileNamesItsLine) {
-  const std::string text = R"(name: fb
-ground_points: {A: [0, 0], D: [0.3, 0]}
-bodies:
-  - {name: crank, mass_kg: 0.5, com_m: [0.04, 0], inertia_kgm2: 2.0e-4, points: {B: [0.08, 0]}}
-  - {name: coupler, mass_kg: 1.2, com_m: [0.14, 0], inertia_kgm2: 7.8e-3, points: {C: [0.28, 0]}}
-  - {name: rocker, mass_kg: 0.9, com_m: [0.1, 0], inertia_kgm2: 3.0e-3, points: {C: [0.2, 0]}}
-joints:
-  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank}
-  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler}
-  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 90}
-loops:
-  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
-independent: crank
-)";
+  const std::string text = test::kFourbar;  // the four-bar the reader's own tests use
   const TempScene file(text);
   SceneSource source(file.path);
   ASSERT_TRUE(source.parsed());
@@ -143,20 +131,8 @@ independent: crank
 // Aliases share one node in yaml-cpp's tree: an override through one name changes the other too,
 // in the copy as in the file's own tree.
 TEST(SceneSource, AliasesStaySharedInTheCopies) {
-  const std::string text = R"(name: fb
-ground_points: {A: [0, 0], D: [0.3, 0]}
-bodies:
-  - {name: crank, mass_kg: &m 0.5, com_m: [0.04, 0], inertia_kgm2: 2.0e-4, points: {B: [0.08, 0]}}
-  - {name: coupler, mass_kg: 1.2, com_m: [0.14, 0], inertia_kgm2: 7.8e-3, points: {C: [0.28, 0]}}
-  - {name: rocker, mass_kg: *m, com_m: [0.1, 0], inertia_kgm2: 3.0e-3, points: {C: [0.2, 0]}}
-joints:
-  - {name: crank, type: revolute, parent: ground, parent_point: A, child: crank}
-  - {name: coupler, type: revolute, parent: crank, parent_point: B, child: coupler}
-  - {name: rocker, type: revolute, parent: ground, parent_point: D, child: rocker, guess_deg: 90}
-loops:
-  - {name: C, body_a: coupler, point_a: C, body_b: rocker, point_b: C}
-independent: crank
-)";
+  const std::string text =
+      test::with(test::with(test::kFourbar, "mass_kg: 0.5", "mass_kg: &m 0.5"), "mass_kg: 0.9", "mass_kg: *m");
   const TempScene file(text);
   SceneSource source(file.path);
   const std::vector<Override> o{{"bodies.crank.mass_kg", "0.7"}};

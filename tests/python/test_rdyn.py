@@ -112,6 +112,11 @@ def test_argument_errors_name_the_option():
         rdyn.calibrate(scene, cadence_hz=-1)
     with pytest.raises(TypeError):
         rdyn.simulate(scene, duration=1, no_such_option=3)
+    # A bool is not a number here (float(True) is 1: calibrate ran at 1 Hz for cadence_hz=True).
+    with pytest.raises(rdyn.ArgumentError, match="cadence_hz"):
+        rdyn.calibrate(rdyn.load_scene("bicycle"), cadence_hz=True)
+    with pytest.raises(rdyn.ArgumentError, match="duration"):
+        rdyn.simulate(scene, duration=False)
 
 
 def test_table_error():
