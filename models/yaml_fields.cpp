@@ -311,8 +311,10 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
   // without a range could not be given one (`independent_range.0=…` has no item to set). Only
   // scalars inside, so no structure enters through --set.
   YAML::Node list;
+  // A scalar key keeps its text (description=[draft]), but for `all`: outputs.joints and
+  // outputs.reactions take `all` or a list, and `--set 'outputs.reactions=[crank, C]'` was refused.
   if (o.value.size() >= 2 && o.value.front() == '[' && o.value.back() == ']' &&
-      !(cur[last] && cur[last].IsScalar())) {  // a scalar key keeps its text: description=[draft]
+      !(cur[last] && cur[last].IsScalar() && cur[last].Scalar() != "all")) {
     try {
       list = YAML::Load(o.value);
     } catch (const YAML::Exception&) {
@@ -321,7 +323,7 @@ void apply_override(YAML::Node root, const Override& o, const std::string& file,
     if (!list.IsSequence() || list.size() > 64 ||
         std::any_of(list.begin(), list.end(), [](const YAML::Node& n) { return !n.IsScalar(); }))
       fail("a list value is written [a, b, …] with at most 64 scalar items");
-    if (cur[last] && !cur[last].IsSequence()) fail("only scalars and lists can be set");
+    if (cur[last] && cur[last].IsMap()) fail("only scalars and lists can be set");
   } else if (cur[last] && !cur[last].IsScalar()) {
     fail("only scalar values can be set");
   }

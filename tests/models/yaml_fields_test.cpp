@@ -96,6 +96,13 @@ TEST(YamlFields, OverridesReachScalarsByPathAndName) {
                                 parse_override("independent_range=[-0.2, 1.0]")});
   ASSERT_TRUE(r2.independent_range);
   EXPECT_DOUBLE_EQ(r2.independent_range->max, 1.0);
+  // `all` replaced by a list (outputs take either); another scalar keeps `[…]` as its text.
+  const Scene all = parse_scene(kFourbar + std::string("outputs: {reactions: all}\n"), "t.yaml",
+                                {parse_override("outputs.reactions=[crank, C]")});
+  EXPECT_EQ(all.outputs.reactions, (std::vector<std::string>{"crank", "C"}));
+  EXPECT_EQ(parse_scene(kFourbar + std::string("description: old\n"), "t.yaml", {parse_override("description=[draft]")})
+                .description,
+            "[draft]");
 }
 
 TEST(YamlFields, MalformedEmptyAndBinaryInputsAreRefused) {
