@@ -237,7 +237,12 @@ models::TimeSeries simulate_reduced_refining(const models::Scene& scene, const S
     try {
       return simulate_reduced_once(scene, a, table, duration, dt_out, start, used, run);
     } catch (const reduced::EnergyBalanceError&) {
-      const bool refinable = !table && a.table.empty() && !a.grid_given && used > 0;
+      // The table is refined only under the default integrator: with a step or tolerance the user
+      // gave, the miss may be theirs (a 1 s fixed step was re-extracted five times, then exit 1).
+      const SimulateArgs defaults;
+      const bool default_integrator =
+          a.reduced_integrator == defaults.reduced_integrator && a.reduced_tolerance == defaults.reduced_tolerance;
+      const bool refinable = !table && a.table.empty() && !a.grid_given && used > 0 && default_integrator;
       if (!refinable || used / 2 < kMinAutoGrid_deg - 1e-9) throw;
       std::fprintf(stderr, "rdyn: the reduced run on the %g° table misses its energy balance: extracting at %g°\n",
                    used, used / 2);

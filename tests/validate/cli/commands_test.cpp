@@ -181,6 +181,12 @@ TEST_F(Cli, ADefaultGridWhoseRunMissesItsEnergyBalanceIsRefined) {
   std::ifstream k(dir_ / "knee" / "run.json");
   const auto knee = nlohmann::json::parse(k);
   EXPECT_LT(knee["energy_balance_residual_J"].get<double>(), 0.01 * knee["energy_scale_J"].get<double>());
+  // A step the user gave is theirs to blame: no table is re-extracted for it.
+  r = rdyn("simulate bicycle --model reduced --reduced-integrator rk4-fixed --fixed-step 0.5 --duration 3 --out " +
+           (dir_ / "coarse").string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("energy balance does not close"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("extracting at"), std::string::npos) << r.output;
   r = rdyn("simulate " + saddle + " --model reduced --grid-deg 2.5 --out " + (dir_ / "given").string());
   EXPECT_EQ(r.status, 1) << r.output;
   EXPECT_NE(r.output.find("energy balance does not close"), std::string::npos) << r.output;
