@@ -199,6 +199,13 @@ std::string find_malformed_record(const json& s) {
     for (const char* k : {"target", "error"})  // null: not measured (NaN)
       if (!v.contains(k) || !(v[k].is_number() || v[k].is_null())) return at + "." + k + ": missing or not a number";
   }
+  // The status and its reasons agree as validate writes them: a "pass" with failures rendered
+  // "pass" above a failure.
+  const json* failures = s.contains("failures") ? &s["failures"] : nullptr;
+  const std::string status = s.contains("status") && s["status"].is_string() ? s["status"].get<std::string>() : "";
+  if (status != "pass" && status != "fail") return "status: missing or not pass or fail";
+  if (!failures || !failures->is_array()) return "failures: missing or not a list";
+  if ((status == "pass") != failures->empty()) return "status: " + status + " contradicts the failures listed";
   return "";
 }
 

@@ -126,6 +126,12 @@ TEST(ReportTables, ABrokenRunOrVerdictRecordIsFoundByItsPath) {
             "verdicts[0].within_target: missing or not true/false");
   EXPECT_EQ(edited([](json& e) { e["verdicts"][0].erase("target"); }), "verdicts[0].target: missing or not a number");
   EXPECT_EQ(edited([](json& e) { e["verdicts"][0]["error"] = nullptr; }), "");  // not measured: null, as written
+  // A status its failures contradict (it rendered "pass" above a failure).
+  EXPECT_EQ(edited([](json& e) { e["failures"] = json::array({"threshold qdot missed"}); }),
+            s["status"] == "pass" ? "status: pass contradicts the failures listed" : "");
+  EXPECT_EQ(edited([](json& e) { e["status"] = "fail"; e["failures"] = json::array(); }),
+            "status: fail contradicts the failures listed");
+  EXPECT_EQ(edited([](json& e) { e["status"] = "ok"; }), "status: missing or not pass or fail");
 }
 
 // A window of fewer than two revolutions (a run that never settles, which fails validate) is not
