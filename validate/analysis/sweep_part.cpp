@@ -192,6 +192,10 @@ SweepPart parse_sweep_part(const std::string& text, const std::string& file) {
     if (c <= previous) fail("case", fmt::format("case {} after case {}: rows out of order or doubled", c, previous));
     const std::string& status = r.fields[status_at];
     if (status != "ok" && status != "error") fail("status", "expected ok or error, got '" + status + "'");
+    // As rdyn writes them: a failed case says why, a case that ran has no error (an edit ok →
+    // error with an empty reason was merged).
+    if ((status == "error") == r.fields[n - 1].empty())
+      fail("error", status == "error" ? "a case with status error gives its reason" : "a case with status ok has no error");
     if (status == "error") ++p.failed;
     previous = c;
     p.cases.push_back(c);

@@ -85,6 +85,8 @@ TEST(SweepPart, MalformedPartsAreRefusedWithTheirLine) {
   std::string doubled = file_of("0/1", "0-5/5", 0, 2) + row(1) + "\n";
   std::string short_row = file_of("0/1", "0-5/5", 0, 1) + "1,0.2,ok,1\n";
   std::string bad_status = file_of("0/1", "0-5/5", 0, 1) + "1,0.2,done,1,2,3,4,5,\n";
+  std::string silent_error = file_of("0/1", "0-5/5", 0, 1) + "1,0.2,error,1,2,3,4,5,\n";  // edited ok → error
+  std::string ok_with_error = file_of("0/1", "0-5/5", 0, 1) + "1,0.2,ok,1,2,3,4,5,diverged\n";
   const std::vector<Bad> cases{
       {good.substr(0, good.size() - 1), 8, "row"},                                 // cut: no final line break
       {good.substr(0, good.find("at q")), 6, "row"},                               // cut inside a quoted field
@@ -92,6 +94,8 @@ TEST(SweepPart, MalformedPartsAreRefusedWithTheirLine) {
       {doubled, 5, "case"},
       {short_row, 4, "row"},
       {bad_status, 4, "status"},
+      {silent_error, 4, "error"},
+      {ok_with_error, 4, "error"},
       {file_of("1/2", "3-5/5", 0, 1), 3, "case"},                                  // outside its range
       {file_of("1/2", "2-5/5", 3, 5), 1, "rdyn-sweep"},                            // not shard 1/2's cases
       {file_of("2/2", "3-5/5", 3, 5), 1, "rdyn-sweep"},                            // i ≥ N
