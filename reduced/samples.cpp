@@ -165,10 +165,13 @@ struct TableReader {
     return true;
   }
   double number(const std::string& cell, const std::string& what) const {
+    // Decimal only, as rdyn writes (%.17g): strtod also reads hex ("0x10" was 16 in a table
+    // without a checksum) and "inf"/"nan".
+    const bool decimal = cell.find_first_not_of("0123456789+-.eE") == std::string::npos;
     char* end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
-      fail(ln, fmt::format("{}: not a finite number: '{}'", what, cell.substr(0, 40)));
+    if (cell.empty() || !decimal || end != cell.c_str() + cell.size() || !std::isfinite(v))
+      fail(ln, fmt::format("{}: not a finite decimal number: '{}'", what, cell.substr(0, 40)));
     // The reduced model multiplies table values with each other and with q̇²: a value near the
     // double's limit (m1 = 1e308) overflowed there into NaN, reported without file or line.
     if (std::abs(v) > kMaxTableMagnitude)
