@@ -343,12 +343,10 @@ std::vector<const CLI::App*> subcommands(const CLI::App& app) {
   return app.get_subcommands([](const CLI::App*) { return true; });
 }
 
-std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
-  if (argc < 2 || argv[1][0] == '-') return "";
-  for (const CLI::App* sub : subcommands(app))
-    if (sub->check_name(argv[1])) return "";
+// Text a user typed, shown with its control characters as \xNN (never written to the terminal).
+std::string shown_text(const char* text) {
   std::string shown;
-  for (const char* c = argv[1]; *c; ++c) {
+  for (const char* c = text; *c; ++c) {
     const auto b = static_cast<unsigned char>(*c);
     if (b < 0x20 || b == 0x7f) {
       char hex[8];
@@ -359,6 +357,13 @@ std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
     }
   }
   return shown;
+}
+
+std::string unknown_subcommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return "";
+  for (const CLI::App* sub : subcommands(app))
+    if (sub->check_name(argv[1])) return "";
+  return shown_text(argv[1]);
 }
 
 std::string subcommand_names(const CLI::App& app) {
@@ -463,7 +468,8 @@ int main(int argc, char** argv) {
                    typed.c_str(), subcommand_names(app).c_str());
       return kExitBadInput;
     }
-    app.exit(e);
+    // With the prefix every other refusal has (CLI11 printed "--model: bogus not in {…}" bare).
+    std::fprintf(stderr, "rdyn: error: %s\nRun with --help for more information.\n", shown_text(e.what()).c_str());
     return kExitBadInput;
   }
   return run_command(app, a);

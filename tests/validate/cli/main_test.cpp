@@ -92,6 +92,18 @@ TEST_F(Main, AnUnknownSubcommandExitsTwoNamingIt) {
   EXPECT_NE(r.err.find("'bad\\x1b[2Jname'"), std::string::npos) << r.err;
 }
 
+// The parser's own refusals carry the prefix every refusal has, user text shown, not written.
+TEST_F(Main, ParserRefusalsHaveThePrefix) {
+  auto r = rdyn({"simulate", "fourbar", "--model", "bogus", "--out", "o"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err.rfind("rdyn: error: --model: bogus not in {full,reduced}", 0), 0u) << r.err;
+  r = rdyn({"simulate", "fourbar", "--model", std::string("a\x1b[2Jb"), "--out", "o"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a\\x1b[2Jb"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
 TEST_F(Main, NoSubcommandExitsTwo) {
   const auto r = rdyn({});
   EXPECT_EQ(r.status, 2);
