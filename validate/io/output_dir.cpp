@@ -302,6 +302,14 @@ OutputFile::OutputFile(std::string path, bool force, Recogniser is_ours) {
   const bool stream_name = path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0;
   if (stat(path.c_str(), &given) == 0 && (stream_name || S_ISCHR(given.st_mode) || S_ISFIFO(given.st_mode))) {
     if (S_ISDIR(given.st_mode)) throw OutputError(path + ": is a folder; give a file name");
+    // A regular file there is a stream only through a descriptor (/dev/stdout into a redirected
+    // file); any other is the kernel's (/proc/sys/kernel/hostname: written through as root it
+    // changed a setting) or a process's own (/proc/self/comm).
+    const bool descriptor = path == "/dev/stdout" || path == "/dev/stderr" || path.rfind("/dev/fd/", 0) == 0 ||
+                            (path.rfind("/proc/", 0) == 0 && path.find("/fd/") != std::string::npos);
+    if (S_ISREG(given.st_mode) && !descriptor)
+      throw OutputError(path + ": is a kernel or device file, not an output (of /dev and /proc only devices, FIFOs, "
+                               "/dev/stdout, /dev/stderr and …/fd/N descriptors are written through)");
     if (S_ISFIFO(given.st_mode)) {
       fifo_fd_ = open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
       if (fifo_fd_ < 0)

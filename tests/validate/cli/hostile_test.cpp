@@ -268,6 +268,8 @@ void outputs(std::vector<Case>& cs) {
                   {"extract", "fourbar", "--out", name}, 0, "", {}, nullptr, "", {},
                   [](const fs::path&, const RdynRun& r) { EXPECT_EQ(r.out.rfind("# rdyn-table v1", 0), 0u) << r.out; }});
   cs.push_back({"extract_to_dev_full", {"extract", "fourbar", "--out", "/dev/full"}, 2, "No space left"});
+  // A kernel file is not a stream (written through as root, /proc/sys/… changed a setting).
+  cs.push_back({"extract_to_proc_comm", {"extract", "fourbar", "--out", "/proc/self/comm"}, 2, "kernel or device file"});
   cs.push_back({"extract_follows_symlink_to_file", {"extract", "fourbar", "--out", "link.csv"}, 0, "", {},
                 [](const fs::path& d) { fs::create_symlink("real.csv", d / "link.csv"); }, "", {},
                 [](const fs::path& d, const RdynRun&) {
