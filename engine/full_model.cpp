@@ -436,14 +436,17 @@ enum class Walk {
 
 Walk assemble_by_continuation(const FullModel::Impl& m, State& s) {
   const State start = s;
-  m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.joints[m.independent].guess);
-  m.set_law(s, 0, poly_law(m.scene.joints[m.independent].guess, 0.0, 0.0));
+  // A gearless mechanism repeats each turn: the walk starts whole turns on, toward q, and walks
+  // the last part of a turn (from 30° to 1e6° it gave up at once, blaming a singular configuration).
+  const double guess = m.scene.joints[m.independent].guess, q_to = m.scene.initial.q;
+  const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
+  const double g0 = rev && m.scene.gears.empty() ? guess + 2 * M_PI * std::trunc((q_to - guess) / (2 * M_PI)) : guess;
+  m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), g0);
+  m.set_law(s, 0, poly_law(g0, 0.0, 0.0));
   if (!(assemble(m, s, false) <= 1e-8)) {
     s = start;
     return Walk::GuessesDoNotAssemble;
   }
-  const double q_to = m.scene.initial.q;
-  const bool rev = m.scene.joints[m.independent].type == models::JointType::Revolute;
   const double q_from = m.joint_mobod[m.independent].getOneQ(s, MobilizerQIndex(0));
   const double max_move = rev ? 2 * M_PI / 180 : 0.02 * std::max(1e-3, std::abs(q_to - q_from));
   // A move that does not close is halved (near a flat configuration Newton's basin shrinks),

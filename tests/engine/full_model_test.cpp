@@ -211,6 +211,22 @@ TEST(FullModelAssembly, GearedStartATurnOnProjectsToTheSameConfiguration) {
   EXPECT_NEAR(turned[index("slow")], 430.2 * kPi / 180, 1e-12);
 }
 
+// A gearless mechanism started many turns away (inside the scene limit of 5.7e7°) walks only the
+// last part of a turn: 1e6° was refused as "across a singular configuration" after no move at all.
+TEST(FullModelAssembly, AStartManyTurnsAwayIsTheSameConfigurationAsItsRemainder) {
+  auto joints_at = [](double q_deg) {
+    auto scene = models::load_scene("fourbar");
+    scene.initial.q = q_deg * kPi / 180;
+    FullModel model(scene);
+    FullWorkspace ws(model);
+    return calc_kinetostatic(model, ws, scene.initial.q, 0, 0, Loads::Off).joint_q;
+  };
+  expect_same_configuration(joints_at(1e6), joints_at(280), "1e6° against 280°");
+  expect_same_configuration(joints_at(-1e6), joints_at(80), "-1e6° against 80°");
+  expect_same_configuration(joints_at(500000 + 0.5), joints_at(320.5), "500000.5° against 320.5°");
+  EXPECT_NEAR(joints_at(1e6)[0], 1e6 * kPi / 180, 1e-12 * 1e6);  // the coordinate as given
+}
+
 // The five-bar's closed form on the scene's branch (P left of T_slow → T_fast): slow θ, fast
 // φ = 6θ + c, T_slow = 0.07 (cos θ, sin θ), T_fast = B + 0.05 (cos φ, sin φ), P where the arms
 // (0.22 m from T_slow, 0.20 m from T_fast) meet; arm1 = ∠(P − T_slow) − θ, arm2 = ∠(P − T_fast) − φ.
