@@ -9,6 +9,7 @@
 
 #include "models/scene_yaml.hpp"
 #include "reduced/table.hpp"
+#include "tests/validate/analysis/same_calibration.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -38,11 +39,7 @@ TEST(CalibrateOnTable, AgreesWithTheCopyingRouteAndGivesTheTableBack) {
   Progress quiet(false);
   const auto copied = calibrate(scene, table, opt, quiet);  // builds its model on a copy
   const auto lent = calibrate_on_table(table, scene, scene, opt, quiet);
-  EXPECT_EQ(lent.load_value, copied.load_value);
-  EXPECT_EQ(lent.resistance_coefficient, copied.resistance_coefficient);
-  EXPECT_EQ(lent.mean_cadence_hz_reduced, copied.mean_cadence_hz_reduced);
-  EXPECT_EQ(lent.speed_fluctuation, copied.speed_fluctuation);
-  EXPECT_EQ(lent.peak_forces_N, copied.peak_forces_N);
+  test::expect_same_calibration(copied, lent);
   // The scene's 125 W dissipated on the steady cycle (the power search's tolerance: 1e-8 in log).
   EXPECT_NEAR(lent.mean_dissipated_power_w, 125.0, 125.0 * 2e-8);
   EXPECT_EQ(table.table.coef, coef);            // back, unchanged

@@ -22,6 +22,7 @@
 #include "validate/analysis/calibrate_on_table.hpp"
 #include "validate/analysis/sweep_peaks.hpp"
 #include "tests/validate/analysis/jansen_text.hpp"
+#include "tests/validate/analysis/same_calibration.hpp"
 
 namespace rdyn::validate {
 namespace {
@@ -561,14 +562,7 @@ TEST(Calibrate, ATableOfTheColumnsACaseReadsCalibratesAsTheWholeTable) {
   EXPECT_EQ(part.samples.min_conditioning, whole.samples.min_conditioning);
   Progress quiet(false);
   const auto a = calibrate(scene, whole, opt, quiet);
-  const auto b = calibrate_on_table(part, scene, scene, opt, quiet);
-  EXPECT_EQ(b.load_value, a.load_value);
-  EXPECT_EQ(b.mean_cadence_hz_reduced, a.mean_cadence_hz_reduced);
-  EXPECT_EQ(b.mean_power_w, a.mean_power_w);
-  EXPECT_EQ(b.peak_force_N, a.peak_force_N);
-  EXPECT_EQ(b.speed_fluctuation, a.speed_fluctuation);
-  EXPECT_EQ(b.steady_q, a.steady_q);
-  EXPECT_EQ(b.steady_qdot, a.steady_qdot);
+  test::expect_same_calibration(a, calibrate_on_table(part, scene, scene, opt, quiet));
 }
 
 // A case near a dead point is handled as cold even after the best neighbour (its own topology,
