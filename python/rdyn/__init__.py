@@ -38,8 +38,10 @@ __all__ = ["load_scene", "extract", "load_table", "simulate", "calibrate", "driv
 
 
 def _real(value, name):
-    """A number argument as float; True and False are refused (float(True) is 1.0: calibrate ran at
-    1 Hz when given cadence_hz=True)."""
+    """A number argument as float (None stays None: not given); True and False are refused
+    (float(True) is 1.0: calibrate ran at 1 Hz when given cadence_hz=True)."""
+    if value is None:
+        return None
     if isinstance(value, bool):
         raise ArgumentError(f"{name}: expected a number (got {value!r})")
     return float(value)
@@ -202,9 +204,8 @@ def calibrate(scene, cadence_hz=None, power_w=None, load=None, grid_deg=None, in
     None: the scene's validation.calibrate.grid_deg, else 10° halved while it does not resolve
     the mechanism (the JSON's "grid_deg" is the grid used)."""
     scene = _as_scene(scene, "calibrate")
-    return _json.loads(_rdyn.calibrate(scene._scene, None if cadence_hz is None else _real(cadence_hz, "cadence_hz"),
-                                       None if power_w is None else _real(power_w, "power_w"), load or "",
-                                       None if grid_deg is None else _real(grid_deg, "grid_deg"), interpolation))
+    return _json.loads(_rdyn.calibrate(scene._scene, _real(cadence_hz, "cadence_hz"), _real(power_w, "power_w"),
+                                       load or "", _real(grid_deg, "grid_deg"), interpolation))
 
 
 def drive(scene, cadence_hz=None, profile=None, model="reduced", duration=None, table=None, dt_out=None,
@@ -313,10 +314,10 @@ def sweep(scene, vary, map=None, cadence_hz=None, power_w=None, load=None, grid_
         peaks = (peaks,)
     spec = (scene.name_or_path if isinstance(scene.name_or_path, str) else _os.fspath(scene.name_or_path),
             tuple(scene.sets), tuple(_axis_text(k, v) for k, v in vary.items()),
-            None if cadence_hz is None else _real(cadence_hz, "cadence_hz"),
-            None if power_w is None else _real(power_w, "power_w"),
-            load or "", None if grid_deg is None else _real(grid_deg, "grid_deg"),
-            None if drive_cadence_hz is None else _real(drive_cadence_hz, "drive_cadence_hz"),
+            _real(cadence_hz, "cadence_hz"),
+            _real(power_w, "power_w"),
+            load or "", _real(grid_deg, "grid_deg"),
+            _real(drive_cadence_hz, "drive_cadence_hz"),
             tuple(peaks))
     plan = _plan(spec)  # checked here, before any case runs: bad input raises at once
     header = _csv_rows(plan.header)[0]

@@ -1,7 +1,7 @@
-#include "reduced/reduced_model.hpp"
 #include "validate/cli/drive_command.hpp"
 
 #include "reduced/joint_outputs.hpp"
+#include "reduced/reduced_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +22,6 @@
 namespace rdyn::validate {
 
 namespace {
-
 
 // The output rows: every k-th row of the fine record and its last (the duration itself).
 DriveRecord every_kth_row(const DriveRecord& r, long k) {

@@ -90,6 +90,7 @@ struct ValidationResult {
   // resolve the mechanism (validate/analysis/build_reduced's extract_resolving). The ladder always
   // has it; the default thresholds, the figure's reduced run and the drive cycle are on it.
   double default_grid_deg = 10.0;
+  reduced::Samples default_samples;  // that table (empty when it is the 10° one or none closed)
   models::TimeSeries reference, showcase;        // showcase: reduced, default grid, default settings
   int showcase_run = -1;
   reduced::Samples samples10;                    // the 10° table
@@ -125,9 +126,14 @@ models::Scene extraction_scene(const models::Scene& scene);
 // ladders, analyse_runs, calibration, thresholds, calc_first_screen.
 ValidationResult run_validation(const models::Scene& scene, const ValidationOptions& opt, Progress& progress);
 
-// The grid rdyn's commands take for the scene by default (ValidationResult::default_grid_deg):
-// 10°, halved while its table does not resolve the mechanism (extract_resolving).
-double calc_default_grid(const models::Scene& scene);
+// The table rdyn's commands take for the scene by default (ValidationResult::default_grid_deg):
+// 10°, halved while it does not resolve the mechanism (extract_resolving); its samples are the
+// drive cycle's. A sweep that does not close at any grid: 10° and no samples.
+struct DefaultTable {
+  double grid_deg = 10.0;
+  reduced::Samples samples;
+};
+DefaultTable calc_default_table(const models::Scene& scene);
 
 // Stage 1: the reference (full model at the scene's reference tolerance), its change when the
 // tolerance is halved, the compared window and the scene's time scale, into `v` (whose

@@ -282,9 +282,8 @@ std::string headline(const json& s) {
 std::string showcase_note(const json& s) {
   const json& sc = s.value("showcase_reduced", json(nullptr));
   if (!sc.is_object()) return "";
-  // The default grid (summaries before it was recorded: 10°).
-  const double grid = s.value("default_grid_deg", json(10.0)).is_number() ? s.value("default_grid_deg", 10.0) : 10.0;
-  return "<p>The reduced run drawn is the " + H(fmt::format("{:g}", grid)) +
+  // Summaries written before the default grid was recorded drew the 10° table.
+  return "<p>The reduced run drawn is the " + H(fmt::format("{:g}", default_grid_deg(s).value_or(10.0))) +
          "° table at the default settings (" + H(str(sc, "label")) +
          "); its errors are " + H(pct(error_of(sc, "qdot")) + " for the speed" + other_errors(s, sc)) +
          ". The recommended setting's errors are in the verdict.</p>";

@@ -209,6 +209,12 @@ std::string find_malformed_record(const json& s) {
   return "";
 }
 
+std::optional<double> default_grid_deg(const json& s) {
+  const auto it = s.find("default_grid_deg");
+  if (it == s.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
 bool is_joint_output(const json& s, const json& q) {
   for (const auto& j : s.value("joint_output_quantities", json::array()))
     if (j == q) return true;
@@ -246,10 +252,9 @@ std::string thresholds_table(const json& s) {
       h += "<p>The scene declares no thresholds: it is judged against the defaults (docs/scene-format.md, "
            "\"Validation settings\"): every compared quantity within 0.5 % of its peak on the grid rdyn's commands "
            "take for this scene" +
-           (s.contains("default_grid_deg") && s.at("default_grid_deg").is_number()
-                ? fmt::format(" ({:g}°: 10°, halved while the table does not resolve the mechanism)",
-                              s.at("default_grid_deg").get<double>())
-                : std::string()) +
+           (default_grid_deg(s) ? fmt::format(" ({:g}°: 10°, halved while the table does not resolve the mechanism)",
+                                              *default_grid_deg(s))
+                                : std::string()) +
            ".</p>";
     h += "<table><tr><th>quantity</th><th>grid</th><th>limit</th><th>error</"
          "th><th>run</th>"

@@ -3,6 +3,7 @@
 // shares (numbers never "nan": "n/a"; scene text escaped).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -35,6 +36,9 @@ std::string compared_over(const json& s);
 std::string table_csv(const json& t);
 // Whether q is one of the summary's joint outputs (reactions, shaking, joint motion).
 bool is_joint_output(const json& s, const json& q);
+// The grid the default thresholds and figure 2 are on (summary.json's default_grid_deg); empty
+// for a summary written before it was recorded.
+std::optional<double> default_grid_deg(const json& s);
 // The first value of a hand-edited summary that `rdyn validate` could not have written, as
 // "path: value why" ("recommended_speedup: \"fast\" is not a number", "runs[3].steps: 1e+300 is
 // not a count", "duration_s: -3 is negative", a number beyond ±1e100, a threshold whose pass

@@ -96,7 +96,9 @@ TEST(Harness, DriveCycleRefinesATableThatDoesNotResolveTheMechanism) {
   const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/fivebar-2to1.yaml");
   ValidationResult v;
   v.samples10 = extract_from_full(extraction_scene(scene), 10, reduced::Method::Kinetostatic).samples;
-  v.default_grid_deg = calc_default_grid(scene);
+  const auto d = calc_default_table(scene);
+  v.default_grid_deg = d.grid_deg;
+  v.default_samples = d.samples;
   EXPECT_EQ(v.default_grid_deg, 2.5);
   calc_drive_cycle(scene, v);
   ASSERT_TRUE(v.drive_cycle);
@@ -112,12 +114,12 @@ TEST(Harness, DriveCycleRefinesATableThatDoesNotResolveTheMechanism) {
 // The default grid is the one the commands take: 10° where it resolves the mechanism (the
 // four-bar: m1 misses 1.4e-4 from every other grid point), finer where it does not.
 TEST(Harness, DefaultGridIsTheCommandsGrid) {
-  EXPECT_EQ(calc_default_grid(models::load_scene("fourbar")), 10.0);
+  EXPECT_EQ(calc_default_table(models::load_scene("fourbar")).grid_deg, 10.0);
   double grid = 0.0;
   const auto scene = models::load_scene(std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml");
   extract_resolving(extraction_scene(scene), 10.0, false, reduced::Method::Kinetostatic, grid);
   EXPECT_LT(grid, 10.0);
-  EXPECT_EQ(calc_default_grid(scene), grid);
+  EXPECT_EQ(calc_default_table(scene).grid_deg, grid);
 }
 
 // The recommended run is the cheapest within the target on every judged quantity; when none is,
