@@ -1,6 +1,7 @@
 #include "validate/cli/commands.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +28,7 @@
 #include "validate/cli/cli_limits.hpp"
 #include "validate/io/escape.hpp"
 #include "validate/harness/harness.hpp"
+#include "validate/harness/grid_check.hpp"
 #include "validate/cli/inspect.hpp"
 #include "validate/cli/animate_command.hpp"
 #include "engine/inspect.hpp"
@@ -223,19 +225,61 @@ models::TimeSeries simulate_reduced_once(const models::Scene& scene, const Simul
   return ts;
 }
 
+// The default grid's run against the run on half its grid (validate/harness/grid_check.hpp): the
+// finer run is taken while some column changes more than kGridCheckMaxChange of its peak, and
+// run.json's grid_check says what was compared; a run that did not converge is written with a
+// warning naming the column.
+models::TimeSeries check_default_grid(const models::Scene& scene, const SimulateArgs& a, double duration,
+                                      double dt_out, models::TimeSeries ts, double grid_deg, nlohmann::json& run) {
+  struct GridRun {
+    models::TimeSeries ts;
+    nlohmann::json run;
+  };
+  SimulateArgs given = a;
+  given.grid_given = true;  // each grid as asked: the check does the halving
+  GridCheck check;
+  GridRun kept = check_grid_by_runs(
+      GridRun{std::move(ts), run}, grid_deg,
+      [&](double g) {
+        GridRun r{{}, run};
+        double used = 0;
+        r.ts = simulate_reduced_once(scene, given, nullptr, duration, dt_out, g, used, r.run);
+        return r;
+      },
+      true, check);
+  run = std::move(kept.run);
+  run["grid_check"] = grid_check_json(check);
+  if (!check.not_compared.empty())
+    std::fprintf(stderr,
+                 "rdyn: warning: the reduced run on the %g° table was not checked against one on half its grid, "
+                 "which failed: %s (run.json: grid_check)\n",
+                 check.grid_deg, check.not_compared.c_str());
+  else if (!check.verified)
+    std::fprintf(stderr,
+                 "rdyn: warning: the reduced run has not converged in its grid: on the %g° and %g° tables %s differs "
+                 "by %.2g %% of its peak (more than %g %%); the %g° run is written: compare it with --model full "
+                 "(run.json: grid_check)\n",
+                 check.coarser_grid_deg, check.grid_deg, check.column.c_str(), 100 * check.change,
+                 100 * kGridCheckMaxChange, check.grid_deg);
+  return std::move(kept.ts);
+}
+
 // A default grid (no --grid-deg, no table) whose run misses its own energy balance is halved and
 // the run repeated, down to kMinAutoGrid_deg: m1's half-grid miss (extract_resolving) does not
 // see every table too coarse for its motion — the high-saddle bicycle's 2.5° table resolves m1
 // (miss below 1e-3) while its run, through the steep me2 of an almost straight leg, misses its
 // energy balance by 3.7 %; refined (to 0.3125°, where m1's miss also asks for it) it balances to
-// 0.139 J of 1.81e3 J.
+// 0.139 J of 1.81e3 J. The run kept is then checked against the run on half its grid
+// (check_default_grid).
 models::TimeSeries simulate_reduced_refining(const models::Scene& scene, const SimulateArgs& a,
                                              const reduced::Samples* table, double duration, double dt_out,
                                              nlohmann::json& run) {
   double start = a.grid_deg, used = 0;
   for (;;) {
     try {
-      return simulate_reduced_once(scene, a, table, duration, dt_out, start, used, run);
+      auto ts = simulate_reduced_once(scene, a, table, duration, dt_out, start, used, run);
+      if (used > 0 && !a.grid_given) ts = check_default_grid(scene, a, duration, dt_out, std::move(ts), used, run);
+      return ts;
     } catch (const reduced::EnergyBalanceError&) {
       // The table is refined only under the default integrator: with a step or tolerance the user
       // gave, the miss may be theirs (a 1 s fixed step was re-extracted five times, then exit 1).

@@ -62,7 +62,8 @@ void add_simulate_command(CLI::App& app, SimulateArgs& sim) {
   red->add_option("--table", sim.table, "Reduced table from `rdyn extract` (default: extract now)");
   red->add_option("--grid-deg", sim.grid_deg,
                   "Grid step when extracting [deg] (default 10, as the paper, halved down to 0.3125 while the table "
-                  "does not resolve m1: its half-grid miss above 1e-3)")
+                  "does not resolve the mechanism, then while the run changes more than 5e-4 of a column's peak on "
+                  "half the grid; run.json: grid_check)")
       ->each([&sim](const std::string&) { sim.grid_given = true; });
   red->add_option("--method", sim.method, "Extraction method")
       ->check(CLI::IsMember({"kinetostatic", "paper-sweep", "integrated", "direct"}));

@@ -100,7 +100,11 @@ Comparison compare_series(const models::TimeSeries& ref, const models::TimeSerie
     for (size_t s = 0; s < a.size(); ++s) {
       const double d = (*b[s])[i] - (*a[s])[i];
       c.signals[s].peak = std::max(c.signals[s].peak, std::abs((*a[s])[i]));
-      c.signals[s].max_rel = std::max(c.signals[s].max_rel, std::abs(d));
+      // A NaN stays (std::max would drop it): a run with one is never within any error.
+      if (std::isnan(d) || std::isnan(c.signals[s].max_rel))
+        c.signals[s].max_rel = NAN;
+      else
+        c.signals[s].max_rel = std::max(c.signals[s].max_rel, std::abs(d));
       sum2[s] += d * d;
     }
   }

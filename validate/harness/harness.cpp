@@ -18,6 +18,7 @@
 #include "validate/harness/pareto.hpp"
 #include "validate/harness/peers.hpp"
 #include "validate/harness/thresholds.hpp"
+#include "validate/harness/grid_check.hpp"
 #include "validate/harness/timing.hpp"
 
 namespace rdyn::validate {
@@ -417,16 +418,46 @@ void judge_thresholds(const models::Scene& scene, ValidationResult& v) {
 }  // namespace
 
 // A table whose full-turn sweep does not close at any grid keeps 10°: the ladder
-// (require_closed_turn off) records what each grid gives.
+// (require_closed_turn off) records what each grid gives. The grid is then checked as `rdyn
+// simulate` checks it (validate/harness/grid_check.hpp): the scene's run with the default
+// settings against the run on half the grid.
 DefaultTable calc_default_table(const models::Scene& scene) {
   DefaultTable d;
+  const models::Scene xscene = extraction_scene(scene);
   try {
-    d.samples = extract_resolving(extraction_scene(scene), kDefaultThresholdGrid_deg, /*grid_given=*/false,
+    d.samples = extract_resolving(xscene, kDefaultThresholdGrid_deg, /*grid_given=*/false,
                                   reduced::Method::Kinetostatic, d.grid_deg)
                     .samples;
   } catch (const reduced::SweepNotClosed&) {
     return {};
   }
+  struct GridRun {
+    reduced::Samples samples;
+    models::TimeSeries ts;
+  };
+  reduced::ReducedOptions ro;  // simulate's defaults (rk8pd at 1e-8) over the scene's run
+  ro.duration_s = scene.simulation.duration_s;
+  ro.output_interval_s = scene.simulation.output_interval_s;
+  auto run_on = [&](const reduced::Samples& samples) {
+    const auto m = reduced::make_reduced_model(samples, xscene, reduced::Interpolation::Fourier);
+    GridRun r{samples, {}};
+    r.ts = with_joint_outputs(scene, m, reduced::simulate_reduced(m, scene.initial.q, scene.initial.qdot, ro));
+    return r;
+  };
+  GridRun kept;
+  try {
+    kept = run_on(d.samples);
+  } catch (const std::runtime_error& e) {  // not a model, or its run fails: the ladder says why
+    d.check.grid_deg = d.grid_deg;
+    d.check.not_compared = e.what();
+    return d;
+  }
+  kept = check_grid_by_runs(
+      std::move(kept), d.grid_deg,
+      [&](double g) { return run_on(extract_from_full(xscene, g, reduced::Method::Kinetostatic).samples); }, false,
+      d.check);
+  d.grid_deg = d.check.grid_deg;
+  d.samples = std::move(kept.samples);
   return d;
 }
 
@@ -588,6 +619,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
   run_stage(v, "reduced ladder", [&] {
     auto d = calc_default_table(scene);
     v.default_grid_deg = d.grid_deg;
+    v.default_grid_check = d.check;
     if (d.grid_deg != 10.0) v.default_samples = std::move(d.samples);
     run_reduced_ladder(scene, with_grid(plan, v.default_grid_deg), v, progress);
     calc_dense_params(scene, v);

@@ -12,6 +12,7 @@
 #include "reduced/samples.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/calibrate.hpp"
+#include "validate/harness/grid_check.hpp"
 #include "validate/analysis/drive.hpp"
 #include "validate/harness/compare.hpp"
 #include "validate/harness/convergence.hpp"
@@ -90,6 +91,7 @@ struct ValidationResult {
   // resolve the mechanism (validate/analysis/build_reduced's extract_resolving). The ladder always
   // has it; the default thresholds, the figure's reduced run and the drive cycle are on it.
   double default_grid_deg = 10.0;
+  GridCheck default_grid_check;      // its run against the run on half its grid (grid_check.hpp)
   reduced::Samples default_samples;  // that table (empty when it is the 10° one or none closed)
   models::TimeSeries reference, showcase;        // showcase: reduced, default grid, default settings
   int showcase_run = -1;
@@ -132,6 +134,7 @@ ValidationResult run_validation(const models::Scene& scene, const ValidationOpti
 struct DefaultTable {
   double grid_deg = 10.0;
   reduced::Samples samples;
+  GridCheck check;  // its run against the run on half its grid, as simulate checks it
 };
 DefaultTable calc_default_table(const models::Scene& scene);
 

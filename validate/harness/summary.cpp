@@ -316,6 +316,7 @@ nlohmann::json summary_json(const ValidationResult& v) {
   // The grid rdyn's commands take for this scene by default (10°, halved while it does not
   // resolve the mechanism): the showcase's and the default thresholds' grid.
   j["default_grid_deg"] = v.default_grid_deg;
+  j["default_grid_check"] = grid_check_json(v.default_grid_check);
   add_first_screen_json(v, j);
   if (v.budget)
     j["error_budget"] = {

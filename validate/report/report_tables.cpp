@@ -252,7 +252,8 @@ std::string thresholds_table(const json& s) {
       h += "<p>The scene declares no thresholds: it is judged against the defaults (docs/scene-format.md, "
            "\"Validation settings\"): every compared quantity within 0.5 % of its peak on the grid rdyn's commands "
            "take for this scene" +
-           (default_grid_deg(s) ? fmt::format(" ({:g}°: 10°, halved while the table does not resolve the mechanism)",
+           (default_grid_deg(s) ? fmt::format(" ({:g}°: 10°, halved while the table does not resolve the mechanism or its run "
+                                                          "changes on half the grid)",
                                               *default_grid_deg(s))
                                 : std::string()) +
            ".</p>";

@@ -47,6 +47,16 @@ TEST(Compare, SteadyWindowSkipsTheTransient) {
   EXPECT_TRUE(detect_steady_window(short_run, true).whole_run);
 }
 
+// A NaN in a run is no error of 0: it stays NaN, which no threshold passes (t.error <= max).
+TEST(Compare, ANanInARunIsNeverWithinAnyError) {
+  auto ref = relaxing(0.5), run = ref;
+  run.forces[0][4000] = NAN;
+  run.forces[0][4001] += 1.0;  // a later, finite difference does not hide it
+  const auto c = compare_series(ref, run, 3.0);
+  EXPECT_TRUE(std::isnan(c.find("F")->max_rel));
+  EXPECT_EQ(c.find("qdot")->max_rel, 0.0);
+}
+
 TEST(Compare, RelativeErrorsAndGateExclusion) {
   auto ref = relaxing(0.5), run = ref;
   for (auto& v : run.qdot) v += 0.01;
