@@ -16,6 +16,7 @@
 #include "validate/cli/commands.hpp"
 #include "validate/cli/cli_limits.hpp"
 #include "validate/analysis/drive.hpp"
+#include "validate/harness/grid_check.hpp"
 #include "validate/cli/decimal_number.hpp"
 #include "validate/io/output_dir.hpp"
 
@@ -196,12 +197,56 @@ DriveRecord calc_drive_record(const DriveArgs& a, const models::Scene& scene, co
   }
   double grid = a.grid_deg;  // a default grid refined where it does not resolve the mechanism
   auto e = extract_resolving(rscene, a.grid_deg, a.grid_given, reduced::Method::Kinetostatic, grid);
-  const auto model = reduced::make_reduced_model(e.samples, rscene, reduced::parse_interpolation(a.interpolation));
+  // The drive on a table, as a run the grid check compares: the drive is a joint output there
+  // (its column's name), q̇ the motion's own.
+  struct GridRun {
+    DriveRecord r;
+    models::TimeSeries ts;
+    std::string fit;
+    double extraction_ms = 0.0;
+  };
+  const std::string drive_name = scene.find_joint(scene.independent)->type == models::JointType::Revolute
+                                     ? "drive_Nm" : "drive_N";
+  auto run_on = [&](const reduced::Samples& samples, double extraction_ms) {
+    const auto model = reduced::make_reduced_model(samples, rscene, reduced::parse_interpolation(a.interpolation));
+    GridRun g{calc_drive_reduced(oscene, model, motion), {}, model.table.fit, extraction_ms};
+    g.ts.t = g.r.t;
+    g.ts.q = g.r.q;
+    g.ts.qdot = g.r.qdot;
+    g.ts.force_names = g.r.force_names;
+    g.ts.forces = g.r.forces;
+    g.ts.column_names = g.r.column_names;
+    g.ts.columns = g.r.columns;
+    g.ts.column_names.insert(g.ts.column_names.begin(), drive_name);
+    g.ts.columns.insert(g.ts.columns.begin(), g.r.drive);
+    return g;
+  };
   warn_coarse_table(e.samples, run);
-  DriveRecord r = calc_drive_reduced(oscene, model, motion);
-  run.update({{"grid_deg", grid}, {"interpolation", model.table.fit}, {"extraction_ms", e.extraction_ms}});
+  GridRun kept = run_on(e.samples, e.extraction_ms);
+  if (!a.grid_given) {  // a default grid is checked on half of it, as simulate checks it
+    GridCheck check;
+    kept = check_grid_by_runs(
+        std::move(kept), grid,
+        [&](double g) {
+          auto x = extract_from_full(rscene, g, reduced::Method::Kinetostatic);
+          return run_on(x.samples, x.extraction_ms);
+        },
+        true, check);
+    grid = check.grid_deg;
+    run["grid_check"] = grid_check_json(check);
+    if (!check.verified) {
+      const std::string why = check.not_compared.empty()
+                                  ? fmt::format("{} changes {:.2g} % of its peak", check.column, 100 * check.change)
+                                  : check.not_compared;
+      std::fprintf(stderr,
+                   "rdyn: warning: the reduced drive on the %g° table was not confirmed on half its grid (%s); compare "
+                   "it with --model full (run.json: grid_check)\n",
+                   grid, why.c_str());
+    }
+  }
+  run.update({{"grid_deg", grid}, {"interpolation", kept.fit}, {"extraction_ms", kept.extraction_ms}});
   if (grid != a.grid_deg) run["grid_refined_from_deg"] = a.grid_deg;
-  return r;
+  return std::move(kept.r);
 }
 
 // run.json's results: the drive's statistics, the constraint-force peaks and the motor check.

@@ -125,7 +125,7 @@ Comparison compare_series(const models::TimeSeries& ref, const models::TimeSerie
   // up over long runs (pointwise errors then measure the phase, not the model).
   size_t i0 = 0;
   while (i0 < ref.t.size() && ref.t[i0] < t_start - 1e-12) ++i0;
-  if (i0 + 1 < ref.t.size()) {
+  if (i0 + 1 < ref.t.size() && ref.q.size() == ref.t.size() && run.q.size() == run.t.size()) {
     const double T = ref.t.back() - ref.t[i0];
     const double mean_ref = (ref.q.back() - ref.q[i0]) / T, mean_run = (run.q.back() - run.q[i0]) / T;
     // Relative to the mean speed, or to 1 % of the peak speed when the mean is smaller (an

@@ -122,5 +122,32 @@ TEST(DriveCommand, WritesItsOutputsAndKeepsTheContract) {
   fs::remove_all(dir);
 }
 
+// A default grid is checked by the drive on half of it, as simulate checks its run: the bicycle's
+// 10° knee line is interpolated 1.7e-3 off near the straight leg, so its drive is taken on 5°
+// (within 1e-5 of the full model's); a given 10° stays, and is as far off as measured.
+TEST(DriveCommand, ADefaultGridIsCheckedByTheDriveOnHalfIt) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rdyn_drive_grid_{}", ::getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto drive = [&](const std::string& model, const std::string& out, const std::vector<std::string>& more) {
+    std::vector<std::string> args{"drive", "bicycle", "--cadence-hz", "1", "--model", model, "--out", out};
+    args.insert(args.end(), more.begin(), more.end());
+    const auto r = test::run_rdyn(args, dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(test::slurp(dir / out / "run.json"));
+  };
+  const auto full = drive("full", "full", {}), checked = drive("reduced", "checked", {}),
+             given = drive("reduced", "given", {"--grid-deg", "10"});
+  EXPECT_EQ(checked["grid_deg"].get<double>(), 5);
+  EXPECT_TRUE(checked["grid_check"]["verified"].get<bool>());
+  EXPECT_EQ(checked["grid_check"]["coarser_grid_deg"].get<double>(), 10);
+  EXPECT_FALSE(given.contains("grid_check"));
+  const double peak = full["drive_peak"].get<double>(), knee = full["constraint_force_peaks_N"]["knee"].get<double>();
+  EXPECT_NEAR(checked["drive_peak"].get<double>(), peak, 1e-5 * peak);
+  EXPECT_NEAR(checked["constraint_force_peaks_N"]["knee"].get<double>(), knee, 1e-5 * knee);
+  EXPECT_GT(std::abs(given["drive_peak"].get<double>() - peak), 1e-3 * peak);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rdyn::validate
