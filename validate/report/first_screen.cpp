@@ -279,6 +279,28 @@ std::string headline(const json& s) {
   return out + reference_sentence(s);
 }
 
+// What the default grid's check found (summary.json default_grid_check, validate/harness/grid_check.hpp):
+// the scene's run on that grid against the run on half of it.
+std::string grid_check_sentence(const json& s) {
+  const json& c = s.value("default_grid_check", json(nullptr));
+  if (!c.is_object() || !c.value("grid_deg", json(nullptr)).is_number()) return "";
+  const double g = c["grid_deg"].get<double>();
+  const auto change = c.value("change", json(nullptr));
+  const std::string column = c.value("column", std::string());
+  if (c.value("verified", false) && change.is_number() && c.value("finer_grid_deg", json(nullptr)).is_number())
+    return H(fmt::format(" That grid was checked as rdyn simulate checks it: the scene's run on it changes {} by {} of "
+                         "its peak on the {:g}° table.",
+                         column, pct(change.get<double>()), c["finer_grid_deg"].get<double>()));
+  if (const std::string why = c.value("not_compared", std::string()); !why.empty())
+    return H(fmt::format(" That grid's run could not be compared with one on half of it: {}.", why));
+  if (change.is_number())
+    return H(fmt::format(" That grid's run has not converged: {} still changed by {} of its peak between the {:g}° "
+                         "and {:g}° tables (more than {}), so its errors above are the measure.",
+                         column, pct(change.get<double>()), c.value("coarser_grid_deg", 0.0), g,
+                         pct(c.value("max_change", 5e-4))));
+  return "";
+}
+
 std::string showcase_note(const json& s) {
   const json& sc = s.value("showcase_reduced", json(nullptr));
   if (!sc.is_object()) return "";
@@ -286,7 +308,7 @@ std::string showcase_note(const json& s) {
   return "<p>The reduced run drawn is the " + H(fmt::format("{:g}", default_grid_deg(s).value_or(10.0))) +
          "° table at the default settings (" + H(str(sc, "label")) +
          "); its errors are " + H(pct(error_of(sc, "qdot")) + " for the speed" + other_errors(s, sc)) +
-         ". The recommended setting's errors are in the verdict.</p>";
+         ". The recommended setting's errors are in the verdict." + grid_check_sentence(s) + "</p>";
 }
 
 std::string matched_target_note(const json& s) {

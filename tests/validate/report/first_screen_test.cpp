@@ -63,6 +63,30 @@ TEST(FirstScreen, OneSettingOneSpeedupEveryErrorOnIt) {
   EXPECT_EQ(h.find(v.runs[3].label()), std::string::npos) << h;
 }
 
+// Figure 2's note says what the default grid's check found: verified on half the grid, not
+// converged (with the change that is left), or not compared (with why); nothing for a summary
+// without the check.
+TEST(FirstScreen, TheDrawnRunSaysHowItsGridWasChecked) {
+  auto v = distinct_runs();
+  v.default_grid_deg = 30;
+  v.default_grid_check = {30, 15, 60, "F", 2e-4, true, ""};
+  EXPECT_NE(showcase_note(summary_json(v)).find("changes F by 0.02 % of its peak on the 15° table"), std::string::npos)
+      << showcase_note(summary_json(v));
+  v.default_grid_check = {30, 0, 60, "F", 3e-2, false, ""};
+  EXPECT_NE(showcase_note(summary_json(v)).find("has not converged: F still changed by 3 % of its peak between the "
+                                                "60° and 30° tables (more than 0.05 %)"),
+            std::string::npos)
+      << showcase_note(summary_json(v));
+  v.default_grid_check = {30, 0, 0, "", NAN, false, "the <15°> table is not a model"};
+  EXPECT_NE(showcase_note(summary_json(v)).find("could not be compared with one on half of it: the &lt;15°&gt; table"),
+            std::string::npos)
+      << showcase_note(summary_json(v));
+  auto s = summary_json(v);
+  s.erase("default_grid_check");
+  EXPECT_EQ(showcase_note(s).find("checked"), std::string::npos);
+  EXPECT_EQ(showcase_note(s).find("converged"), std::string::npos);
+}
+
 // The status line names what decided it: a failing threshold with its error and grid.
 TEST(FirstScreen, FailingThresholdIsNamedWithItsGrid) {
   auto v = distinct_runs();
