@@ -36,16 +36,6 @@ SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
   return J;
 }
 
-// Smallest over largest singular value of G_free (0 when rank is missing).
-double conditioning_of(FactorSVD& svd, const Matrix& G_free) {
-  Vector sv;
-  svd.getSingularValues(sv);
-  if (sv.size() == 0 || !(sv[0] > 0)) return 0.0;
-  // Rank deficiency shows as missing or tiny singular values (min(nrow, ncol) of them).
-  const int expected = std::min(G_free.nrow(), G_free.ncol());
-  return sv.size() < expected ? 0.0 : sv[sv.size() - 1] / sv[0];
-}
-
 // A scene joint's component of a mobility-space vector (folded joints through their gear).
 double joint_part(const FullModel::Impl& m, const State& s, const Vector& u, int j) {
   if (const auto& f = m.joint_fold[j]) return f->ratio * joint_part(m, s, u, f->driver_joint);
@@ -201,8 +191,9 @@ void polish_projection(const FullModel::Impl& m, State& s) {
 void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
   m.system.realize(s, Stage::Position);
   out.J = calc_split_jacobian(m, s);
+  out.conditioning = out.J.G.nrow() == 0 ? 1.0 : 0.0;
   if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) {
-    out.svd.emplace(out.J.G_free);
+    out.conditioning = calc_conditioning(out.J.G_free);
     out.ls.emplace(out.J.G_free);
   }
   const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
@@ -224,7 +215,7 @@ BranchTangent calc_branch_tangent(const FullModel::Impl& m, State& s, double x) 
   BranchRates rates;
   calc_branch_rates(m, s, rates);
   BranchTangent t;
-  t.singular = rates.svd && conditioning_of(*rates.svd, rates.J.G_free) < kSingularConditioning;
+  t.singular = rates.J.G.nrow() > 0 && rates.J.G_free.ncol() > 0 && rates.conditioning < kSingularConditioning;
   m.matter.multiplyByN(s, false, rates.r, t.dq);
   m.matter.multiplyByN(s, false, rates.b, t.ddq);
   return t;

@@ -296,8 +296,7 @@ double calc_loop_conditioning(const FullModel::Impl& m, const State& s) {
   m.system.realize(s, Stage::Position);
   const auto J = calc_split_jacobian(m, s);
   if (J.G.nrow() == 0) return 1.0;
-  FactorSVD svd(J.G_free);
-  return conditioning_of(svd, J.G_free);
+  return calc_conditioning(J.G_free);
 }
 
 namespace {
@@ -334,10 +333,6 @@ void project_sample(const FullModel::Impl& m, FullWorkspace::Impl& w, double q) 
   m.system.realize(w.state, Stage::Position);
 }
 
-double conditioning_of_rates(BranchRates& r) {
-  return r.J.G.nrow() == 0 ? 1.0 : r.svd ? conditioning_of(*r.svd, r.J.G_free) : 0.0;
-}
-
 // Stage 3: r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its
 // accelerations) from the Jacobian of this configuration (calc_branch_rates); the state is left
 // at u = r. Near a singular configuration, not on it (there the rates are repaired, not
@@ -346,11 +341,11 @@ double conditioning_of_rates(BranchRates& r) {
 BranchRates& calc_sample_rates(const FullModel::Impl& m, State& s, BranchRates& first, BranchRates& polished,
                                double& conditioning) {
   calc_branch_rates(m, s, first);
-  conditioning = conditioning_of_rates(first);
+  conditioning = first.conditioning;
   if (conditioning < kSingularConditioning || conditioning >= kPolishConditioning) return first;
   polish_projection(m, s);
   calc_branch_rates(m, s, polished);
-  conditioning = conditioning_of_rates(polished);
+  conditioning = polished.conditioning;
   return polished;
 }
 
