@@ -11,28 +11,29 @@ namespace rdyn::engine {
 using namespace SimTK;
 
 
-SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
-  SplitJacobian J;
-  calc_constraint_jacobian(m, s, J.G);
+namespace {
+
+// J.G's columns split into the free mobilities' (all but the independent coordinate and the
+// constraint actuators): J.free_cols and J.G_free.
+void split_jacobian(const FullModel::Impl& m, const State& s, SplitJacobian& J) {
   std::vector<bool> keep(s.getNU(), true);
   keep[m.joint_mobod[m.independent].getFirstUIndex(s)] = false;
   for (const auto& sl : m.actuator_slider) keep[sl.getFirstUIndex(s)] = false;
+  J.free_cols.clear();
   for (int c = 0; c < s.getNU(); ++c)
     if (keep[c]) J.free_cols.push_back(c);
   J.G_free.resize(J.G.nrow(), static_cast<int>(J.free_cols.size()));
   for (int r = 0; r < J.G.nrow(); ++r)
     for (size_t c = 0; c < J.free_cols.size(); ++c) J.G_free(r, static_cast<int>(c)) = J.G(r, J.free_cols[c]);
-  return J;
 }
 
-// Smallest over largest singular value of G_free (0 when rank is missing).
-double conditioning_of(FactorSVD& svd, const Matrix& G_free) {
-  Vector sv;
-  svd.getSingularValues(sv);
-  if (sv.size() == 0 || !(sv[0] > 0)) return 0.0;
-  // Rank deficiency shows as missing or tiny singular values (min(nrow, ncol) of them).
-  const int expected = std::min(G_free.nrow(), G_free.ncol());
-  return sv.size() < expected ? 0.0 : sv[sv.size() - 1] / sv[0];
+}  // namespace
+
+SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const State& s) {
+  SplitJacobian J;
+  calc_constraint_jacobian(m, s, J.G);
+  split_jacobian(m, s, J);
+  return J;
 }
 
 // A scene joint's component of a mobility-space vector (folded joints through their gear).
@@ -54,42 +55,56 @@ double joint_part(const FullModel::Impl& m, const State& s, const Vector& u, int
 bool newton_project(const FullModel::Impl& m, State& s) {
   constexpr double kTolerance = 1e-13;  // [m, rad]: tighter than projectQ's 1e-12 (RMS)
   constexpr int kMaxIterations = 8;
-  m.system.realize(s, Stage::Position);
-  auto worst = [&] {
-    const Vector& e = s.getQErr();
-    double w = 0.0;
-    for (int i = 0; i < e.size(); ++i) w = std::max(w, std::abs(e[i]));
-    return w;  // NaN compares false below: not contracting
-  };
-  double err = worst();
-  if (err <= kTolerance) return true;
-  if (s.getNQ() != s.getNU()) return false;
-  const auto J = calc_split_jacobian(m, s);
-  if (J.G.nrow() != s.getNQErr() || J.G_free.ncol() == 0) return false;
-  // The q index of each free mobility (each mobilizer's q's and u's pair up one to one).
-  std::vector<int> q_of_u(s.getNU(), -1);
-  for (int b = 0; b < m.matter.getNumBodies(); ++b) {
-    const MobilizedBody& mb = m.matter.getMobilizedBody(MobilizedBodyIndex(b));
-    if (mb.getNumQ(s) != mb.getNumU(s)) return false;
-    for (int k = 0; k < mb.getNumU(s); ++k) q_of_u[mb.getFirstUIndex(s) + k] = mb.getFirstQIndex(s) + k;
-  }
-  std::vector<int> q_of(J.free_cols.size());
-  for (size_t c = 0; c < J.free_cols.size(); ++c)
-    if ((q_of[c] = q_of_u[J.free_cols[c]]) < 0) return false;
-  LeastSquares chord(J.G_free);  // one decomposition for every iteration
-  // Between the first realization and the last the errors come from the coordinates alone
-  // (calc_constraint_errors, when the plan describes the state's rows): 2 Position realizations
-  // a projection instead of 4–5. A configuration is accepted on Simbody's own errors only, so a
-  // plan that disagreed would cost iterations, never accuracy.
-  const ConstraintJacobianPlan* plan =
-      m.jacobian_plan && m.jacobian_plan->rows == s.getNQErr() && m.jacobian_plan->nu == s.getNU() ? &*m.jacobian_plan
-                                                                                                    : nullptr;
-  Vector dx, rhs = s.getQErr(), e;
   auto largest = [](const Vector& v) {
     double w = 0.0;
     for (int i = 0; i < v.size(); ++i) w = std::max(w, std::abs(v[i]));
-    return w;
+    return w;  // NaN compares false below: not contracting
   };
+  // Where the plan describes the state's rows, the errors and the chord's Jacobian come from the
+  // coordinates alone (calc_constraint_errors_and_jacobian), and Simbody realizes only the
+  // configuration the plan's errors accept: one Position realization a projection instead of
+  // 2 (4–5 before the plan). A configuration is accepted on Simbody's own errors only, so a plan
+  // that disagreed would cost iterations, never accuracy.
+  const ConstraintJacobianPlan* plan = s.getNQ() == s.getNU() ? usable_plan(m, s) : nullptr;
+  Vector e;
+  SplitJacobian J;
+  if (plan) {
+    calc_constraint_errors_and_jacobian(*plan, s.getQ(), e, J.G);
+  } else {
+    m.system.realize(s, Stage::Position);
+    e = s.getQErr();
+  }
+  double err = largest(e);
+  if (err <= kTolerance) {
+    if (!plan) return true;
+    m.system.realize(s, Stage::Position);
+    e = s.getQErr();
+    if ((err = largest(e)) <= kTolerance) return true;
+    plan = nullptr;  // closed by the plan's errors, not by Simbody's: Simbody's from here on
+  }
+  if (s.getNQ() != s.getNU()) return false;
+  if (J.G.nrow() == 0) calc_constraint_jacobian(m, s, J.G);  // realized above
+  split_jacobian(m, s, J);
+  if (J.G.nrow() != s.getNQErr() || J.G_free.ncol() == 0) return false;
+  // The q index of each free mobility (each mobilizer's q's and u's pair up one to one).
+  std::vector<int> q_of(J.free_cols.size(), -1);
+  if (const auto* p = m.jacobian_plan ? &*m.jacobian_plan : nullptr; p && p->nu == s.getNU()) {
+    std::vector<int> q_of_u(s.getNU(), -1);
+    for (const auto& mob : p->mobilities) q_of_u[mob.u] = mob.q;
+    for (size_t c = 0; c < J.free_cols.size(); ++c) q_of[c] = q_of_u[J.free_cols[c]];
+  } else {
+    std::vector<int> q_of_u(s.getNU(), -1);
+    for (int b = 0; b < m.matter.getNumBodies(); ++b) {
+      const MobilizedBody& mb = m.matter.getMobilizedBody(MobilizedBodyIndex(b));
+      if (mb.getNumQ(s) != mb.getNumU(s)) return false;
+      for (int k = 0; k < mb.getNumU(s); ++k) q_of_u[mb.getFirstUIndex(s) + k] = mb.getFirstQIndex(s) + k;
+    }
+    for (size_t c = 0; c < J.free_cols.size(); ++c) q_of[c] = q_of_u[J.free_cols[c]];
+  }
+  for (int q : q_of)
+    if (q < 0) return false;
+  LeastSquares chord(J.G_free);  // one decomposition for every iteration
+  Vector dx, rhs = e;
   for (int it = 0; it < kMaxIterations; ++it) {
     rhs *= -1.0;
     chord.solve(rhs, dx);
@@ -99,7 +114,7 @@ bool newton_project(const FullModel::Impl& m, State& s) {
     double next = plan ? largest(e) : NAN;
     if (!plan || next <= kTolerance) {
       m.system.realize(s, Stage::Position);
-      next = worst();
+      next = largest(s.getQErr());
       if (next <= kTolerance) return true;
       plan = nullptr;  // closed by the plan's errors, not by Simbody's: Simbody's from here on
       e = s.getQErr();
@@ -176,8 +191,9 @@ void polish_projection(const FullModel::Impl& m, State& s) {
 void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
   m.system.realize(s, Stage::Position);
   out.J = calc_split_jacobian(m, s);
+  out.conditioning = out.J.G.nrow() == 0 ? 1.0 : 0.0;
   if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) {
-    out.svd.emplace(out.J.G_free);
+    out.conditioning = calc_conditioning(out.J.G_free);
     out.ls.emplace(out.J.G_free);
   }
   const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
@@ -199,7 +215,7 @@ BranchTangent calc_branch_tangent(const FullModel::Impl& m, State& s, double x) 
   BranchRates rates;
   calc_branch_rates(m, s, rates);
   BranchTangent t;
-  t.singular = rates.svd && conditioning_of(*rates.svd, rates.J.G_free) < kSingularConditioning;
+  t.singular = rates.J.G.nrow() > 0 && rates.J.G_free.ncol() > 0 && rates.conditioning < kSingularConditioning;
   m.matter.multiplyByN(s, false, rates.r, t.dq);
   m.matter.multiplyByN(s, false, rates.b, t.ddq);
   return t;

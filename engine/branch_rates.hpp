@@ -21,9 +21,6 @@ struct SplitJacobian {
 };
 SplitJacobian calc_split_jacobian(const FullModel::Impl& m, const SimTK::State& s);
 
-// Smallest over largest singular value of G_free (0 when rank is missing).
-double conditioning_of(SimTK::FactorSVD& svd, const SimTK::Matrix& G_free);
-
 // A scene joint's component of a mobility-space vector (folded joints through their gear).
 double joint_part(const FullModel::Impl& m, const SimTK::State& s, const SimTK::Vector& u, int j);
 
@@ -53,12 +50,13 @@ void polish_projection(const FullModel::Impl& m, SimTK::State& s);
 // (kinetostatic mode): r (q̇ = 1, ẋ = 0) from G_free r_free = −G e_independent, and b = dr/dq (the
 // accelerations at q̈ = ẍ = 0) from G_free b_free = −bias (Simbody: acceleration constraint errors
 // G u̇ + bias, bias = −Ġu at this velocity); least squares: G may carry redundant rows, the system
-// is consistent. Leaves u = r in the state, realized to Velocity; J and its SVD stay for further
-// solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
+// is consistent. Leaves u = r in the state, realized to Velocity; J and its factorization stay for
+// further solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
 struct BranchRates {
   SplitJacobian J;
-  std::optional<SimTK::FactorSVD> svd;  // of J.G_free, when there are rows and free columns: its conditioning
-  std::optional<LeastSquares> ls;       // the same, for the solves (one decomposition for all)
+  // calc_conditioning of J.G_free: 1 without rows, 0 with rows but no free columns.
+  double conditioning = 1.0;
+  std::optional<LeastSquares> ls;  // of J.G_free, for the solves (one decomposition for all)
   SimTK::Vector r, b;                   // [mobilities]
   // v: prescribed entries set; the free ones solved from G_free v_free = rhs.
   void complete(SimTK::Vector& v, const SimTK::Vector& rhs) {

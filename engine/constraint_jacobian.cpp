@@ -100,42 +100,39 @@ std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullMo
   return plan;
 }
 
-void calc_constraint_jacobian(const FullModel::Impl& m, const State& s, Matrix& G) {
+const ConstraintJacobianPlan* usable_plan(const FullModel::Impl& m, const State& s) {
   const auto& plan = m.jacobian_plan;
   bool usable = plan && plan->rows == s.getNQErr() && s.getNUErr() == plan->rows && s.getNU() == plan->nu &&
                 m.matter.getNumConstraints() == static_cast<int>(m.constraints.size());
   for (size_t c = 0; usable && c < m.constraints.size(); ++c) usable = !m.constraints[c].second.isDisabled(s);
-  if (!usable) {
-    m.matter.calcG(s, G);
-    return;
-  }
-  G.resize(plan->rows, plan->nu);
+  return usable ? &*plan : nullptr;
+}
+
+namespace {
+
+// Rows of G per constraint in Simbody's order, from each mobility's axis and pivot in Ground
+// (a pin's M z axis and origin, a slider's M x axis) and, per PointOnLine, the follower point
+// S and the line body's rotation in Ground (`line_frame(l)` → {p_S, R_GL}). One formula for
+// both routes: the realized State's frames and the frames from q alone.
+template <class LineFrame>
+void fill_jacobian(const ConstraintJacobianPlan& plan, const std::vector<Vec3>& axis, const std::vector<Vec3>& pivot,
+                   const LineFrame& line_frame, Matrix& G) {
+  G.resize(plan.rows, plan.nu);
   G = 0.0;
-  // Per mobility: a pin's axis and pivot, a slider's direction, in Ground (M's z and origin: a
-  // pin turns M about F's z with their origins together; a slider moves M along F's x = M's x).
-  std::vector<Vec3> axis(plan->mobilities.size()), pivot(plan->mobilities.size());
-  for (size_t k = 0; k < plan->mobilities.size(); ++k) {
-    const auto& mob = plan->mobilities[k];
-    const MobilizedBody& mb = m.matter.getMobilizedBody(mob.body);
-    const Transform X_GM = mb.getBodyTransform(s) * mb.getOutboardFrame(s);
-    axis[k] = mob.pin ? Vec3(X_GM.z()) : Vec3(X_GM.x());
-    pivot[k] = X_GM.p();
-  }
   int row = 0;
-  for (size_t c = 0; c < plan->line_of.size(); ++c) {
-    if (plan->line_of[c] < 0) {
-      const auto& g = plan->gears[plan->gear_of[c]];
+  for (size_t c = 0; c < plan.line_of.size(); ++c) {
+    if (plan.line_of[c] < 0) {
+      const auto& g = plan.gears[plan.gear_of[c]];
       G(row, g.u_driver) += -g.ratio;
       G(row, g.u_driven) += 1.0;
       row += 1;
       continue;
     }
-    const auto& l = plan->lines[plan->line_of[c]];
-    const Vec3 p_S = m.matter.getMobilizedBody(l.follower).findStationLocationInGround(s, l.point_F);
-    const Rotation& R_GL = m.matter.getMobilizedBody(l.line).getBodyRotation(s);
+    const auto& l = plan.lines[plan.line_of[c]];
+    const auto [p_S, R_GL] = line_frame(l);
     const Vec3 nx = R_GL * l.x_L, ny = R_GL * l.y_L;
     for (const auto& [k, sign] : l.moves) {
-      const auto& mob = plan->mobilities[k];
+      const auto& mob = plan.mobilities[k];
       const Vec3 v = mob.pin ? Vec3(axis[k] % (p_S - pivot[k])) : axis[k];
       G(row, mob.u) += sign * dot(nx, v);
       G(row + 1, mob.u) += sign * dot(ny, v);
@@ -144,7 +141,9 @@ void calc_constraint_jacobian(const FullModel::Impl& m, const State& s, Matrix& 
   }
 }
 
-void calc_constraint_errors(const ConstraintJacobianPlan& plan, const Vector& q, Vector& perr) {
+// Each mobilized body's X_GB from the coordinates alone: X_GB = X_GP X_PF X_FM(q) X_MB down the
+// tree, X_FM a turn about z (pin) or a shift along x (slider).
+std::vector<Transform> calc_body_frames(const ConstraintJacobianPlan& plan, const Vector& q) {
   std::vector<Transform> X_GB(plan.mobilities.size());
   for (size_t k = 0; k < plan.mobilities.size(); ++k) {
     const auto& mob = plan.mobilities[k];
@@ -156,7 +155,15 @@ void calc_constraint_errors(const ConstraintJacobianPlan& plan, const Vector& q,
     const Transform X_GF = mob.parent < 0 ? mob.X_PF : X_GB[mob.parent] * mob.X_PF;
     X_GB[k] = X_GF * X_FM * ~mob.X_BM;
   }
-  auto frame = [&](int mobility) { return mobility < 0 ? Transform() : X_GB[mobility]; };
+  return X_GB;
+}
+
+Transform frame_of(const std::vector<Transform>& X_GB, int mobility) {
+  return mobility < 0 ? Transform() : X_GB[mobility];
+}
+
+void errors_from_frames(const ConstraintJacobianPlan& plan, const std::vector<Transform>& X_GB, const Vector& q,
+                        Vector& perr) {
   perr.resize(plan.rows);
   int row = 0;
   for (size_t c = 0; c < plan.line_of.size(); ++c) {
@@ -166,11 +173,55 @@ void calc_constraint_errors(const ConstraintJacobianPlan& plan, const Vector& q,
       continue;
     }
     const auto& l = plan.lines[plan.line_of[c]];
-    const Vec3 p_S = frame(l.follower_mobility) * l.point_F;
-    const Vec3 p_PC = ~frame(l.line_mobility) * p_S - l.point_L;  // as PointOnLineImpl's perr
+    const Vec3 p_S = frame_of(X_GB, l.follower_mobility) * l.point_F;
+    const Vec3 p_PC = ~frame_of(X_GB, l.line_mobility) * p_S - l.point_L;  // as PointOnLineImpl's perr
     perr[row++] = dot(p_PC, Vec3(l.x_L));
     perr[row++] = dot(p_PC, Vec3(l.y_L));
   }
+}
+
+}  // namespace
+
+void calc_constraint_jacobian(const FullModel::Impl& m, const State& s, Matrix& G) {
+  const ConstraintJacobianPlan* plan = usable_plan(m, s);
+  if (!plan) {
+    m.matter.calcG(s, G);
+    return;
+  }
+  // Per mobility: a pin's axis and pivot, a slider's direction, in Ground (M's z and origin: a
+  // pin turns M about F's z with their origins together; a slider moves M along F's x = M's x).
+  std::vector<Vec3> axis(plan->mobilities.size()), pivot(plan->mobilities.size());
+  for (size_t k = 0; k < plan->mobilities.size(); ++k) {
+    const auto& mob = plan->mobilities[k];
+    const MobilizedBody& mb = m.matter.getMobilizedBody(mob.body);
+    const Transform X_GM = mb.getBodyTransform(s) * mb.getOutboardFrame(s);
+    axis[k] = mob.pin ? Vec3(X_GM.z()) : Vec3(X_GM.x());
+    pivot[k] = X_GM.p();
+  }
+  fill_jacobian(*plan, axis, pivot, [&](const ConstraintJacobianPlan::LineRows& l) {
+    return std::pair<Vec3, Rotation>(m.matter.getMobilizedBody(l.follower).findStationLocationInGround(s, l.point_F),
+                                     m.matter.getMobilizedBody(l.line).getBodyRotation(s));
+  }, G);
+}
+
+void calc_constraint_errors(const ConstraintJacobianPlan& plan, const Vector& q, Vector& perr) {
+  errors_from_frames(plan, calc_body_frames(plan, q), q, perr);
+}
+
+void calc_constraint_errors_and_jacobian(const ConstraintJacobianPlan& plan, const Vector& q, Vector& perr,
+                                         Matrix& G) {
+  const std::vector<Transform> X_GB = calc_body_frames(plan, q);
+  errors_from_frames(plan, X_GB, q, perr);
+  std::vector<Vec3> axis(plan.mobilities.size()), pivot(plan.mobilities.size());
+  for (size_t k = 0; k < plan.mobilities.size(); ++k) {
+    const Transform X_GM = X_GB[k] * plan.mobilities[k].X_BM;
+    axis[k] = plan.mobilities[k].pin ? Vec3(X_GM.z()) : Vec3(X_GM.x());
+    pivot[k] = X_GM.p();
+  }
+  fill_jacobian(plan, axis, pivot, [&](const ConstraintJacobianPlan::LineRows& l) {
+    return std::pair<Vec3, Rotation>(frame_of(X_GB, l.follower_mobility) * l.point_F,
+                                     frame_of(X_GB, l.line_mobility).R());
+  }, G);
 }
 
 }  // namespace rdyn::engine

@@ -51,6 +51,10 @@ struct ConstraintJacobianPlan {
 // The gear rows come from Impl::coupled_gears (the scene gear behind each CoordinateCoupler).
 std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullModel::Impl& m);
 
+// The plan when it describes the state's rows (its rows and mobilities, every constraint enabled),
+// else nullptr (calcG's case). The state must be realized to Instance.
+const ConstraintJacobianPlan* usable_plan(const FullModel::Impl& m, const SimTK::State& s);
+
 // G at a state realized to Position: G u = d(perr)/dt for the q̇ = N u of pins and sliders
 // (N = I). Per PointOnLine row n·(v_S − v_C) — S the follower point, C the material point of the
 // line body at S, n the row's normal rotated with the line body (Simbody's
@@ -70,5 +74,13 @@ void calc_constraint_jacobian(const FullModel::Impl& m, const SimTK::State& s, S
 // (tests/engine/constraint_jacobian_test.cpp); callers accept a configuration only on Simbody's
 // own errors.
 void calc_constraint_errors(const ConstraintJacobianPlan& plan, const SimTK::Vector& q, SimTK::Vector& perr);
+
+// The errors and G together from the coordinates alone: G as calc_constraint_jacobian forms it,
+// with the frames of calc_constraint_errors instead of a realized State's. The chord Newton
+// projection's Jacobian at its starting configuration, which needed a Position realization for
+// nothing else (~28 k instructions on the bicycle, 1.3 M of a sweep case's 30 M, issue #28).
+// Equal to calcG at the realized configuration to rounding (tests/engine/constraint_jacobian_test.cpp).
+void calc_constraint_errors_and_jacobian(const ConstraintJacobianPlan& plan, const SimTK::Vector& q,
+                                         SimTK::Vector& perr, SimTK::Matrix& G);
 
 }  // namespace rdyn::engine

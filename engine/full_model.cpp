@@ -42,15 +42,9 @@ class LawMotion : public Motion::Custom::Implementation {
     if (static_cast<int>(idx.size()) <= slot_) idx.resize(slot_ + 1);
     idx[slot_] = impl_.matter.allocateDiscreteVariable(s, Stage::Time, new Value<Law>(Law(0)));
   }
-  void calcPrescribedPosition(const State& s, int nq, Real* q) const override {
-    q[0] = eval(s, 0);
-  }
-  void calcPrescribedPositionDot(const State& s, int nq, Real* qd) const override {
-    qd[0] = eval(s, 1);
-  }
-  void calcPrescribedPositionDotDot(const State& s, int nq, Real* qdd) const override {
-    qdd[0] = eval(s, 2);
-  }
+  void calcPrescribedPosition(const State& s, int nq, Real* q) const override { q[0] = eval(s, 0); }
+  void calcPrescribedPositionDot(const State& s, int nq, Real* qd) const override { qd[0] = eval(s, 1); }
+  void calcPrescribedPositionDotDot(const State& s, int nq, Real* qdd) const override { qdd[0] = eval(s, 2); }
 
  private:
   double eval(const State& s, int order) const {
@@ -605,13 +599,15 @@ FullWorkspace::FullWorkspace(const FullModel& model)
     if (!m.joint_fold[j]) m.joint_mobod[j].setOneQ(s, MobilizerQIndex(0), m.scene.joints[j].guess);
   m.joint_mobod[m.independent].setOneQ(s, MobilizerQIndex(0), m.scene.initial.q);
   m.set_law(s, 0, poly_law(m.scene.initial.q, 0.0, 0.0));
-  const State guesses = s;
+  const Vector q_guesses = s.getQ();  // only q changes below (a State copy: ~0.3 M instructions)
   // Directly at the initial q; where that fails, or lands a revolute joint more than
   // kFarFromGuess_deg from its guess (on another branch: a parallelogram chain started 0.1° from
   // flat with its 90° guesses folded into the antiparallelogram), by continuation from the
   // configuration the guesses describe, when that reaches the initial q.
   const bool direct = newton_assemble(m, s) || assemble(m, s, true) <= 1e-8;
   if (!direct || far_from_guesses(m, s)) {
+    State guesses = s;
+    guesses.updQ() = q_guesses;
     State walked = guesses;
     const Walk walk = assemble_by_continuation(m, walked);
     // Through a singular configuration along the guesses' branch, as the extraction and the

@@ -296,8 +296,7 @@ double calc_loop_conditioning(const FullModel::Impl& m, const State& s) {
   m.system.realize(s, Stage::Position);
   const auto J = calc_split_jacobian(m, s);
   if (J.G.nrow() == 0) return 1.0;
-  FactorSVD svd(J.G_free);
-  return conditioning_of(svd, J.G_free);
+  return calc_conditioning(J.G_free);
 }
 
 namespace {
@@ -334,24 +333,20 @@ void project_sample(const FullModel::Impl& m, FullWorkspace::Impl& w, double q) 
   m.system.realize(w.state, Stage::Position);
 }
 
-double conditioning_of_rates(BranchRates& r) {
-  return r.J.G.nrow() == 0 ? 1.0 : r.svd ? conditioning_of(*r.svd, r.J.G_free) : 0.0;
-}
-
 // Stage 3: r (q̇ = 1, ẋ = 0: the velocity projection of call (i)) and b = dr/dq (its
 // accelerations) from the Jacobian of this configuration (calc_branch_rates); the state is left
 // at u = r. Near a singular configuration, not on it (there the rates are repaired, not
 // computed), the projection is polished to rounding and the rates computed again
 // (polish_projection). Returns the rates used; `conditioning` is theirs.
-BranchRates& calc_sample_rates(const FullModel::Impl& m, State& s, BranchRates& first, BranchRates& polished,
-                               double& conditioning) {
+BranchRates& calc_sample_rates(const FullModel::Impl& m, State& s, BranchRates& first,
+                               std::optional<BranchRates>& polished, double& conditioning) {
   calc_branch_rates(m, s, first);
-  conditioning = conditioning_of_rates(first);
+  conditioning = first.conditioning;
   if (conditioning < kSingularConditioning || conditioning >= kPolishConditioning) return first;
   polish_projection(m, s);
-  calc_branch_rates(m, s, polished);
-  conditioning = conditioning_of_rates(polished);
-  return polished;
+  calc_branch_rates(m, s, polished.emplace());
+  conditioning = polished->conditioning;
+  return *polished;
 }
 
 // Stage 4: every joint's coordinate, rate per unit q̇ and the rate's slope. Returns false when
@@ -428,8 +423,13 @@ void update_anchor(const FullModel::Impl& m, FullWorkspace::Impl& w, double q, c
   w.anchor_set = true;
   w.anchor_x = q;
   w.anchor_q = s.getQ();
-  m.matter.multiplyByN(s, false, rates.r, w.anchor_dq);
-  m.matter.multiplyByN(s, false, rates.b, w.anchor_ddq);
+  if (m.jacobian_plan) {  // only pins and sliders: N = I, its product a copy (~3 k instructions each)
+    w.anchor_dq = rates.r;
+    w.anchor_ddq = rates.b;
+  } else {
+    m.matter.multiplyByN(s, false, rates.r, w.anchor_dq);
+    m.matter.multiplyByN(s, false, rates.b, w.anchor_ddq);
+  }
   double dx = q - x_before;  // unwrapped: a relabelled turn between the two gives no chord
   // How far a chord may reach: two extrapolation lengths from the previous grid point; from the
   // start, wherever it was (the first grid point is the one nearest the start, and the first
@@ -483,7 +483,8 @@ KinetostaticSample calc_kinetostatic_sample(const FullModel& model, FullWorkspac
   project_sample(m, w, q);
   KinetostaticSample out;
   out.near_singular = w.near_singular_projections > singular_before;
-  BranchRates first, polished;
+  BranchRates first;
+  std::optional<BranchRates> polished;  // near a singular configuration only
   double conditioning = 1.0;
   BranchRates& rates = calc_sample_rates(m, s, first, polished, conditioning);
   bool finite = fill_joint_rates(m, s, rates.r, rates.b, out);

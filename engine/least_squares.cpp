@@ -1,5 +1,6 @@
 #include "engine/least_squares.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -50,7 +51,68 @@ double pivoted_qr(int m, int n, std::vector<double>& a, std::vector<double>& bet
   return r11 > 0 ? rnn / r11 : 0.0;
 }
 
+// The singular values of the column-major p × k matrix b (p ≥ k) by one-sided Jacobi
+// rotations (Hestenes 1958; Demmel & Veselić, "Jacobi's method is more accurate than QR", SIAM
+// J. Matrix Anal. Appl. 13 (1992): small singular values to high relative accuracy): pairs of
+// columns are rotated until every pair is orthogonal to rounding, and the column norms are then
+// the singular values. Returns the smallest over the largest (0 for a zero matrix).
+double jacobi_conditioning(int p, int k, std::vector<double>& b) {
+  constexpr double kOrthogonal = 1e-15;  // |a_i·a_j| ≤ this × |a_i| |a_j|: orthogonal to rounding
+  constexpr int kMaxSweeps = 60;
+  auto col = [&](int j) { return &b[static_cast<size_t>(j) * p]; };
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    bool rotated = false;
+    for (int i = 0; i + 1 < k; ++i)
+      for (int j = i + 1; j < k; ++j) {
+        double* ai = col(i);
+        double* aj = col(j);
+        double alpha = 0.0, beta = 0.0, gamma = 0.0;
+        for (int r = 0; r < p; ++r) alpha += ai[r] * ai[r], beta += aj[r] * aj[r], gamma += ai[r] * aj[r];
+        if (!(std::abs(gamma) > kOrthogonal * std::sqrt(alpha * beta))) continue;
+        rotated = true;
+        const double zeta = (beta - alpha) / (2 * gamma);
+        const double t = (zeta >= 0 ? 1.0 : -1.0) / (std::abs(zeta) + std::sqrt(1 + zeta * zeta));
+        const double c = 1 / std::sqrt(1 + t * t), sn = c * t;
+        for (int r = 0; r < p; ++r) {
+          const double x = ai[r], y = aj[r];
+          ai[r] = c * x - sn * y;
+          aj[r] = sn * x + c * y;
+        }
+      }
+    if (!rotated) break;
+  }
+  double smallest = INFINITY, largest = 0.0;
+  for (int j = 0; j < k; ++j) {
+    double n2 = 0.0;
+    for (int r = 0; r < p; ++r) n2 += col(j)[r] * col(j)[r];
+    smallest = std::min(smallest, std::sqrt(n2));
+    largest = std::max(largest, std::sqrt(n2));
+  }
+  return largest > 0 ? smallest / largest : 0.0;
+}
+
 }  // namespace
+
+double calc_conditioning(const Matrix& A) {
+  const int m = A.nrow(), n = A.ncol(), k = std::min(m, n), p = std::max(m, n);
+  if (k == 0) return 0.0;
+  if (k > kMaxJacobiColumns) {
+    FactorSVD svd(A);
+    Vector sv;
+    svd.getSingularValues(sv);
+    // Rank deficiency shows as missing or tiny singular values (min(m, n) of them).
+    if (sv.size() < k || !(sv[0] > 0)) return 0.0;
+    return sv[sv.size() - 1] / sv[0];
+  }
+  std::vector<double> b(static_cast<size_t>(p) * k);  // A, or Aᵀ when wide: p × k, p ≥ k
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (!std::isfinite(A(i, j))) return 0.0;
+      b[m >= n ? static_cast<size_t>(j) * p + i : static_cast<size_t>(i) * p + j] = A(i, j);
+    }
+  const double c = jacobi_conditioning(p, k, b);
+  return std::isfinite(c) ? c : 0.0;
+}
 
 LeastSquares::LeastSquares(const Matrix& A) : m_(A.nrow()), n_(A.ncol()) {
   if (m_ >= n_ && n_ > 0) {

@@ -37,4 +37,14 @@ class LeastSquares {
   std::optional<SimTK::FactorSVD> svd_;  // the fallback
 };
 
+// Smallest over largest singular value of A (0 when A is empty, zero, not finite or of
+// missing rank): the loop Jacobian's conditioning, which decides singular configurations
+// (kSingularConditioning) and where projections are polished. For min(m, n) ≤
+// kMaxJacobiColumns by one-sided Jacobi rotations, ~3 k instructions for the bicycle's 4 × 4
+// where SimTK::FactorSVD (LAPACK gesdd with Simbody's set-up) took ~18 k: 0.9 M of a ~30 M
+// sweep case (issue #28). Larger ones (a 40-loop chain's 80 rows) go to FactorSVD. The two
+// agree to rounding (tests/engine/least_squares_test.cpp).
+inline constexpr int kMaxJacobiColumns = 12;
+double calc_conditioning(const SimTK::Matrix& A);
+
 }  // namespace rdyn::engine

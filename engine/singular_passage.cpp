@@ -150,12 +150,11 @@ double set_branch_velocity(const FullModel& model, BranchGuard& g, double q, dou
   m.set_law(s, 0, poly_law(q, 1.0, 0.0));
   m.set_load_mode(s, kLoadsOff);
   calc_branch_rates(m, s, rates);
-  auto conditioning = [&] { return rates.J.G.nrow() == 0 ? 1.0 : rates.svd ? conditioning_of(*rates.svd, rates.J.G_free) : 0.0; };
-  double k = conditioning();
+  double k = rates.conditioning;
   if (k >= kSingularConditioning && k < kPolishConditioning) {
     polish_projection(m, s);
     calc_branch_rates(m, s, rates);
-    k = conditioning();
+    k = rates.conditioning;
   }
   m.set_law(s, 0, poly_law(q, qdot, 0.0));
   s.updU() = rates.r * qdot;

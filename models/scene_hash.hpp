@@ -28,6 +28,12 @@ namespace rdyn::models {
 // columns' order), maps are sorted by key.
 std::string canonical_scene_text(const Scene& scene);
 
+// Appends v as C99's "%a" prints a double with glibc (0x1.8p+1, 0x0p+0, 0x0.8p-1022 for a
+// subnormal, inf, -nan; lowercase, trailing zeros of the fraction dropped): the canonical text's
+// numbers, byte for byte what snprintf wrote before (the table headers' recorded hashes stay
+// valid), without snprintf's cost.
+void append_hex_double(std::string& out, double v);
+
 // 64-bit FNV-1a of canonical_scene_text (offset basis 14695981039346656037, prime
 // 1099511628211 — Fowler, Noll, Vo; IETF draft-eastlake-fnv, section 2).
 std::uint64_t scene_hash(const Scene& scene);

@@ -4,7 +4,7 @@
 // QErr, on the shipped scenes' kinds of systems: pins and PointOnLine loops
 // (four-bar), constraint actuators' slider chains (the bicycle's knee forces), prismatic joints
 // (slider-crank, crane), an unfolded gear's coupler row; and the guard that hands a system it does
-// not describe back to calcG.
+// not describe back to calcG. The errors and G from the coordinates alone against the same.
 #include "engine/constraint_jacobian.hpp"
 
 #include <gtest/gtest.h>
@@ -52,6 +52,13 @@ void expect_as_calc_g(const models::Scene& scene, FullModelOptions o, int expect
     m.matter.calcG(s, reference);
     ASSERT_EQ(reference.nrow(), expected_rows);
     EXPECT_LE(relative_difference(G, reference), 1e-12) << scene.source_file << " at q = " << q;
+    // The route from the coordinates alone (the chord Newton projection's first Jacobian).
+    Matrix G_q;
+    SimTK::Vector e;
+    calc_constraint_errors_and_jacobian(*m.jacobian_plan, s.getQ(), e, G_q);
+    EXPECT_LE(relative_difference(G_q, reference), 1e-12) << scene.source_file << " at q = " << q;
+    ASSERT_EQ(e.size(), expected_rows);
+    for (int i = 0; i < e.size(); ++i) EXPECT_LE(std::abs(e[i]), 1e-11) << scene.source_file << " row " << i;
   }
 }
 
@@ -106,6 +113,15 @@ void expect_errors_as_simbody(const models::Scene& scene, FullModelOptions o) {
     for (int i = 0; i < e.size(); ++i) d = std::max(d, std::abs(e[i] - reference[i])), scale = std::max(scale, std::abs(reference[i]));
     EXPECT_GT(scale, 1e-3) << scene.source_file;  // the loops do gape: not zero against zero
     EXPECT_LE(d, 1e-12 * scale) << scene.source_file << " trial " << trial;
+    // Errors and G together from q: the same errors, and Simbody's calcG at this configuration
+    // (G depends on the configuration, on the manifold or off it).
+    SimTK::Vector e2;
+    Matrix G, reference_G;
+    calc_constraint_errors_and_jacobian(*m.jacobian_plan, q, e2, G);
+    m.matter.calcG(s, reference_G);
+    ASSERT_EQ(e2.size(), e.size());
+    for (int i = 0; i < e.size(); ++i) EXPECT_EQ(e2[i], e[i]) << scene.source_file << " row " << i;
+    EXPECT_LE(relative_difference(G, reference_G), 1e-12) << scene.source_file << " trial " << trial;
   }
 }
 

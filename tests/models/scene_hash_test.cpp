@@ -3,7 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <functional>
+#include <limits>
+#include <random>
 #include <set>
 
 #include "models/scene_yaml.hpp"
@@ -29,6 +35,39 @@ struct Mutation {
   const char* field;
   std::function<void(Scene&)> apply;
 };
+
+// The canonical text's numbers against glibc's own "%a" (what the text was written with before):
+// special values, signs, both ends of the exponent range, subnormals, fractions with and without
+// trailing zero digits, and 200 000 random bit patterns.
+TEST(SceneHash, HexDoubleAsPrintfA) {
+  auto printf_a = [](double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%a", v);
+    return std::string(buf);
+  };
+  auto ours = [](double v) {
+    std::string s = "x";  // appends to what is there
+    append_hex_double(s, v);
+    return s.substr(1);
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> values{0.0, -0.0, 1.0, -1.0, 2.0, 0.5, 3.0, 0.1, -0.3, 1e300, 1e-300, 9.81, 1.5, 0.75,
+                             std::numeric_limits<double>::max(), std::numeric_limits<double>::min(),
+                             std::numeric_limits<double>::denorm_min(), -std::numeric_limits<double>::denorm_min(),
+                             std::numeric_limits<double>::min() / 3, std::numeric_limits<double>::epsilon(),
+                             1 + std::numeric_limits<double>::epsilon(), inf, -inf,
+                             std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN()};
+  for (double v : values) EXPECT_EQ(ours(v), printf_a(v)) << printf_a(v);
+  std::mt19937_64 rng(28);
+  for (int i = 0; i < 200000; ++i) {
+    std::uint64_t bits = rng();
+    if (i % 4 == 1) bits &= ~(std::uint64_t{0x7ff} << 52);  // subnormals
+    if (i % 4 == 2) bits &= ~((std::uint64_t{1} << (rng() % 52)) - 1);  // trailing zero digits
+    double v;
+    std::memcpy(&v, &bits, sizeof v);
+    ASSERT_EQ(ours(v), printf_a(v)) << i;
+  }
+}
 
 TEST(SceneHash, IsDeterministicAndSixteenHexDigits) {
   const Scene a = full_scene(), b = full_scene();

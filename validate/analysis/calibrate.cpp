@@ -18,6 +18,7 @@
 #include "reduced/simulate_reduced.hpp"
 #include "reduced/steady_cycle.hpp"
 #include "validate/analysis/operating_point.hpp"
+#include "validate/analysis/revolution_work.hpp"
 #include "validate/analysis/build_reduced.hpp"
 #include "validate/analysis/confirm_full.hpp"
 
@@ -257,78 +258,6 @@ namespace {
 
 [[noreturn]] void fail_field(const models::Scene& scene, const std::string& field, const std::string& msg) {
   throw models::SceneError(scene.source_file, scene.line_of(field), scene.field_of(field), msg);
-}
-
-// The work per revolution of every non-conservative load at the constant target rate, with the
-// selected loads at unit value (±1: set_load(m, sel, 1) first). Both parts are linear in the
-// load values: a torque does T·∫ r [gate] dq, a point force T·∫ τ (−dL/dq) [gate] dq, a motor
-// s·∫ (1 − r q̇/ω0) r dq, a brake ∫ T_b(w q̇) w dq (springs and gravity do none over a turn).
-struct RevolutionWork {
-  double unit = 0.0;            // the selected loads' work per unit value [J per N·m or N]
-  double other = 0.0;           // every other load's [J]
-  double scale = 0.0;           // Σ|r| dq of the selected loads, for the round-off test of `unit`
-  double other_scale = 0.0;     // Σ|work| of the others, for the round-off test of `other`
-  double max_motor_rate = 0.0;  // a selected motor's largest joint rate over its no-load speed
-  double brakes = 0.0;          // the resistances' alone [J]
-  // Each other load's [J], to name them when they already balance the resistances.
-  std::vector<double> torque, force, motor;
-};
-
-RevolutionWork calc_revolution_work(const reduced::ReducedModel& m, const Selection& sel, double q_start,
-                                    double cadence_hz) {
-  const int n = 3600;
-  const double qd = 2 * M_PI * cadence_hz, dq = 2 * M_PI / n;
-  std::vector<char> selected_torque(m.torques.size(), 0), selected_motor(m.motors.size(), 0),
-      selected_force(m.point_forces.size(), 0);
-  for (const auto& en : sel.entries)
-    (en.motor ? selected_motor : en.point_force ? selected_force : selected_torque)[en.index] = 1;
-  RevolutionWork w;
-  w.torque.assign(m.torques.size(), 0.0), w.force.assign(m.point_forces.size(), 0.0);
-  w.motor.assign(m.motors.size(), 0.0);
-  for (int i = 0; i < n; ++i) {
-    const double q = q_start + (i + 0.5) * dq;
-    for (size_t k = 0; k < m.torques.size(); ++k) {
-      const auto& t = m.torques[k];
-      const bool on = t.gate < 0 || m.gates[t.gate].sign * m.table.eval(m.gates[t.gate].c_r, q) * qd > 0;
-      // Generalized force per unit value: τ(θ(q))·r_j for a profiled load, r_j otherwise.
-      const double tau = t.c_tau >= 0 ? m.table.eval(t.c_tau, q) : 1.0;
-      const double r_j = tau * m.table.eval(t.c_r, q);
-      if (selected_torque[k]) w.scale += std::abs(r_j) * dq;
-      if (on) (selected_torque[k] ? w.unit : w.other) += t.value * r_j * dq;  // value ±1 when selected
-      if (on && !selected_torque[k]) w.other_scale += std::abs(t.value * r_j) * dq, w.torque[k] += t.value * r_j * dq;
-    }
-    // Point forces: T·τ·(−dL/dq) per unit tension, gated like torques (Qpf column as the ratio).
-    for (size_t k = 0; k < m.point_forces.size(); ++k) {
-      const auto& f = m.point_forces[k];
-      const bool on = f.gate < 0 || m.gates[f.gate].sign * m.table.eval(m.gates[f.gate].c_r, q) * qd > 0;
-      const double Q = (f.c_tau >= 0 ? m.table.eval(f.c_tau, q) : 1.0) * m.table.eval(f.c_r, q);
-      if (selected_force[k]) w.scale += std::abs(Q) * dq;
-      if (on) (selected_force[k] ? w.unit : w.other) += f.value * Q * dq;
-      if (on && !selected_force[k]) w.other_scale += std::abs(f.value * Q) * dq, w.force[k] += f.value * Q * dq;
-    }
-    for (size_t k = 0; k < m.motors.size(); ++k) {
-      const auto& mo = m.motors[k];
-      const double r_j = m.table.eval(mo.c_r, q);
-      const double wm = models::motor_torque(mo.stall, mo.no_load_speed, r_j * qd) * r_j * dq;
-      if (selected_motor[k]) {
-        w.unit += wm;
-        w.scale += std::abs(r_j) * dq;
-        w.max_motor_rate = std::max(w.max_motor_rate, r_j * qd / mo.no_load_speed);
-      } else {
-        w.other += wm;
-        w.other_scale += std::abs(wm);
-        w.motor[k] += wm;
-      }
-    }
-    for (const auto& b : m.brakes) {
-      const double wr = m.table.eval(b.c_w, q);
-      const double wb = models::resistance_torque(b.law, b.coefficient, wr * qd) * wr * dq;
-      w.other += wb;
-      w.other_scale += std::abs(wb);
-      w.brakes += wb;
-    }
-  }
-  return w;
 }
 
 // The energy balance's first guess T0 = −W_other/W_unit, after refusing (exit 2, naming the load
