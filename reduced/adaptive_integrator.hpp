@@ -76,6 +76,13 @@ bool is_adaptive_method(const std::string& name);
 void calc_hermite(const AdaptiveIntegrator::Point& a, const AdaptiveIntegrator::Point& b, double s, double& q,
                   double& qdot, double& work);
 
+// A step from q0 to q1 (q monotone) that passes a whole window of gate g — two or more of its
+// switch angles (Gate::roots, every turn's copy on a periodic table) strictly between q0 and q1,
+// so its switching function may have the same sign at both ends: the fraction of the step at which
+// q reaches the middle of the first window in the direction of motion; 1 when it passes fewer
+// than two (or the gate's angles are not known).
+double calc_gate_window_fraction(const ReducedModel& m, int g, double q0, double q1);
+
 // The edge of a range table's validity domain that q has crossed.
 double domain_edge(const ReducedModel& m, double q);
 

@@ -382,9 +382,10 @@ def test_sweep_on_any_pool_is_the_cli_sweep(rdyn_cli, tmp_path):
     assert [r["status"] for r in cli] == ["ok"] * 3
     assert list(cli[0]) == ["case", "bicycle_leg.crank_length_m", "status", "drive_rms_Nm", "drive_peak_Nm",
                             "drive_mean_Nm", "mean_power_w", "peak_power_w", "peak_knee_force_N", "error"]
-    # Each case is `rdyn drive --model reduced` of that scene over one revolution on 1° rows.
+    # Each case is `rdyn drive --model reduced` of that scene over one revolution on 1° rows, on the
+    # sweep's grid (10° here: a sweep refines by the table alone, drive also by the drive on half the grid).
     rdyn_cli("drive", "bicycle", "--set", "bicycle_leg.crank_length_m=0.17", "--cadence-hz", "1", "--model",
-             "reduced", "--dt-out", repr(1 / 360), "--out", str(tmp_path / "drive"))
+             "reduced", "--dt-out", repr(1 / 360), "--grid-deg", "10", "--out", str(tmp_path / "drive"))
     one = read_json(tmp_path / "drive" / "run.json")
     for key, col in (("drive_rms", "drive_rms_Nm"), ("drive_peak", "drive_peak_Nm"), ("mean_power_W", "mean_power_w")):
         assert abs(cli[1][col] - one[key]) <= 1e-9 * abs(one[key]), key

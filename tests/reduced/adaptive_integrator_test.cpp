@@ -153,5 +153,52 @@ TEST(AdaptiveIntegrator, AStalledDriveAtAGateStopsEarlyNamingTheStepsItWouldNeed
   EXPECT_NEAR(ts.t.back(), 10.0, 1e-12);
 }
 
+TEST(AdaptiveIntegrator, AGateWindowIsLocatedFromTheSwitchAnglesAStepPasses) {
+  auto scene = test::analytic_scene();
+  scene.joint_torques.push_back({"tool", "crank", 1.0, models::RateGate{"crank", +1}});
+  test::AnalyticSource src;
+  ExtractOptions eo;
+  eo.step_rad = 10 * M_PI / 180;
+  auto m = make_reduced_model(extract_samples(src, scene, eo), scene, Interpolation::CubicSpline);
+  ASSERT_EQ(m.gates.size(), 1u);
+  set_gate_roots(m.gates[0], {0.1, 0.2});
+  EXPECT_DOUBLE_EQ(calc_gate_window_fraction(m, 0, 0.0, 0.3), 0.5);   // the middle, 0.15
+  EXPECT_DOUBLE_EQ(calc_gate_window_fraction(m, 0, 0.3, 0.0), 0.5);   // backwards: the same window
+  EXPECT_DOUBLE_EQ(calc_gate_window_fraction(m, 0, 0.0, 0.15), 1.0);  // one angle: its sign changes
+  EXPECT_DOUBLE_EQ(calc_gate_window_fraction(m, 0, 0.0, 0.1), 1.0);   // an end on an angle: not inside
+  // Every turn's copy on a periodic table: from 2π + 0.05 to 2π + 0.45, the window at 2π + 0.15.
+  EXPECT_NEAR(calc_gate_window_fraction(m, 0, 2 * M_PI + 0.05, 2 * M_PI + 0.45), 0.25, 1e-12);
+  // Two turns in one step: the first window met, going down from 0.3 it is the one at 0.15.
+  EXPECT_NEAR(calc_gate_window_fraction(m, 0, 0.3, 0.3 - 4 * M_PI), (0.15 - 0.3) / (-4 * M_PI), 1e-12);
+}
+
+// A torque on the crank gated on over 0.03 rad a turn (switch angles 0.1 and 0.13 set on the
+// model: the switching function −sin((q − 0.1)/2)·sin((q − 0.13)/2)·q̇ is positive only between
+// them) does T·0.03 of work at every pass, whatever its timing. The free crank at ~30 rad/s passes
+// the window in ~1 ms, inside one rk8pd step at 1e-8: 2 switches of 36 were seen and the work was
+// 0.03 J of 0.27 J (a five-bar's forces came out 60 % off, exit 0). Located, every pass's to 1e-7.
+TEST(AdaptiveIntegrator, AGateWindowInsideOneStepIsNotSteppedOver) {
+  auto scene = test::analytic_scene();
+  constexpr double kT = 0.5, kA = 0.1, kB = 0.13;
+  scene.joint_torques.push_back({"tool", "crank", kT, models::RateGate{"crank", +1}});
+  test::AnalyticSource src;
+  ExtractOptions eo;
+  eo.step_rad = 10 * M_PI / 180;
+  auto m = make_reduced_model(extract_samples(src, scene, eo), scene, Interpolation::CubicSpline);
+  ASSERT_EQ(m.gates.size(), 1u);
+  set_gate_roots(m.gates[0], {kA, kB});
+  m.gates[0].root_sign = -1.0;
+  ReducedOptions opt;
+  opt.duration_s = 3.0, opt.output_interval_s = 0.01;
+  const auto ts = simulate_reduced(m, 1.0, 30.0, opt);
+  const double q_end = ts.q.back();
+  int passes = 0;
+  for (int k = 0; kB + 2 * M_PI * k < q_end; ++k)
+    if (kA + 2 * M_PI * k > 1.0) ++passes;
+  ASSERT_GE(passes, 3);
+  EXPECT_EQ(ts.stats.events, 2 * passes);  // on and off at every pass
+  EXPECT_NEAR(ts.work.back(), passes * kT * (kB - kA), 1e-7 * passes * kT * (kB - kA));
+}
+
 }  // namespace
 }  // namespace rdyn::reduced
