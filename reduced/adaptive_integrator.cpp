@@ -373,6 +373,15 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   // reduced one ran for minutes (issue #23's shaper).
   constexpr long kWindow = 1000;
   constexpr double kHopeless = 100.0;
+  // A window of steps that left t where it was (cuts at a gate chattering at a standstill, each
+  // below t's ulp) is as hopeless: it was not counted, and a Jansen leg stalled against a backstop
+  // gate ran 8 minutes to its step budget, whose message blamed the tolerance.
+  if (d.steps > 0 && d.steps % kWindow == 0 && d.ws.t == d.window_t0)
+    throw models::NumericalError(fmt::format(
+        "reduced integration stopped at t = {:.6g} s of {:.6g} s ({}, q̇ = {:.3g} {}): its last {} steps did not "
+        "advance the time: the motion is too stiff or too fast (a load switching back and forth at a standstill, a "
+        "stalled drive)",
+        d.ws.t, t_end, describe_q(m.revolute, d.ws.q), d.ws.qdot, m.revolute ? "rad/s" : "m/s", kWindow));
   if (d.steps > 0 && d.steps % kWindow == 0 && d.ws.t != d.window_t0) {
     const double mean_h = (d.ws.t - d.window_t0) / kWindow;
     const double needed = static_cast<double>(attempted) + (t_end - d.ws.t) / std::max(mean_h, 1e-300);

@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -241,6 +243,63 @@ TEST_F(Cli, ADefaultGridIsCheckedAgainstTheRunOnHalfIt) {
   EXPECT_LT(run["grid_check"]["change"].get<double>(), 5e-4);
   std::ifstream g(dir_ / "given" / "run.json");
   EXPECT_FALSE(nlohmann::json::parse(g).contains("grid_check"));
+}
+
+// Every column of a timeseries.csv, by name.
+std::map<std::string, std::vector<double>> read_columns(const fs::path& csv) {
+  std::ifstream f(csv);
+  std::string line;
+  std::getline(f, line);
+  std::vector<std::string> names;
+  for (size_t a = 0, b; a <= line.size(); a = b + 1) {
+    b = std::min(line.find(',', a), line.size());
+    names.push_back(line.substr(a, b - a));
+  }
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(f, line))
+    for (size_t a = 0, b, k = 0; a <= line.size() && k < names.size(); a = b + 1, ++k) {
+      b = std::min(line.find(',', a), line.size());
+      cols[names[k]].push_back(std::stod(line.substr(a, b - a)));
+    }
+  return cols;
+}
+
+// A gate open over ~8° of the crank a turn (5–20 ms; a five-bar geared 3:1, its tool torque on
+// while the link l1 turns the positive way) was stepped over by the reduced integrator: exit 0,
+// q̈ 22 % and the forces up to 60 % off. Every column now agrees with the full model's within
+// 1e-3 of its peak (measured 3.6e-5); a stall against a gate on the crank's own rate stops at once
+// (it ran 8 minutes to its step budget), as the full model does.
+TEST_F(Cli, AGateWindowShorterThanAStepIsNotSteppedOver) {
+  const std::string scenes = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/";
+  for (const char* model : {"full", "reduced"}) {
+    const CliRun r = rdyn("simulate " + scenes + "fivebar3-gate-window.yaml --duration 1.5 --model " + model +
+                          " --out " + (dir_ / model).string());
+    ASSERT_EQ(r.status, 0) << r.output;
+  }
+  auto full = read_columns(dir_ / "full" / "timeseries.csv"), red = read_columns(dir_ / "reduced" / "timeseries.csv");
+  ASSERT_EQ(full.size(), red.size());
+  double largest_reaction = 0;
+  for (const auto& [name, v] : full)
+    if (name.rfind("R_", 0) == 0)
+      for (double x : v) largest_reaction = std::max(largest_reaction, std::abs(x));
+  for (const auto& [name, v] : full) {
+    if (name == "t" || name == "q" || name == "energy" || name == "work") continue;
+    ASSERT_EQ(red[name].size(), v.size()) << name;
+    double peak = name.rfind("R_", 0) == 0 ? 1e-9 * largest_reaction : 0, diff = 0;
+    for (size_t i = 0; i < v.size(); ++i) {
+      peak = std::max(peak, std::abs(v[i]));
+      diff = std::max(diff, std::abs(red[name][i] - v[i]));
+    }
+    EXPECT_LT(diff, 1e-3 * peak) << name;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun r = rdyn("simulate " + scenes + "jansen2-backstop.yaml --model reduced --duration 20 --out " +
+                        (dir_ / "stall").string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("reduced integration stopped at t = 2.15"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("a load switching back and forth at a standstill"), std::string::npos) << r.output;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 60.0);
+  EXPECT_FALSE(fs::exists(dir_ / "stall"));
 }
 
 TEST_F(Cli, ExtractedTableSimulatesWithoutRebuildingTheFullModel) {
