@@ -126,26 +126,6 @@ void set_gate_orientation(const Samples& s, const Table& table, ReducedModel::Ga
 
 }  // namespace
 
-void check_force_poles(const ReducedModel& m, double q, double t) {
-  for (size_t k = 0; k < m.force_poles.size(); ++k)
-    for (double p : m.force_poles[k]) {
-      const double d = m.table.periodic ? std::remainder(q - p, 2 * M_PI) : q - p;
-      if (!(std::abs(d) < m.pole_band)) continue;
-      const bool deg = m.revolute;
-      throw models::NumericalError(fmt::format(
-          "the reduced model cannot give constraint force '{}' at t = {:.6g} s, q = {}: its parameters have a pole "
-          "at the singular configuration q = {} (the constraint actuator's rates diverge there) and no "
-          "interpolation of the table represents it within {} of it; use --model full, or leave '{}' out of the "
-          "scene's outputs",
-          m.force_names[k], t, deg ? fmt::format("{:.6g}°", q * 180 / M_PI) : fmt::format("{:.6g} m", q),
-          deg ? fmt::format("{:.6g}°", p * 180 / M_PI) : fmt::format("{:.6g} m", p),
-          std::isinf(m.pole_band) ? std::string("a whole turn (fourier)")
-                                  : deg ? fmt::format("{:.6g}°", m.pole_band * 180 / M_PI)
-                                        : fmt::format("{:.6g} m", m.pole_band),
-          m.force_names[k]));
-    }
-}
-
 std::vector<std::string> reduced_model_columns(const models::Scene& scene) {
   std::vector<std::string> names;  // each name once, in the order first required
   auto col = [&](const std::string& name) {

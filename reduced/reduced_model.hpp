@@ -169,7 +169,8 @@ double calc_sample(const ReducedModel& m, ReducedWorkspace& ws, double q, double
 // Throws NumericalError when q lies within m.pole_band of a pole of a constraint force (no
 // interpolation of me1, me2 and Q_x represents a pole: an isosceles slider-crank's rod force
 // came out 0.23 N where the full model gives 28.4 N, and 1.7 % off four grid steps away). Called
-// for every output row of simulate and drive; `t` names the row.
+// for every output row of simulate and drive; `t` names the row. A reaction's internal line is
+// named as its joint's reaction (reduced/force_poles.cpp).
 void check_force_poles(const ReducedModel& m, double q, double t);
 
 // Prescribed motion, the inverse form of Eksergian's equation: the generalized force a drive on
