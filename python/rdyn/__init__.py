@@ -191,6 +191,8 @@ def simulate(scene, model="reduced", duration=None, table=None, **options):
     for key, value in options.items():
         if key in ("model", "duration", "table") or not hasattr(args, key):
             raise TypeError(f"simulate() got an unknown option {key!r}")
+        if key in ("dt_out", "tolerance", "grid_deg", "reduced_tolerance", "fixed_step"):
+            value = _real(value, key)  # a bool is no number (grid_deg=True ran on a 1° grid)
         setattr(args, key, value)
     args.grid_given = "grid_deg" in options  # else refined where 10° does not resolve the mechanism
     table = _as_table(table, scene, "simulate")

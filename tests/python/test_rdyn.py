@@ -117,6 +117,8 @@ def test_argument_errors_name_the_option():
         rdyn.calibrate(rdyn.load_scene("bicycle"), cadence_hz=True)
     with pytest.raises(rdyn.ArgumentError, match="duration"):
         rdyn.simulate(scene, duration=False)
+    with pytest.raises(rdyn.ArgumentError, match="grid_deg"):  # it ran on a 1° grid
+        rdyn.simulate(scene, duration=1, grid_deg=True)
 
 
 def test_table_error():
