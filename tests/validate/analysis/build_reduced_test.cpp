@@ -123,6 +123,28 @@ TEST(BuildReduced, AGeneralizedForceTheGridDoesNotResolveIsRefinedToo) {
   EXPECT_LE(calc_resolution_miss(e.samples).second, kAutoRefineMiss);
 }
 
+// A Q_cons that is rounding (no gravity, no spring) is not resolved: the grid is m1's to judge. A
+// Q_cons of 1e-8 of m1's peak that turns 20 times a turn still is.
+TEST(BuildReduced, AGeneralizedForceOfRoundingIsNotChased) {
+  reduced::Samples s;
+  s.periodic = true;
+  s.names = {"m1", "Q_cons"};
+  s.columns.resize(2);
+  for (int i = 0; i < 36; ++i) {
+    const double q = i * 10 * M_PI / 180;
+    s.q.push_back(q);
+    s.columns[0].push_back(2.0 + 0.1 * std::cos(q));
+    s.columns[1].push_back(1e-17 * ((i * 7919) % 13 - 6));  // noise
+  }
+  auto [column, miss] = calc_resolution_miss(s);
+  EXPECT_EQ(column, "m1");
+  EXPECT_LT(miss, 1e-6);
+  for (int i = 0; i < 36; ++i) s.columns[1][i] = 2e-8 * std::sin(20 * s.q[i]);
+  std::tie(column, miss) = calc_resolution_miss(s);
+  EXPECT_EQ(column, "Q_cons");
+  EXPECT_GT(miss, 0.1);
+}
+
 // A flywheel geared 24:1 and out of balance, without gravity: m1 and Q_cons are resolved at 10°,
 // its bearing's reaction line is not (the half table misses it by 2.0 of its peak); the default
 // grid goes to 2.5°, where every line is resolved, and the reduced reaction agrees with the full
