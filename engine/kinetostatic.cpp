@@ -84,10 +84,11 @@ std::vector<double> point_force_rates(const FullModel::Impl& m, const State& s) 
   for (const auto& f : m.scene.point_forces) {
     const auto line = calc_point_force_line(m, s, f, true);
     if (!(line.length >= models::limits::kMinPointForceLength_m) || !std::isfinite(line.rate))
-      throw models::NumericalError(fmt::format("{}: point force '{}' has its points {:.3g} m apart at {} = {:.6g}: its "
-                                               "line of action has no direction there",
-                                               m.scene.source_file, f.name, line.length, m.scene.independent,
-                                               m.joint_q(s, m.independent)));
+      throw models::PointForceMeeting(
+          fmt::format("{}: point force '{}' has its points {:.3g} m apart at {} = {:.6g}: its line of action has no "
+                      "direction there",
+                      m.scene.source_file, f.name, line.length, m.scene.independent, m.joint_q(s, m.independent)),
+          m.joint_q(s, m.independent), f.name);
     out.push_back(line.rate);
   }
   return out;

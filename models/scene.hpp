@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "models/load_profile.hpp"
@@ -44,6 +45,17 @@ class SceneError : public std::runtime_error {
 class NumericalError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// A point force's points meet (its line of action has no direction there; the full model stops
+// there): `q` the independent coordinate where, `load` the point force. A range table may end
+// short of it instead (validate/analysis/build_reduced.cpp): the motion may never get there.
+class PointForceMeeting : public NumericalError {
+ public:
+  PointForceMeeting(const std::string& what, double q_at, std::string load_name)
+      : NumericalError(what), q(q_at), load(std::move(load_name)) {}
+  double q;
+  std::string load;
 };
 
 inline constexpr const char* kGround = "ground";

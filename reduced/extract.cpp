@@ -336,11 +336,12 @@ void check_point_force_meeting(KinetostaticSource& src, const models::Scene& sce
     if (c.Lq[f][i0] < 0 && c.Lq[f][i1] > 0)
       if (const auto qm = find_point_force_meeting(src, static_cast<long>(f), s.q[i0], c.Lq[f][i0], s.q[i1] + offset,
                                                    c.Lq[f][i1]))
-        throw models::NumericalError(fmt::format(
-            "point force '{}': its points meet near q = {:.6g} between grid points (the line's length reaches "
-            "zero and its direction reverses), where the line of action has no direction; the full model stops "
-            "there too; move the attachment points apart",
-            scene.point_forces[f].name, *qm >= s.q[0] + 2 * kPi ? *qm - 2 * kPi : *qm));
+        throw PointForceMeeting(
+            fmt::format("point force '{}': its points meet near q = {:.6g} between grid points (the line's length "
+                        "reaches zero and its direction reverses), where the line of action has no direction; the "
+                        "full model stops there too; move the attachment points apart",
+                        scene.point_forces[f].name, *qm >= s.q[0] + 2 * kPi ? *qm - 2 * kPi : *qm),
+            *qm >= s.q[0] + 2 * kPi ? *qm - 2 * kPi : *qm, scene.point_forces[f].name);
 }
 
 // Stores one grid sample's values in the columns.

@@ -91,4 +91,10 @@ class SweepNotClosed : public TableError {
   using TableError::TableError;
 };
 
+// A point force's points meeting (models::PointForceMeeting) between two grid points or on one:
+// a range table may end short of it (validate/analysis/build_reduced.cpp).
+using models::PointForceMeeting;
+// The edge kind of a range table that ends short of such a meeting.
+inline constexpr const char* kPointForceMeetingEdge = "point force meeting";
+
 }  // namespace rdyn::reduced

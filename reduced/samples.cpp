@@ -226,8 +226,8 @@ void read_metadata(TableReader& r, Samples& s) {
         std::string w = e == &s.min_edge ? v.substr(0, comma) : v.substr(comma + 1);
         for (char& c : w)
           if (c == '_') c = ' ';
-        if (w != "dead point" && w != "declared limit" && w != "unknown")
-          r.fail(1, "field 'edges': each edge is dead_point, declared_limit or unknown");
+        if (w != "dead point" && w != "declared limit" && w != "point force meeting" && w != "unknown")
+          r.fail(1, "field 'edges': each edge is dead_point, declared_limit, point_force_meeting or unknown");
         *e = w == "unknown" ? "" : w;
       }
     } else if (k == "grid_deg") {

@@ -92,13 +92,31 @@ Extraction extract_from_full(const engine::FullModel& model, double grid_deg, re
   if (!domain->unbounded_reason.empty()) throw engine::EngineError(domain->unbounded_reason);
   opt.range = reduced::ExtractRange{domain->min, domain->max, domain->min_edge, domain->max_edge};
   for (const auto& sp : domain->singular) opt.singular_hints.push_back(sp.q);  // the walk's scan
-  e.range = opt.range;
   e.dead_min = domain->dead_min;
   e.dead_max = domain->dead_max;
   const auto t = clock::now();
   engine::FullKinetostaticSource source(model, /*wrap_turns=*/false);
   e.stages.assembly_ms = ms(t, clock::now());  // a failed full-turn attempt counts as kinetostatics
-  e.samples = reduced::extract_samples(source, scene, opt);
+  try {
+    e.samples = reduced::extract_samples(source, scene, opt);
+  } catch (const reduced::PointForceMeeting& meet) {
+    // A range whose point force's points meet inside it ends there, on the side of the start: a
+    // cylinder-driven lift whose cable's points meet at a stroke the motion never reaches was
+    // refused while the full model ran (it stops only when a run gets there, as the table's edge
+    // now stops the reduced one). A margin of 1e-3 of the range keeps the points apart by more than the
+    // 1e-6 m a line needs for a direction (models::limits::kMinPointForceLength_m).
+    const double q0 = scene.initial.q, margin = 1e-3 * (opt.range->max - opt.range->min);
+    if (meet.q - margin > q0 && meet.q - margin > opt.range->min + margin)
+      opt.range->max = meet.q - margin, opt.range->max_edge = reduced::kPointForceMeetingEdge;
+    else if (meet.q + margin < q0 && meet.q + margin < opt.range->max - margin)
+      opt.range->min = meet.q + margin, opt.range->min_edge = reduced::kPointForceMeetingEdge;
+    else
+      throw;
+    std::fprintf(stderr, "rdyn: point force '%s': its points meet at q = %.6g inside the range: the table ends there\n",
+                 meet.load.c_str(), meet.q);
+    e.samples = reduced::extract_samples(source, scene, opt);
+  }
+  e.range = opt.range;
   return finish(source);
 }
 
