@@ -190,23 +190,28 @@ void polish_projection(const FullModel::Impl& m, State& s) {
 
 void calc_branch_rates(const FullModel::Impl& m, State& s, BranchRates& out) {
   m.system.realize(s, Stage::Position);
-  out.J = calc_split_jacobian(m, s);
+  // In place: out's matrices and vectors keep their storage from the previous sample.
+  calc_constraint_jacobian(m, s, out.J.G);
+  split_jacobian(m, s, out.J);
   out.conditioning = out.J.G.nrow() == 0 ? 1.0 : 0.0;
+  out.ls.reset();
   if (out.J.G.nrow() > 0 && out.J.G_free.ncol() > 0) {
     out.conditioning = calc_conditioning(out.J.G_free);
     out.ls.emplace(out.J.G_free);
   }
   const int nu = s.getNU(), ind = m.joint_mobod[m.independent].getFirstUIndex(s);
-  out.r = Vector(nu, 0.0);
+  out.r.resize(nu);
+  out.r = 0.0;
   out.r[ind] = 1.0;
   out.complete(out.r, out.column(ind));
   s.updU() = out.r;
   m.system.realize(s, Stage::Velocity);
-  out.b = Vector(nu, 0.0);
+  out.b.resize(nu);
+  out.b = 0.0;
   if (out.J.G.nrow() > 0) {
-    Vector bias;
-    m.matter.calcBiasForAccelerationConstraints(s, bias);
-    out.complete(out.b, -bias);
+    m.matter.calcBiasForAccelerationConstraints(s, out.bias_);
+    for (int i = 0; i < out.bias_.size(); ++i) out.bias_[i] = -out.bias_[i];  // −bias, in place
+    out.complete(out.b, out.bias_);
   }
 }
 

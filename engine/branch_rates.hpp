@@ -52,6 +52,7 @@ void polish_projection(const FullModel::Impl& m, SimTK::State& s);
 // G u̇ + bias, bias = −Ġu at this velocity); least squares: G may carry redundant rows, the system
 // is consistent. Leaves u = r in the state, realized to Velocity; J and its factorization stay for
 // further solves (calc_kinetostatic_sample's r_x,k). The one route to r and b (the sample, follow_branch).
+// `out` may hold an earlier configuration's rates: every field is overwritten (its storage reused).
 struct BranchRates {
   SplitJacobian J;
   // calc_conditioning of J.G_free: 1 without rows, 0 with rows but no free columns.
@@ -61,16 +62,20 @@ struct BranchRates {
   // v: prescribed entries set; the free ones solved from G_free v_free = rhs.
   void complete(SimTK::Vector& v, const SimTK::Vector& rhs) {
     if (!ls) return;
-    SimTK::Vector x;
-    ls->solve(rhs, x);
-    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x[static_cast<int>(c)];
+    ls->solve(rhs, x_);
+    for (size_t c = 0; c < J.free_cols.size(); ++c) v[J.free_cols[c]] = x_[static_cast<int>(c)];
   }
-  // −(column col of G): the right-hand side for a unit rate of prescribed mobility col.
-  SimTK::Vector column(int col) const {
-    SimTK::Vector rhs(J.G.nrow());
-    for (int r = 0; r < J.G.nrow(); ++r) rhs[r] = -J.G(r, col);
-    return rhs;
+  // −(column col of G): the right-hand side for a unit rate of prescribed mobility col, in a
+  // scratch vector that the next call overwrites.
+  const SimTK::Vector& column(int col) {
+    rhs_.resize(J.G.nrow());
+    for (int r = 0; r < J.G.nrow(); ++r) rhs_[r] = -J.G(r, col);
+    return rhs_;
   }
+  // Scratch of complete(), column() and calc_branch_rates (the bias): a BranchRates reused from
+  // sample to sample (the workspace's) allocates none of its vectors again — a SimTK::Vector
+  // costs ~1 k instructions to build and free, and a sample built ~15 (issue #28).
+  SimTK::Vector x_, rhs_, bias_;
 };
 void calc_branch_rates(const FullModel::Impl& m, SimTK::State& s, BranchRates& out);
 

@@ -41,7 +41,7 @@ std::vector<std::pair<int, double>> moves_of(const ConstraintJacobianPlan& plan,
 }  // namespace
 
 std::optional<ConstraintJacobianPlan> make_constraint_jacobian_plan(const FullModel::Impl& m) {
-  const State& s = m.default_state;
+  const State& s = m.default_state();
   ConstraintJacobianPlan plan;
   plan.nu = s.getNU();
   for (int b = 1; b < m.matter.getNumBodies(); ++b) {

@@ -290,8 +290,7 @@ FullModel::Impl::Impl(const models::Scene& s, FullModelOptions o)
     actuator_motion.push_back(Motion::Custom(actuator_slider[k], new LawMotion(*this, 1 + static_cast<int>(k))));
   add_scene_loads(*this);
   try {
-    default_state = system.realizeTopology();
-    system.realizeModel(default_state);
+    system.realizeTopology();  // its default State is realized through Model (Simbody's System.h)
     jacobian_plan = make_constraint_jacobian_plan(*this);
   } catch (const std::exception& e) {
     throw EngineError(std::string("Simbody could not build the system: ") + describe_simbody_exception(e));
@@ -654,6 +653,8 @@ FullWorkspace::FullWorkspace(const FullModel& model)
   check_point_forces(m, s);
 }
 
+FullWorkspace::Impl::Impl(const FullModel::Impl& m) : model(m), state(m.default_state()) {}
+FullWorkspace::Impl::~Impl() = default;
 FullWorkspace::~FullWorkspace() = default;
 FullWorkspace::FullWorkspace(FullWorkspace&&) noexcept = default;
 

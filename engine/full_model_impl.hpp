@@ -73,7 +73,10 @@ struct FullModel::Impl {
   // Owned here, filled by the callbacks through the pointer (the model stays const to runs).
   std::unique_ptr<StateIndices> indices = std::make_unique<StateIndices>();
 
-  SimTK::State default_state;
+  // The system's own default State (realizeTopology's, already realized through Model): read in
+  // place; a copy held here cost ~0.28 M instructions per built model (a sweep case builds one,
+  // issue #28), and every workspace copies it anyway.
+  const SimTK::State& default_state() const { return system.getDefaultState(); }
 
   Impl(const models::Scene& s, FullModelOptions o);
 
@@ -102,6 +105,8 @@ struct FullModel::Impl {
   std::pair<double, std::string> worst_gear_error(const SimTK::State& s) const;
 };
 
+struct BranchRates;  // engine/branch_rates.hpp
+
 struct FullWorkspace::Impl {
   const FullModel::Impl& model;
   SimTK::State state;
@@ -118,7 +123,11 @@ struct FullWorkspace::Impl {
   // Projections of this workspace that needed the 1e-9 fallback (a singular configuration): the
   // extraction flags a sample singular when its call raised this.
   long near_singular_projections = 0;
-  explicit Impl(const FullModel::Impl& m) : model(m), state(m.default_state) {}
+  // calc_kinetostatic_sample's branch rates (engine/branch_rates.hpp), kept from sample to sample
+  // so that their matrices and vectors are allocated once per workspace, not per sample.
+  std::unique_ptr<BranchRates> sample_rates;
+  explicit Impl(const FullModel::Impl& m);  // engine/full_model.cpp, where BranchRates is complete
+  ~Impl();
 };
 
 // Joint coordinates of the mechanism (constraint actuators' sliders excluded), loop and gear

@@ -1,12 +1,15 @@
 // Rates along the assembly branch (engine/branch_rates.cpp), through the public calls that use
 // them: the kinetostatic sample's velocity ratios r and slopes b = dr/dq against central
 // differences of the projected positions (a second route: positions only, no Jacobian solve),
-// and the polished rates near a parallelogram's aligned position against its closed form.
+// and the polished rates near a parallelogram's aligned position against its closed form; and
+// calc_branch_rates into a BranchRates reused from configuration to configuration (as the
+// workspace's) against a fresh one.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "engine/branch_guard.hpp"
+#include "engine/branch_rates.hpp"
 #include "engine/kinetostatic.hpp"
 #include "models/scene_yaml.hpp"
 #include "test_scenes.hpp"
@@ -59,6 +62,40 @@ TEST(BranchRates, PolishedNearTheAlignedPositionTheyAreTheParallelogramsOwn) {
       EXPECT_NEAR(s.ratio_q[2], 1.0, 1e-8) << q;
       for (double b : s.ratio_slope) EXPECT_NEAR(b, 0.0, 1e-6) << q;
       EXPECT_NEAR(s.m1, test::parallelogram_m1(), 1e-9 * test::parallelogram_m1()) << q;
+    }
+  }
+}
+
+TEST(BranchRates, AReusedOneGivesAFreshOnesRatesBitForBit) {
+  // calc_branch_rates overwrites every field of its output in place (issue #28: the sample's
+  // rates keep their storage in the workspace): at configurations along the turn of mechanisms
+  // with loops only, a gear (the bicycle's flywheel), a slider and the crane, the reused
+  // BranchRates holds what a fresh one gets, bit for bit, and keeps no stale factorization.
+  for (const char* name : {"fourbar", "bicycle", "slider-crank", "crane-luffing", "bicycle-profile"}) {
+    const auto scene = models::load_scene(name);
+    const FullModel model(scene);
+    FullWorkspace ws(model);
+    BranchRates reused;
+    for (int k = 0; k < 9; ++k) {
+      // A turn for a crank; the crane's cylinder over its declared stroke [1.0, 1.9] m.
+      const bool revolute = scene.joints[model.impl().independent].type == models::JointType::Revolute;
+      const double q = revolute ? scene.initial.q + k * 2 * kPi / 9 : 1.05 + 0.1 * k;
+      calc_kinetostatic_sample(model, ws, q, 0.7, SampleParts::All);  // a projected configuration
+      SimTK::State& s = ws.impl().state;
+      BranchRates fresh;
+      calc_branch_rates(model.impl(), s, fresh);
+      calc_branch_rates(model.impl(), s, reused);
+      ASSERT_EQ(fresh.r.size(), reused.r.size()) << name;
+      for (int i = 0; i < fresh.r.size(); ++i) {
+        EXPECT_EQ(fresh.r[i], reused.r[i]) << name << " " << k << " " << i;
+        EXPECT_EQ(fresh.b[i], reused.b[i]) << name << " " << k << " " << i;
+      }
+      EXPECT_EQ(fresh.conditioning, reused.conditioning) << name;
+      EXPECT_EQ(fresh.J.free_cols, reused.J.free_cols) << name;
+      EXPECT_EQ(fresh.ls.has_value(), reused.ls.has_value()) << name;
+      ASSERT_EQ(fresh.J.G.nrow(), reused.J.G.nrow()) << name;
+      for (int r = 0; r < fresh.J.G.nrow(); ++r)
+        for (int c = 0; c < fresh.J.G.ncol(); ++c) EXPECT_EQ(fresh.J.G(r, c), reused.J.G(r, c)) << name;
     }
   }
 }
