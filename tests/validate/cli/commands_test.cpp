@@ -36,6 +36,35 @@ CliRun rdyn(const std::string& args) {
   return r;
 }
 
+// Every column of a timeseries.csv, by name.
+std::map<std::string, std::vector<double>> read_columns(const fs::path& csv) {
+  std::ifstream f(csv);
+  std::string line;
+  std::getline(f, line);
+  std::vector<std::string> names;
+  for (size_t a = 0, b; a <= line.size(); a = b + 1) {
+    b = std::min(line.find(',', a), line.size());
+    names.push_back(line.substr(a, b - a));
+  }
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(f, line))
+    for (size_t a = 0, b, k = 0; a <= line.size() && k < names.size(); a = b + 1, ++k) {
+      b = std::min(line.find(',', a), line.size());
+      cols[names[k]].push_back(std::stod(line.substr(a, b - a)));
+    }
+  return cols;
+}
+
+// max |run − ref| / max |ref| (the two series of one length).
+double max_rel_difference(const std::vector<double>& ref, const std::vector<double>& run) {
+  double peak = 0, d = 0;
+  for (size_t i = 0; i < ref.size() && i < run.size(); ++i) {
+    peak = std::max(peak, std::abs(ref[i]));
+    d = std::max(d, std::abs(run[i] - ref[i]));
+  }
+  return d / peak;
+}
+
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -49,6 +78,15 @@ class Cli : public ::testing::Test {
     const auto p = dir_ / name;
     std::ofstream(p, std::ios::binary) << text;
     return p.string();
+  }
+  // `rdyn simulate ARGS --out <dir>/NAME` (status 0 expected): one column of its timeseries.csv;
+  // `said` gets what it printed.
+  std::vector<double> simulated(const std::string& args, const std::string& name, const std::string& column,
+                                std::string* said = nullptr) {
+    const CliRun r = rdyn("simulate " + args + " --out " + (dir_ / name).string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    if (said) *said = r.output;
+    return read_columns(dir_ / name / "timeseries.csv")[column];
   }
   // Bad input: status 2, a message naming `file`, and no output folder left behind.
   void expect_refused(const std::string& args, const std::string& file) {
@@ -104,20 +142,7 @@ TEST_F(Cli, ACoarsePeriodicTableIsFlaggedAndAFineOneIsNot) {
 TEST_F(Cli, AnUnresolvedDefaultGridIsRefined) {
   const std::string jansen = std::string(RDYN_SOURCE_DIR) + "/tests/validate/scenes/jansen-leg.yaml";
   auto qddot = [&](const std::string& args, const std::string& name, std::string* output = nullptr) {
-    const auto out = dir_ / name;
-    const CliRun r = rdyn("simulate " + args + " --model reduced --duration 0.5 --dt-out 0.01 --out " + out.string());
-    EXPECT_EQ(r.status, 0) << r.output;
-    if (output) *output = r.output;
-    std::ifstream f(out / "timeseries.csv");
-    std::string line;
-    std::getline(f, line);
-    std::vector<double> v;
-    while (std::getline(f, line)) {  // t,q,qdot,qddot,...
-      size_t a = 0;
-      for (int k = 0; k < 3; ++k) a = line.find(',', a) + 1;
-      v.push_back(std::stod(line.substr(a, line.find(',', a) - a)));
-    }
-    return v;
+    return simulated(args + " --model reduced --duration 0.5 --dt-out 0.01", name, "qddot", output);
   };
   std::string said;
   const auto auto_grid = qddot(jansen, "auto", &said);
@@ -127,14 +152,8 @@ TEST_F(Cli, AnUnresolvedDefaultGridIsRefined) {
   const auto coarse = qddot(jansen + " --grid-deg 10", "coarse");
   ASSERT_EQ(auto_grid.size(), fine.size());
   ASSERT_EQ(coarse.size(), fine.size());
-  double peak = 0, d_auto = 0, d_coarse = 0;
-  for (size_t i = 0; i < fine.size(); ++i) {
-    peak = std::max(peak, std::abs(fine[i]));
-    d_auto = std::max(d_auto, std::abs(auto_grid[i] - fine[i]));
-    d_coarse = std::max(d_coarse, std::abs(coarse[i] - fine[i]));
-  }
-  EXPECT_LT(d_auto, 1e-3 * peak);
-  EXPECT_GT(d_coarse, 1e-2 * peak);
+  EXPECT_LT(max_rel_difference(fine, auto_grid), 1e-3);
+  EXPECT_GT(max_rel_difference(fine, coarse), 1e-2);
   std::ifstream j(dir_ / "auto" / "run.json");
   const std::string json((std::istreambuf_iterator<char>(j)), std::istreambuf_iterator<char>());
   EXPECT_NE(json.find("\"grid_refined_from_deg\": 10"), std::string::npos) << json;
@@ -201,21 +220,7 @@ TEST_F(Cli, ADefaultGridWhoseRunMissesItsEnergyBalanceIsRefined) {
 // changes 1.7e-6 on 2.5°), within 1e-4 of the full model. A given grid is not checked.
 TEST_F(Cli, ADefaultGridIsCheckedAgainstTheRunOnHalfIt) {
   auto knee = [&](const std::string& args, const std::string& name, std::string* said = nullptr) {
-    const auto out = dir_ / name;
-    const CliRun r = rdyn("simulate bicycle " + args + " --duration 1.5 --dt-out 0.005 --out " + out.string());
-    EXPECT_EQ(r.status, 0) << r.output;
-    if (said) *said = r.output;
-    std::ifstream f(out / "timeseries.csv");
-    std::string line;
-    std::getline(f, line);
-    const size_t col = static_cast<size_t>(std::count(line.begin(), line.begin() + line.find("F_knee"), ','));
-    std::vector<double> v;
-    while (std::getline(f, line)) {
-      size_t a = 0;
-      for (size_t k = 0; k < col; ++k) a = line.find(',', a) + 1;
-      v.push_back(std::stod(line.substr(a, line.find(',', a) - a)));
-    }
-    return v;
+    return simulated("bicycle " + args + " --duration 1.5 --dt-out 0.005", name, "F_knee", said);
   };
   std::string said;
   const auto full = knee("--model full", "full");
@@ -226,14 +231,8 @@ TEST_F(Cli, ADefaultGridIsCheckedAgainstTheRunOnHalfIt) {
             std::string::npos) << said;
   ASSERT_EQ(checked.size(), full.size());
   ASSERT_EQ(given.size(), full.size());
-  double peak = 0, d_checked = 0, d_given = 0;
-  for (size_t i = 0; i < full.size(); ++i) {
-    peak = std::max(peak, std::abs(full[i]));
-    d_checked = std::max(d_checked, std::abs(checked[i] - full[i]));
-    d_given = std::max(d_given, std::abs(given[i] - full[i]));
-  }
-  EXPECT_LT(d_checked, 1e-4 * peak);
-  EXPECT_GT(d_given, 1e-3 * peak);
+  EXPECT_LT(max_rel_difference(full, checked), 1e-4);
+  EXPECT_GT(max_rel_difference(full, given), 1e-3);
   std::ifstream j(dir_ / "checked" / "run.json");
   const auto run = nlohmann::json::parse(j);
   EXPECT_EQ(run["grid_deg"].get<double>(), 5);
@@ -243,25 +242,6 @@ TEST_F(Cli, ADefaultGridIsCheckedAgainstTheRunOnHalfIt) {
   EXPECT_LT(run["grid_check"]["change"].get<double>(), 5e-4);
   std::ifstream g(dir_ / "given" / "run.json");
   EXPECT_FALSE(nlohmann::json::parse(g).contains("grid_check"));
-}
-
-// Every column of a timeseries.csv, by name.
-std::map<std::string, std::vector<double>> read_columns(const fs::path& csv) {
-  std::ifstream f(csv);
-  std::string line;
-  std::getline(f, line);
-  std::vector<std::string> names;
-  for (size_t a = 0, b; a <= line.size(); a = b + 1) {
-    b = std::min(line.find(',', a), line.size());
-    names.push_back(line.substr(a, b - a));
-  }
-  std::map<std::string, std::vector<double>> cols;
-  while (std::getline(f, line))
-    for (size_t a = 0, b, k = 0; a <= line.size() && k < names.size(); a = b + 1, ++k) {
-      b = std::min(line.find(',', a), line.size());
-      cols[names[k]].push_back(std::stod(line.substr(a, b - a)));
-    }
-  return cols;
 }
 
 // A gate open over ~8° of the crank a turn (5–20 ms; a five-bar geared 3:1, its tool torque on
