@@ -659,10 +659,14 @@ models::Scene reduced_output_scene(const models::Scene& scene, nlohmann::json& r
   if (!scene.outputs.reactions_all) return scene;
   auto split = reduced::split_reduced_reactions(scene);
   if (!split.not_given.empty()) {
+    // Said once: the grid check's runs start from a run.json that already says it.
+    const bool said = run.contains("reactions_not_given");
     auto ng = nlohmann::json::array();
     for (const auto& [name, why] : split.not_given) {
-      std::fprintf(stderr, "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
-                   name.c_str(), why.c_str());
+      if (!said)
+        std::fprintf(stderr,
+                     "rdyn: warning: the reduced model does not give reaction '%s' (run --model full for it): %s\n",
+                     name.c_str(), why.c_str());
       ng.push_back({{"reaction", name}, {"why", why}});
     }
     run["reactions_not_given"] = ng;
