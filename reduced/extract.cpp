@@ -327,9 +327,8 @@ void bracket_gate(KinetostaticSource& src, const GridPlan& g, const Samples& s, 
   c.gate_roots[gj].push_back(root ? *root : refine_root(src, j, a, ra, b, rb, est));
 }
 
-// A point force's line shortening then lengthening between samples i0 and i1: its points may
-// meet in between (the full model stops there with NumericalError; so does the extraction,
-// naming the load).
+// A point force's line shortening then lengthening between samples i0 and i1: its points may meet in
+// between (the full model stops there; so does the extraction, PointForceMeeting naming the load).
 void check_point_force_meeting(KinetostaticSource& src, const models::Scene& scene, const Samples& s,
                                const SweepColumns& c, long i0, long i1, double offset) {
   for (size_t f = 0; f < c.Lq.size(); ++f)
