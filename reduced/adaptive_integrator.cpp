@@ -282,6 +282,82 @@ struct AdaptiveIntegrator::Impl {
   // trajectory with single steps from the start of the step (dg/dt = g_q q̇ + g_q̇ q̈, the
   // partials by central differences of g), then moved just past the crossing so the sign
   // has changed where the step is cut. Typically three single steps per crossing.
+  // Budgets: every run ends, in steps and in wall time (the clock is read every 64 steps); a run
+  // that cannot finish fails early (NumericalError).
+  void check_budgets(double t_end) {
+    const long attempted = steps + static_cast<long>(evolve->failed_steps);
+    if (attempted >= limits.max_steps)
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s: it used its budget of {} steps (the run needs more; "
+          "loosen the tolerance or shorten the duration)",
+          ws.t, limits.max_steps));
+    // Hopeless runs fail early, as the full model's (engine/forward_dynamics.cpp, check_budgets):
+    // every kWindow accepted steps, the steps still needed to reach t_end at the window's mean step;
+    // more than kHopeless budgets will not finish. A motor stalled against a rate-gated load
+    // chatters at the gate's switch with steps of ~1e-13 s: the full model stopped in 5 s, the
+    // reduced one ran for minutes (issue #23's shaper).
+    constexpr long kWindow = 1000;
+    constexpr double kHopeless = 100.0;
+    // A window of steps that left t where it was (cuts at a gate chattering at a standstill, each
+    // below t's ulp) is as hopeless: it was not counted, and a Jansen leg stalled against a backstop
+    // gate ran 8 minutes to its step budget, whose message blamed the tolerance.
+    if (steps > 0 && steps % kWindow == 0 && ws.t == window_t0)
+      throw models::NumericalError(fmt::format(
+          "reduced integration stopped at t = {:.6g} s of {:.6g} s ({}, q̇ = {:.3g} {}): its last {} steps did not "
+          "advance the time: the motion is too stiff or too fast (a load switching back and forth at a standstill, a "
+          "stalled drive)",
+          ws.t, t_end, describe_q(m.revolute, ws.q), ws.qdot, m.revolute ? "rad/s" : "m/s", kWindow));
+    if (steps > 0 && steps % kWindow == 0 && ws.t != window_t0) {
+      const double mean_h = (ws.t - window_t0) / kWindow;
+      const double needed = static_cast<double>(attempted) + (t_end - ws.t) / std::max(mean_h, 1e-300);
+      window_t0 = ws.t;
+      if (needed > kHopeless * static_cast<double>(limits.max_steps))
+        throw models::NumericalError(fmt::format(
+            "reduced integration stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) "
+            "it would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or too fast "
+            "(a load switching back and forth at a standstill, a stalled drive)",
+            ws.t, t_end, kWindow, mean_h, needed, kHopeless, limits.max_steps));
+    }
+    if (steps % 64 == 0) {
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      if (wall > limits.max_wall_s)
+        throw models::NumericalError(fmt::format(
+            "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps",
+            ws.t, limits.max_wall_s, steps));
+    }
+  }
+
+  // After a successful step from (t_prev, y_prev) to (t, y): returns the GSL status of the step
+  // finally kept.
+  int retake_over_gate_window(double t_prev, const double y_prev[3], double& t) {
+    const size_t ng = m.gates.size();
+    // A gate window the step passed whole (q crossed two switch angles, so the switching function
+    // has one sign at both ends) is not seen by its sign: the step is taken again to the middle of
+    // the window (linear in q; again while it still passes one, at most kWindowRetries times), so
+    // that its end lies inside and the crossing is located below. A five-bar's gate on a joint
+    // that turns the gated way over 8° of the crank (5–20 ms a turn) was stepped over every turn
+    // by the default 1e-8 rk8pd: 26 switches against the full model's 28, its forces 60 % off.
+    constexpr int kWindowRetries = 8;
+    int st = GSL_SUCCESS;
+    for (int k = 0; k < kWindowRetries && st == GSL_SUCCESS && y_prev[1] * y[1] > 0; ++k) {
+      double f = 1.0;
+      for (size_t g = 0; g < ng; ++g) {
+        const double after = calc_switching(m, static_cast<int>(g), y[0], y[1]);
+        if (s_before[g] != 0.0 && (s_before[g] > 0) == (after > 0))
+          f = std::min(f, calc_gate_window_fraction(m, static_cast<int>(g), y_prev[0], y[0]));
+      }
+      if (!(f > 0.0 && f < 1.0)) break;
+      const double h_try = (t - t_prev) * f;
+      if (!(t_prev + h_try > t_prev)) break;
+      t = t_prev;
+      for (int j = 0; j < 3; ++j) y[j] = y_prev[j];
+      double h_step = h_try;
+      st = evolve_apply(&t, t_prev + h_try, &h_step, y);
+      h = std::min(h, h_step);
+    }
+    return st;
+  }
+
   struct Cut {
     double h = 0.0;
     double y[3] = {0, 0, 0};
@@ -359,47 +435,7 @@ void AdaptiveIntegrator::reset(double t, double q, double qdot, double work) {
 bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   auto& d = *impl_;
   const auto& m = d.m;
-  // Budgets: every run ends, in steps and in wall time (the clock is read every 64 steps).
-  const long attempted = d.steps + static_cast<long>(d.evolve->failed_steps);
-  if (attempted >= d.limits.max_steps)
-    throw models::NumericalError(fmt::format(
-        "reduced integration stopped at t = {:.6g} s: it used its budget of {} steps (the run needs more; "
-        "loosen the tolerance or shorten the duration)",
-        d.ws.t, d.limits.max_steps));
-  // Hopeless runs fail early, as the full model's (engine/forward_dynamics.cpp, check_budgets):
-  // every kWindow accepted steps, the steps still needed to reach t_end at the window's mean step;
-  // more than kHopeless budgets will not finish. A motor stalled against a rate-gated load
-  // chatters at the gate's switch with steps of ~1e-13 s: the full model stopped in 5 s, the
-  // reduced one ran for minutes (issue #23's shaper).
-  constexpr long kWindow = 1000;
-  constexpr double kHopeless = 100.0;
-  // A window of steps that left t where it was (cuts at a gate chattering at a standstill, each
-  // below t's ulp) is as hopeless: it was not counted, and a Jansen leg stalled against a backstop
-  // gate ran 8 minutes to its step budget, whose message blamed the tolerance.
-  if (d.steps > 0 && d.steps % kWindow == 0 && d.ws.t == d.window_t0)
-    throw models::NumericalError(fmt::format(
-        "reduced integration stopped at t = {:.6g} s of {:.6g} s ({}, q̇ = {:.3g} {}): its last {} steps did not "
-        "advance the time: the motion is too stiff or too fast (a load switching back and forth at a standstill, a "
-        "stalled drive)",
-        d.ws.t, t_end, describe_q(m.revolute, d.ws.q), d.ws.qdot, m.revolute ? "rad/s" : "m/s", kWindow));
-  if (d.steps > 0 && d.steps % kWindow == 0 && d.ws.t != d.window_t0) {
-    const double mean_h = (d.ws.t - d.window_t0) / kWindow;
-    const double needed = static_cast<double>(attempted) + (t_end - d.ws.t) / std::max(mean_h, 1e-300);
-    d.window_t0 = d.ws.t;
-    if (needed > kHopeless * static_cast<double>(d.limits.max_steps))
-      throw models::NumericalError(fmt::format(
-          "reduced integration stopped at t = {:.6g} s of {:.6g} s: at its mean step of the last {} steps ({:.3g} s) "
-          "it would need ~{:.3g} steps, more than {:g} × the step budget of {}: the motion is too stiff or too fast "
-          "(a load switching back and forth at a standstill, a stalled drive)",
-          d.ws.t, t_end, kWindow, mean_h, needed, kHopeless, d.limits.max_steps));
-  }
-  if (d.steps % 64 == 0) {
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - d.started).count();
-    if (wall > d.limits.max_wall_s)
-      throw models::NumericalError(fmt::format(
-          "reduced integration stopped at t = {:.6g} s: it used its wall-time budget of {:g} s after {} steps",
-          d.ws.t, d.limits.max_wall_s, d.steps));
-  }
+  d.check_budgets(t_end);
   if (std::find(d.pending.begin(), d.pending.end(), 1) != d.pending.end()) {
     for (size_t g = 0; g < d.pending.size(); ++g)
       if (d.pending[g]) d.ws.gate_on[g] = !d.ws.gate_on[g], d.pending[g] = 0;
@@ -422,29 +458,7 @@ bool AdaptiveIntegrator::step(double t_end, double q_stop) {
   d.flipped = false;
   const double stop_before = stop_at_q ? y_prev[0] - q_stop : 0.0;
   int st = d.evolve_apply(&t, t_end, &d.h, d.y);
-  // A gate window the step passed whole (q crossed two switch angles, so the switching function
-  // has one sign at both ends) is not seen by its sign: the step is taken again to the middle of
-  // the window (linear in q; again while it still passes one, at most kWindowRetries times), so
-  // that its end lies inside and the crossing is located below. A five-bar's gate on a joint
-  // that turns the gated way over 8° of the crank (5–20 ms a turn) was stepped over every turn
-  // by the default 1e-8 rk8pd: 26 switches against the full model's 28, its forces 60 % off.
-  constexpr int kWindowRetries = 8;
-  for (int k = 0; k < kWindowRetries && st == GSL_SUCCESS && y_prev[1] * d.y[1] > 0; ++k) {
-    double f = 1.0;
-    for (size_t g = 0; g < ng; ++g) {
-      const double after = calc_switching(m, static_cast<int>(g), d.y[0], d.y[1]);
-      if (d.s_before[g] != 0.0 && (d.s_before[g] > 0) == (after > 0))
-        f = std::min(f, calc_gate_window_fraction(m, static_cast<int>(g), y_prev[0], d.y[0]));
-    }
-    if (!(f > 0.0 && f < 1.0)) break;
-    const double h_try = (t - t_prev) * f;
-    if (!(t_prev + h_try > t_prev)) break;
-    t = t_prev;
-    for (int j = 0; j < 3; ++j) d.y[j] = y_prev[j];
-    double h = h_try;
-    st = d.evolve_apply(&t, t_prev + h_try, &h, d.y);
-    d.h = std::min(d.h, h);
-  }
+  if (st == GSL_SUCCESS) st = d.retake_over_gate_window(t_prev, y_prev, t);
   if (st != GSL_SUCCESS)
     throw models::NumericalError(fmt::format("reduced integration failed at t = {:.6g} s ({}, q̇ = {:.6g} {}): {}",
                                              t_prev, describe_q(m.revolute, y_prev[0]), y_prev[1],
